@@ -1,0 +1,71 @@
+#include "core/reference_trial.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/central_difference_integrator.hpp"
+#include "core/contact_trajectory.hpp"
+
+namespace hapticsim {
+
+std::string_view TrialOutcomeName(TrialOutcome outcome) {
+  switch (outcome) {
+    case TrialOutcome::kCompleted:
+      return "completed";
+    case TrialOutcome::kPredictedUnstable:
+      return "predicted unstable";
+    case TrialOutcome::kDivergedNonFinite:
+      return "diverged: non-finite values";
+    case TrialOutcome::kDivergedEnergy:
+      return "diverged: energy growth";
+  }
+  return "unknown";
+}
+
+TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options) {
+  const Scene& scene = cube.scene();
+  const ElasticModel& model = cube.model();
+  TrialResult result;
+  result.stability = EstimateStability(model);
+  const double dt = scene.solver.dt_s;
+  if (!result.stability.IsStable(dt) && !options.run_if_predicted_unstable) {
+    result.outcome = TrialOutcome::kPredictedUnstable;
+    return result;
+  }
+
+  CentralDifferenceIntegrator integrator(model, dt);
+  const ContactTrajectory trajectory(scene.input);
+  const long steps = scene.num_steps();
+  result.samples.reserve(static_cast<size_t>(steps) + 1);
+
+  const auto start = std::chrono::steady_clock::now();
+  // Step n goes from tₙ to tₙ₊₁ and yields the reaction at tₙ, so steps 0…N give samples 0…N.
+  for (long n = 0; n <= steps; ++n) {
+    const double t = n * dt;
+    const std::array<double, 3> next{0.0, 0.0, trajectory.DepthAt(t + dt)};
+    const StepStatus status = integrator.Step(next);
+    if (status != StepStatus::kOk) {
+      result.outcome = status == StepStatus::kNonFinite ? TrialOutcome::kDivergedNonFinite
+                                                        : TrialOutcome::kDivergedEnergy;
+      break;
+    }
+    ForceSample sample;
+    sample.t_s = t;
+    sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
+    const auto reaction = integrator.driven_reaction();
+    double magnitude2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      sample.feedback_force_n[c] = -reaction[c];
+      magnitude2 += reaction[c] * reaction[c];
+    }
+    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(magnitude2));
+    result.samples.push_back(sample);
+    result.stopped_at_s = t;
+  }
+  result.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.steps = integrator.steps_taken();
+  return result;
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <array>
+#include <string_view>
+#include <vector>
+
+#include "core/cube_scene.hpp"
+#include "core/stability_estimate.hpp"
+
+namespace hapticsim {
+
+/** How a run ended. */
+enum class TrialOutcome {
+  kCompleted,
+  kPredictedUnstable,   ///< refused before the first step: dt ≥ the critical step
+  kDivergedNonFinite,   ///< detected during the run: a non-finite value
+  kDivergedEnergy,      ///< detected during the run: energy beyond the passivity budget
+};
+
+std::string_view TrialOutcomeName(TrialOutcome outcome);
+
+/** One sample of the force time series. */
+struct ForceSample {
+  double t_s = 0;                                  ///< time, s
+  std::array<double, 3> contact_displacement_m{};  ///< prescribed contact displacement, m
+  std::array<double, 3> feedback_force_n{};        ///< force on the user, −R, N
+};
+
+struct TrialResult {
+  TrialOutcome outcome = TrialOutcome::kCompleted;
+  StabilityEstimate stability;
+  std::vector<ForceSample> samples;  ///< t = 0, dt, …, duration (fewer if it diverged)
+  long steps = 0;                    ///< time steps taken
+  double stopped_at_s = 0;           ///< time of the last completed step
+  double peak_force_n = 0;           ///< max |feedback force| over the samples, N
+  double wall_time_s = 0;            ///< compute time of the stepping loop, s
+
+  bool diverged() const {
+    return outcome == TrialOutcome::kDivergedNonFinite || outcome == TrialOutcome::kDivergedEnergy;
+  }
+};
+
+struct TrialOptions {
+  /** Run even when the prediction says dt is past the stability limit (to watch detection). */
+  bool run_if_predicted_unstable = false;
+};
+
+/**
+ * The full-resolution reference simulation of a scene: the whole cube at the finest mesh,
+ * stepped by central difference over the trial, with the stability limit predicted before the
+ * first step and divergence detected during the run.
+ */
+TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options = {});
+
+}  // namespace hapticsim

@@ -1,0 +1,83 @@
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/material.hpp"
+
+namespace hapticsim {
+
+/** How the device drives the contact node along the inward normal (+z). */
+enum class Waveform {
+  kPress,  ///< s·(1 − cos 2πft)/2: a smooth press into the object and back, no velocity jump
+  kSine,   ///< s·sin 2πft: in and out of the object around the rest position
+};
+
+struct MeshSettings {
+  int nodes = 13;        ///< nodes per axis of the cube (mesh.nodes)
+  double edge_m = 0.25;  ///< cube edge length, m (mesh.edge)
+};
+
+struct InputSettings {
+  double amplitude_m = 0.01;           ///< s, m (input.amplitude)
+  double frequency_hz = 1.0;           ///< f, Hz (input.frequency)
+  Waveform waveform = Waveform::kPress;  ///< input.waveform
+  double periods = 1.0;                ///< trial length in periods of f (input.periods)
+};
+
+struct SolverSettings {
+  double dt_s = 1e-3;  ///< time step, s (solver.dt)
+};
+
+/**
+ * Everything that defines a simulation trial. The defaults are the paper's scene: a cube of
+ * edge 0.25 m with 13×13×13 nodes, the four back-face corners fixed, the middle node of the
+ * front face driven by a 1 cm press at 1 Hz for one period, E = 10 kPa, ν = 0.45,
+ * ρ = 1000 kg/m³, d = 10 1/s, dt = 1 ms.
+ */
+struct Scene {
+  MeshSettings mesh;
+  Material material;
+  InputSettings input;
+  SolverSettings solver;
+
+  /** Trial length in seconds: periods / frequency. */
+  double duration_s() const { return input.periods / input.frequency_hz; }
+  /** Number of time steps in the trial (the duration rounded to whole steps). */
+  long num_steps() const;
+};
+
+std::string_view WaveformName(Waveform waveform);
+
+/**
+ * One settable scene key ("section.key"). The table of keys is the single source of truth for
+ * scene files, --set overrides, printing and validation.
+ */
+struct SceneKeyInfo {
+  std::string_view name;     ///< e.g. "material.poisson_ratio"
+  std::string_view unit;     ///< SI unit, or "" when dimensionless
+  std::string_view allowed;  ///< the allowed range, as a message fragment
+  std::string_view meaning;  ///< one line for --help and docs
+};
+
+/** All keys, in the order they are printed. */
+const std::vector<SceneKeyInfo>& SceneKeys();
+
+/**
+ * Sets `key` from its textual value (as given to --set or read from a scene file).
+ * @throws Error naming the key when the key is unknown, the text is not a value of the key's
+ *         type, or the value is outside the key's allowed range.
+ */
+void SetSceneValue(Scene* scene, std::string_view key, std::string_view value_text);
+
+/** The value of `key` as text that SetSceneValue() reads back to the same value. */
+std::string GetSceneValue(const Scene& scene, std::string_view key);
+
+/**
+ * Checks every key's range and the relations between keys.
+ * @throws Error with one message naming the key and its allowed range.
+ */
+void ValidateScene(const Scene& scene);
+
+}  // namespace hapticsim

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "core/hex_grid.hpp"
+#include "core/material.hpp"
+#include "core/stiffness_operator.hpp"
+
+namespace hapticsim {
+
+/**
+ * Matrix-free K·u on a structured grid of identical cube elements: a 27-point node stencil.
+ *
+ * On a structured grid every node sees the same element matrix, so row i of K is a fixed 3×3
+ * block for each of its 27 neighbours, depending only on which of the 8 surrounding elements
+ * exist. That is decided per axis by whether the node lies on the low face, inside, or on the
+ * high face: 3³ = 27 node classes. The stencils of all classes are precomputed from the element
+ * matrix at construction (zero couplings dropped), so Apply() is a pure streaming loop over the
+ * component-blocked arrays: no index arrays, no matrix storage, rows of x vectorised.
+ */
+class StencilStiffness final : public StiffnessOperator {
+ public:
+  StencilStiffness(const HexGrid& grid, const Material& material);
+
+  void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+             Eigen::Ref<Eigen::VectorXd> ku) const override;
+  Eigen::VectorXd Diagonal() const override;
+
+  /** Floating-point operations of one Apply() (2 per stored coupling and node). */
+  double FlopsPerApply() const;
+
+ private:
+  // One coupling: ku_a[i] += coefficient · u[i + offset], where offset already includes the
+  // component block of the source (b·N) and the neighbour's node stride.
+  struct Term {
+    std::ptrdiff_t offset;
+    double coefficient;
+  };
+  // Terms of one node class, split by output component a.
+  using ClassStencil = std::array<std::vector<Term>, 3>;
+
+  static int AxisClass(int index, int count) {
+    return index == 0 ? 0 : (index == count - 1 ? 2 : 1);
+  }
+  void ApplyRow(const double* u, double* ku, int iy, int iz) const;
+
+  HexGrid grid_;
+  std::array<ClassStencil, 27> stencils_;
+};
+
+}  // namespace hapticsim

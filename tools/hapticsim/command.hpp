@@ -1,0 +1,28 @@
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace hapticsim::cli {
+
+/** Exit statuses shared by every subcommand. */
+enum ExitStatus : int {
+  kExitOk = 0,
+  kExitInternalError = 1,
+  kExitBadInput = 2,   ///< bad command line, scene file or value: the message names the key
+  kExitUnstable = 3,   ///< the run was refused as unstable or diverged
+};
+
+/** A registered subcommand: its CLI11 app and what to run when it was chosen. */
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command AddSimulateCommand(CLI::App& parent);
+Command AddStaticCommand(CLI::App& parent);
+Command AddStabilityCommand(CLI::App& parent);
+Command AddSceneCommand(CLI::App& parent);
+
+}  // namespace hapticsim::cli

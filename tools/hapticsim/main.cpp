@@ -1,0 +1,48 @@
+// hapticsim: the command-line front end of the simulation core.
+//
+//   hapticsim simulate [--out forces.csv] [--plot forces.svg]   reference run of a scene
+//   hapticsim static                                             static contact reaction
+//   hapticsim stability                                          critical time step
+//   hapticsim scene                                              the effective scene as TOML
+//
+// Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
+// 1 anything else.
+#include <iostream>
+#include <vector>
+
+#include "core/error.hpp"
+#include "tools/hapticsim/command.hpp"
+
+int main(int argc, char** argv) {
+  using namespace hapticsim::cli;
+  CLI::App app{
+      "hapticsim: force feedback from a deforming soft-tissue model (linear hexahedral FEM),\n"
+      "with the error of that force. Units are SI throughout. Run a subcommand with --help.",
+      "hapticsim"};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Help for every subcommand");
+  const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
+                                      AddStabilityCommand(app), AddSceneCommand(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+  try {
+    for (const Command& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
+  } catch (const hapticsim::Error& e) {
+    std::cerr << "hapticsim: error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "hapticsim: internal error: " << e.what() << "\n";
+    return kExitInternalError;
+  }
+  return kExitInternalError;
+}

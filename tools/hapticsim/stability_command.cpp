@@ -1,0 +1,56 @@
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/cube_scene.hpp"
+#include "core/stability_estimate.hpp"
+#include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/format.hpp"
+#include "tools/hapticsim/scene_options.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+int Run(const SceneOptions& options) {
+  const Scene scene = options.Resolve();
+  const CubeScene cube(scene);
+  const StabilityEstimate estimate = EstimateStability(cube.model());
+  const double dt = scene.solver.dt_s;
+  const bool stable = estimate.IsStable(dt);
+
+  if (options.json) {
+    nlohmann::json out;
+    out["critical_dt_s"] = estimate.critical_dt_s;
+    out["dt_s"] = dt;
+    out["stable"] = stable;
+    out["element_bound_dt_s"] = estimate.element_bound_dt_s;
+    out["omega_max_rad_s"] = estimate.omega_max_rad_s;
+    out["power_iterations"] = estimate.iterations;
+    out["power_iteration_converged"] = estimate.converged;
+    out["dt_fraction_of_critical"] = dt / estimate.critical_dt_s;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::cout << "Stability of central difference: " << scene.mesh.nodes << "³-node cube\n"
+              << "  critical dt (2/ω_max, power iteration on M⁻¹K): "
+              << Duration(estimate.critical_dt_s) << "  (ω_max "
+              << Quantity(estimate.omega_max_rad_s, "rad/s") << ", " << estimate.iterations
+              << " iterations" << (estimate.converged ? "" : ", NOT converged") << ")\n"
+              << "  element-level bound (never above the limit): "
+              << Duration(estimate.element_bound_dt_s) << "\n"
+              << "  dt = " << Duration(dt) << " is " << Quantity(100 * dt / estimate.critical_dt_s, "%")
+              << " of the critical step: " << (stable ? "stable" : "UNSTABLE") << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command AddStabilityCommand(CLI::App& parent) {
+  auto options = std::make_shared<SceneOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "stability", "Critical time step of the scene and whether its solver.dt is below it");
+  AddSceneOptions(app, options.get());
+  return {app, [options] { return Run(*options); }};
+}
+
+}  // namespace hapticsim::cli

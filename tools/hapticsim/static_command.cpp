@@ -1,0 +1,56 @@
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/cube_scene.hpp"
+#include "core/static_solver.hpp"
+#include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/format.hpp"
+#include "tools/hapticsim/scene_options.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+int Run(const SceneOptions& options) {
+  const Scene scene = options.Resolve();
+  const CubeScene cube(scene);
+  const std::array<double, 3> driven{0.0, 0.0, scene.input.amplitude_m};
+  const StaticSolution solution = SolveStatic(cube.model(), driven);
+  const auto& r = solution.driven_reaction;
+  const double stiffness = scene.input.amplitude_m > 0 ? r[2] / scene.input.amplitude_m : 0.0;
+
+  if (options.json) {
+    nlohmann::json out;
+    out["reaction_force_N"] = {r[0], r[1], r[2]};
+    out["feedback_force_N"] = {-r[0], -r[1], -r[2]};
+    out["contact_displacement_m"] = {0.0, 0.0, scene.input.amplitude_m};
+    out["contact_stiffness_N_per_m"] = stiffness;
+    out["cg_iterations"] = solution.iterations;
+    out["relative_residual"] = solution.relative_residual;
+    out["converged"] = solution.converged;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::cout << "Static contact reaction: " << scene.mesh.nodes << "³-node cube, contact pressed "
+              << Quantity(scene.input.amplitude_m, "m") << " into the object (+z)\n"
+              << "  reaction on the object (holds the displacement): [" << Quantity(r[0], "N")
+              << ", " << Quantity(r[1], "N") << ", " << Quantity(r[2], "N") << "]\n"
+              << "  force on the user: " << Quantity(-r[2], "N") << " along z\n"
+              << "  contact stiffness: " << Quantity(stiffness, "N/m") << "\n"
+              << "  conjugate gradients: " << solution.iterations << " iterations, relative residual "
+              << solution.relative_residual << (solution.converged ? "" : " (NOT converged)")
+              << "\n";
+  }
+  return solution.converged ? kExitOk : kExitInternalError;
+}
+
+}  // namespace
+
+Command AddStaticCommand(CLI::App& parent) {
+  auto options = std::make_shared<SceneOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "static", "Static reaction at the contact for the scene's input amplitude (CG solve)");
+  AddSceneOptions(app, options.get());
+  return {app, [options] { return Run(*options); }};
+}
+
+}  // namespace hapticsim::cli
