@@ -11,6 +11,15 @@
 namespace hapticsim {
 
 /**
+ * One coupling of a stencil: ku_a[i] += coefficient · u[i + offset], where offset already includes
+ * the component block of the source (b·N) and the neighbour's node stride.
+ */
+struct StencilTerm {
+  std::ptrdiff_t offset;
+  double coefficient;
+};
+
+/**
  * Matrix-free K·u on a structured grid of identical cube elements: a 27-point node stencil.
  *
  * On a structured grid every node sees the same element matrix, so row i of K is a fixed 3×3
@@ -32,14 +41,8 @@ class StencilStiffness final : public StiffnessOperator {
   double FlopsPerApply() const;
 
  private:
-  // One coupling: ku_a[i] += coefficient · u[i + offset], where offset already includes the
-  // component block of the source (b·N) and the neighbour's node stride.
-  struct Term {
-    std::ptrdiff_t offset;
-    double coefficient;
-  };
   // Terms of one node class, split by output component a.
-  using ClassStencil = std::array<std::vector<Term>, 3>;
+  using ClassStencil = std::array<std::vector<StencilTerm>, 3>;
 
   static int AxisClass(int index, int count) {
     return index == 0 ? 0 : (index == count - 1 ? 2 : 1);

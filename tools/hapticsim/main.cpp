@@ -8,6 +8,7 @@
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
 // 1 anything else.
 #include <iostream>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -23,6 +24,20 @@ int main(int argc, char** argv) {
   app.set_help_all_flag("--help-all", "Help for every subcommand");
   const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
                                       AddStabilityCommand(app), AddSceneCommand(app)};
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string chosen = argv[1];
+    bool known = false;
+    std::string names;
+    for (const Command& command : commands) {
+      known = known || command.app->get_name() == chosen;
+      names += (names.empty() ? "" : ", ") + command.app->get_name();
+    }
+    if (!known) {
+      std::cerr << "hapticsim: error: unknown subcommand '" << chosen << "'; choose one of "
+                << names << " (see hapticsim --help)\n";
+      return kExitBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

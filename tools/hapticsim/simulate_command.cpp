@@ -81,7 +81,7 @@ int Run(const SimulateOptions& options) {
               << Quantity(scene.input.frequency_hz, "Hz") << " for "
               << Duration(scene.duration_s()) << ", dt " << Duration(scene.solver.dt_s) << "\n";
     std::cout << "  stability: critical dt " << Duration(result.stability.critical_dt_s)
-              << " (power iteration), dt is "
+              << " (Lanczos on M⁻¹K), dt is "
               << (result.stability.IsStable(scene.solver.dt_s) ? "below it: stable"
                                                                 : "NOT below it: unstable")
               << "\n";

@@ -25,13 +25,13 @@ int Run(const SceneOptions& options) {
     out["stable"] = stable;
     out["element_bound_dt_s"] = estimate.element_bound_dt_s;
     out["omega_max_rad_s"] = estimate.omega_max_rad_s;
-    out["power_iterations"] = estimate.iterations;
-    out["power_iteration_converged"] = estimate.converged;
+    out["eigen_iterations"] = estimate.iterations;
+    out["eigen_converged"] = estimate.converged;
     out["dt_fraction_of_critical"] = dt / estimate.critical_dt_s;
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << "Stability of central difference: " << scene.mesh.nodes << "³-node cube\n"
-              << "  critical dt (2/ω_max, power iteration on M⁻¹K): "
+              << "  critical dt (2/ω_max, Lanczos on M⁻¹K): "
               << Duration(estimate.critical_dt_s) << "  (ω_max "
               << Quantity(estimate.omega_max_rad_s, "rad/s") << ", " << estimate.iterations
               << " iterations" << (estimate.converged ? "" : ", NOT converged") << ")\n"

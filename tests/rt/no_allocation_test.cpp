@@ -1,0 +1,38 @@
+// The time step runs in the 1 kHz thread: it must never touch the heap.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/central_difference_integrator.hpp"
+#include "core/contact_trajectory.hpp"
+#include "core/cube_scene.hpp"
+#include "tests/support/allocation_counter.hpp"
+
+namespace hapticsim {
+namespace {
+
+TEST(AllocationCounter, SeesOperatorNewAndMalloc) {
+  // The counter itself must be able to fail: a test that cannot fail proves nothing.
+  testing::ScopedAllocationCount count;
+  auto boxed = std::make_unique<std::vector<double>>(1000);
+  void* volatile raw = std::malloc(64);  // volatile: the compiler may not elide the pair
+  std::free(raw);
+  EXPECT_GE(count.count(), 3u);
+}
+
+TEST(TimeStep, NeverAllocates) {
+  const CubeScene cube(Scene{});
+  CentralDifferenceIntegrator dut(cube.model(), cube.scene().solver.dt_s);
+  const ContactTrajectory trajectory(cube.scene().input);
+  std::array<double, 3> next{};
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 500; ++n) {
+    next[2] = trajectory.DepthAt((n + 1) * 1e-3);
+    ASSERT_EQ(dut.Step(next), StepStatus::kOk);
+  }
+  EXPECT_EQ(count.count(), 0u);
+}
+
+}  // namespace
+}  // namespace hapticsim

@@ -1,0 +1,148 @@
+// The hapticsim binary as a user runs it: exit statuses, JSON shapes, files written, and the
+// messages bad input gets.
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/run_command.hpp"
+
+namespace hapticsim {
+namespace {
+
+using testing::CommandResult;
+
+CommandResult Hapticsim(std::vector<std::string> args) {
+  args.insert(args.begin(), HAPTICSIM_CLI_PATH);
+  return testing::RunCommand(args);
+}
+
+nlohmann::json Json(const CommandResult& result) {
+  EXPECT_EQ(result.exit_status, 0) << result.err;
+  return nlohmann::json::parse(result.out);
+}
+
+std::string Temp(const std::string& name) { return ::testing::TempDir() + name; }
+
+TEST(HapticsimCli, HelpListsTheSubcommands) {
+  const CommandResult result = Hapticsim({"--help"});
+  EXPECT_EQ(result.exit_status, 0);
+  for (const char* sub : {"simulate", "static", "stability", "scene"}) {
+    EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
+  }
+}
+
+TEST(HapticsimCli, SimulateJsonReportsTheRunAndWritesTheSeries) {
+  const std::string csv = Temp("cli_forces.csv");
+  const auto json = Json(Hapticsim({"simulate", "--json", "--out", csv}));
+  EXPECT_EQ(json["outcome"], "completed");
+  EXPECT_EQ(json["diverged"], false);
+  EXPECT_EQ(json["predicted_stable"], true);
+  EXPECT_EQ(json["steps"], 1001);
+  EXPECT_DOUBLE_EQ(json["duration_s"].get<double>(), 1.0);
+  EXPECT_GT(json["peak_force_N"].get<double>(), 0.5);
+  EXPECT_GT(json["wall_time_s"].get<double>(), 0.0);
+  EXPECT_EQ(json["time_series_csv"], csv);
+
+  std::ifstream in(csv);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header, "t_s,contact_ux_m,contact_uy_m,contact_uz_m,force_x_N,force_y_N,force_z_N");
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 1001);
+}
+
+TEST(HapticsimCli, SimulateDrawsAPlot) {
+  const std::string svg = Temp("cli_forces.svg");
+  const CommandResult result = Hapticsim({"simulate", "--set", "mesh.nodes=7", "--plot", svg});
+  ASSERT_EQ(result.exit_status, 0) << result.err;
+  std::ifstream in(svg);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str().rfind("<svg", 0), 0u);
+  EXPECT_NE(text.str().find("polyline"), std::string::npos);
+}
+
+TEST(HapticsimCli, StaticJsonGivesTheReactionThatHoldsTheContact) {
+  const auto json = Json(Hapticsim({"static", "--json"}));
+  ASSERT_EQ(json["reaction_force_N"].size(), 3u);
+  EXPECT_GT(json["reaction_force_N"][2].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(json["feedback_force_N"][2].get<double>(),
+                   -json["reaction_force_N"][2].get<double>());
+  EXPECT_EQ(json["converged"], true);
+}
+
+TEST(HapticsimCli, StabilityJsonComparesDtWithTheCriticalStep) {
+  const auto stable = Json(Hapticsim({"stability", "--json"}));
+  EXPECT_EQ(stable["stable"], true);
+  EXPECT_DOUBLE_EQ(stable["dt_s"].get<double>(), 1e-3);
+  EXPECT_GT(stable["critical_dt_s"].get<double>(), 1e-3);
+
+  const auto unstable = Json(Hapticsim({"stability", "--json", "--set", "solver.dt=0.005"}));
+  EXPECT_EQ(unstable["stable"], false);
+}
+
+TEST(HapticsimCli, SimulateRefusesAPredictedUnstableStep) {
+  const CommandResult result = Hapticsim({"simulate", "--set", "solver.dt=0.005"});
+  EXPECT_EQ(result.exit_status, 3);
+  EXPECT_NE(result.out.find("predicted unstable"), std::string::npos) << result.out;
+}
+
+TEST(HapticsimCli, SimulateReportsDetectedDivergence) {
+  const auto result = Hapticsim({"simulate", "--json", "--allow-unstable", "--set",
+                                 "mesh.nodes=7", "--set", "solver.dt=0.01"});
+  EXPECT_EQ(result.exit_status, 3);
+  const auto json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["diverged"], true);
+  EXPECT_NE(json["outcome"].get<std::string>().find("diverged"), std::string::npos);
+}
+
+TEST(HapticsimCli, SceneOutputReadsBackAsAScene) {
+  const CommandResult printed =
+      Hapticsim({"scene", "--set", "material.poisson_ratio=0.49", "--set", "input.waveform=sine"});
+  ASSERT_EQ(printed.exit_status, 0) << printed.err;
+  const std::string file = Temp("cli_scene.toml");
+  std::ofstream(file) << printed.out;
+  const auto json = Json(Hapticsim({"scene", "--json", "--scene", file}));
+  EXPECT_DOUBLE_EQ(json["scene"]["material.poisson_ratio"].get<double>(), 0.49);
+  EXPECT_EQ(json["scene"]["input.waveform"], "sine");
+  EXPECT_EQ(json["units"]["material.density"], "kg/m^3");
+}
+
+struct BadInvocation {
+  std::string name;
+  std::vector<std::string> args;
+  std::string must_mention;
+  friend void PrintTo(const BadInvocation& bad, std::ostream* out) { *out << bad.name; }
+};
+
+class HapticsimCliRejects : public ::testing::TestWithParam<BadInvocation> {};
+
+TEST_P(HapticsimCliRejects, WithStatus2AndAMessageNamingTheProblem) {
+  const CommandResult result = Hapticsim(GetParam().args);
+  EXPECT_EQ(result.exit_status, 2);
+  EXPECT_NE(result.err.find(GetParam().must_mention), std::string::npos) << result.err;
+  EXPECT_TRUE(result.out.empty()) << "bad input must print no result: " << result.out;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadInput, HapticsimCliRejects,
+    ::testing::Values(
+        BadInvocation{"PoissonRatio", {"simulate", "--set", "material.poisson_ratio=0.6"},
+                      "(-1, 0.5)"},
+        BadInvocation{"NegativeModulus", {"static", "--json", "--set", "material.youngs_modulus=-5"},
+                      "material.youngs_modulus must be finite and > 0"},
+        BadInvocation{"OneNode", {"stability", "--set", "mesh.nodes=1"}, "mesh.nodes"},
+        BadInvocation{"NanTimeStep", {"simulate", "--set", "solver.dt=nan"}, "solver.dt"},
+        BadInvocation{"UnknownKey", {"simulate", "--set", "material.colour=red"},
+                      "unknown scene key"},
+        BadInvocation{"MissingFile", {"simulate", "--scene", "/nonexistent.toml"},
+                      "/nonexistent.toml"},
+        BadInvocation{"UnknownOption", {"simulate", "--bogus"}, "--bogus"},
+        BadInvocation{"UnknownSubcommand", {"frobnicate"}, "unknown subcommand 'frobnicate'"}),
+    [](const ::testing::TestParamInfo<BadInvocation>& info) { return info.param.name; });
+
+}  // namespace
+}  // namespace hapticsim
