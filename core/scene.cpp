@@ -1,5 +1,7 @@
 #include "core/scene.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -70,19 +72,24 @@ KeyAccess Real(SceneKeyInfo info, Ref ref, std::function<bool(double)> allowed) 
       }};
 }
 
+// A whole-number key in [lo, hi].
+template <typename Ref>
+KeyAccess Integer(SceneKeyInfo info, Ref ref, long lo, long hi) {
+  return KeyAccess{info,
+                   [ref](const Scene& scene) { return std::to_string(ref(const_cast<Scene&>(scene))); },
+                   [info, ref, lo, hi](Scene* scene, std::string_view text) {
+                     const long value = ParseInteger(info.name, text);
+                     if (value < lo || value > hi) Reject(info.name, text, info.allowed, info.unit);
+                     ref(*scene) = static_cast<int>(value);
+                   }};
+}
+
 const std::vector<KeyAccess>& KeyTable() {
   static const std::vector<KeyAccess> table = [] {
     std::vector<KeyAccess> keys;
-    keys.push_back(KeyAccess{
-        {"mesh.nodes", "", "a whole number from 2 to 401", "nodes per axis of the cube"},
-        [](const Scene& s) { return std::to_string(s.mesh.nodes); },
-        [](Scene* s, std::string_view text) {
-          const long value = ParseInteger("mesh.nodes", text);
-          if (value < 2 || value > 401) {
-            Reject("mesh.nodes", text, "a whole number from 2 to 401", "");
-          }
-          s->mesh.nodes = static_cast<int>(value);
-        }});
+    keys.push_back(Integer({"mesh.nodes", "", "a whole number from 2 to 401",
+                            "nodes per axis of the cube"},
+                           [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
     keys.push_back(Real({"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
                         [](Scene& s) -> double& { return s.mesh.edge_m; },
                         [](double v) { return v > 0; }));
@@ -110,7 +117,13 @@ const std::vector<KeyAccess>& KeyTable() {
     keys.push_back(KeyAccess{
         {"input.waveform", "", "\"press\" or \"sine\"",
          "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-        [](const Scene& s) { return "\"" + std::string(WaveformName(s.input.waveform)) + "\""; },
+        [](const Scene& s) {
+          // Built piecewise: g++ 12 misreports "\"" + string + "\"" under -Wrestrict (PR 105651).
+          std::string text(1, '"');
+          text += WaveformName(s.input.waveform);
+          text += '"';
+          return text;
+        },
         [](Scene* s, std::string_view text) {
           std::string_view bare = text;
           if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
@@ -130,6 +143,45 @@ const std::vector<KeyAccess>& KeyTable() {
     keys.push_back(Real({"solver.dt", "s", "finite and > 0", "time step of the simulation"},
                         [](Scene& s) -> double& { return s.solver.dt_s; },
                         [](double v) { return v > 0; }));
+    keys.push_back(Integer({"adaptivity.primary_size", "",
+                            "a whole number from 0 to 1000 (0 = no adaptivity)",
+                            "primary region: nodes from the contact in every direction (0 = off)"},
+                           [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
+    keys.push_back(Integer({"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
+                            "secondary spacing factor k (× the finest spacing)"},
+                           [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
+    keys.push_back(Real({"adaptivity.secondary_rate", "Hz",
+                         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+                         "update rate of the secondary region"},
+                        [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
+                        [](double v) { return v >= 1 && v == std::floor(v); }));
+    keys.push_back(Integer({"adaptivity.support_layers", "", "a whole number from 0 to 100",
+                            "coarse cells refined around each fixed node (the supports are "
+                            "singular: a coarse cell there is far too stiff)"},
+                           [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
+    keys.push_back(KeyAccess{
+        {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
+         "what the primary sends the secondary: its displacements next to the interface "
+         "(displacement) or its interface forces (force); see docs/regions.md"},
+        [](const Scene& s) {
+          std::string text(1, '"');
+          text += s.adaptivity.displacement_coupling ? "displacement" : "force";
+          text += '"';
+          return text;
+        },
+        [](Scene* s, std::string_view text) {
+          std::string_view bare = text;
+          if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
+            bare = bare.substr(1, bare.size() - 2);
+          }
+          if (bare == "displacement") {
+            s->adaptivity.displacement_coupling = true;
+          } else if (bare == "force") {
+            s->adaptivity.displacement_coupling = false;
+          } else {
+            Reject("adaptivity.coupling", text, "\"displacement\" or \"force\"", "");
+          }
+        }});
     return keys;
   }();
   return table;
@@ -144,6 +196,36 @@ const KeyAccess& FindKey(std::string_view key) {
     known += (known.empty() ? "" : ", ") + std::string(access.info.name);
   }
   throw Error("unknown scene key '" + std::string(key) + "'; known keys: " + known);
+}
+
+void ValidateAdaptivity(const Scene& scene) {
+  const AdaptivitySettings& a = scene.adaptivity;
+  const int intervals = scene.mesh.nodes - 1;
+  if (intervals % a.secondary_lod != 0) {
+    throw Error("adaptivity.secondary_lod = " + std::to_string(a.secondary_lod) +
+                " does not divide the " + std::to_string(intervals) +
+                " node intervals of mesh.nodes = " + std::to_string(scene.mesh.nodes) +
+                ": adaptivity.secondary_lod must divide mesh.nodes - 1");
+  }
+  const double primary_rate = 1.0 / scene.solver.dt_s;
+  if (std::abs(primary_rate - std::round(primary_rate)) > 1e-9 * primary_rate) {
+    throw Error("solver.dt = " + FormatReal(scene.solver.dt_s) + " s gives a primary rate of " +
+                FormatReal(primary_rate) +
+                " Hz: with adaptivity on, solver.dt must be 1 / (a whole number of Hz), e.g. 0.001");
+  }
+  if (a.secondary_rate_hz > std::round(primary_rate)) {
+    throw Error("adaptivity.secondary_rate = " + FormatReal(a.secondary_rate_hz) +
+                " Hz is not allowed: adaptivity.secondary_rate must be at most the primary rate " +
+                "1/solver.dt = " + FormatReal(std::round(primary_rate)) + " Hz");
+  }
+  if (PrimaryBoxCoversObject(scene, a.primary_size)) {
+    int largest = 0;
+    while (largest + 1 < a.primary_size && !PrimaryBoxCoversObject(scene, largest + 1)) ++largest;
+    throw Error("adaptivity.primary_size = " + std::to_string(a.primary_size) +
+                " covers the whole object, leaving no secondary region: adaptivity.primary_size "
+                "must be from 1 to " + std::to_string(largest) + " for this mesh and "
+                "adaptivity.secondary_lod, or 0 to switch adaptivity off");
+  }
 }
 
 }  // namespace
@@ -190,6 +272,21 @@ void ValidateScene(const Scene& scene) {
                 FormatReal(scene.duration_s()) +
                 " s: solver.dt must give between 1 and 1e8 steps");
   }
+  if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
+}
+
+double PrimaryRateHz(const Scene& scene) { return 1.0 / scene.solver.dt_s; }
+
+bool PrimaryBoxCoversObject(const Scene& scene, int primary_size) {
+  const int n = scene.mesh.nodes, k = scene.adaptivity.secondary_lod;
+  const int middle = (n - 1) / 2;
+  const std::array<int, 3> contact{middle, middle, 0};
+  for (int c : contact) {
+    const int lo = std::max(0, c - primary_size), hi = std::min(n - 1, c + primary_size);
+    // Every coarse cell [jk, (j+1)k] overlaps (lo, hi) only if the first and last do.
+    if (!(lo < k && hi > (n - 1) - k)) return false;
+  }
+  return true;
 }
 
 }  // namespace hapticsim

@@ -31,6 +31,22 @@ struct SolverSettings {
 };
 
 /**
+ * Asynchronous regions (the paper's adaptivity parameters). primary_size = 0 switches them off:
+ * the whole object is then solved on the finest mesh at the primary rate (the reference).
+ */
+struct AdaptivitySettings {
+  int primary_size = 0;          ///< nodes from the contact in every direction (adaptivity.primary_size)
+  int secondary_lod = 2;         ///< secondary spacing factor k (adaptivity.secondary_lod)
+  double secondary_rate_hz = 600;  ///< secondary region rate, Hz (adaptivity.secondary_rate)
+  int support_layers = 1;        ///< coarse cells refined around each fixed node (adaptivity.support_layers)
+  /// What the primary sends the secondary for the interface (adaptivity.coupling):
+  /// true = its displacements next to Γ ("displacement", the default), false = its Γ forces.
+  bool displacement_coupling = true;
+
+  bool enabled() const { return primary_size > 0; }
+};
+
+/**
  * Everything that defines a simulation trial. The defaults are the paper's scene: a cube of
  * edge 0.25 m with 13×13×13 nodes, the four back-face corners fixed, the middle node of the
  * front face driven by a 1 cm press at 1 Hz for one period, E = 10 kPa, ν = 0.45,
@@ -41,6 +57,7 @@ struct Scene {
   Material material;
   InputSettings input;
   SolverSettings solver;
+  AdaptivitySettings adaptivity;
 
   /** Trial length in seconds: periods / frequency. */
   double duration_s() const { return input.periods / input.frequency_hz; }
@@ -79,5 +96,14 @@ std::string GetSceneValue(const Scene& scene, std::string_view key);
  * @throws Error with one message naming the key and its allowed range.
  */
 void ValidateScene(const Scene& scene);
+
+/** The primary region's rate 1/solver.dt, Hz. */
+double PrimaryRateHz(const Scene& scene);
+
+/**
+ * True when a primary box of `primary_size` nodes around the contact, refined in whole coarse
+ * cells of adaptivity.secondary_lod, would cover every cell of the object.
+ */
+bool PrimaryBoxCoversObject(const Scene& scene, int primary_size);
 
 }  // namespace hapticsim

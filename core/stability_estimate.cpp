@@ -22,15 +22,26 @@ double ElementBoundCriticalDt(const ElasticModel& model) {
 
 StabilityEstimate EstimateStability(const ElasticModel& model,
                                     const EigenIterationOptions& options) {
-  const Eigen::Index n = model.grid().num_dofs();
+  StabilityEstimate estimate =
+      EstimateStability(model.stiffness(), model.dof_mass(), model.free_mask(), options);
+  estimate.element_bound_dt_s = ElementBoundCriticalDt(model);
+  return estimate;
+}
+
+StabilityEstimate EstimateStability(const StiffnessOperator& stiffness,
+                                    const Eigen::VectorXd& dof_mass,
+                                    const Eigen::VectorXd& free_mask,
+                                    const EigenIterationOptions& options) {
+  const Eigen::Index n = stiffness.num_dofs();
   // D = M^(-1/2) on free DOFs, 0 on constrained ones: A = D K D is symmetric and has the
   // eigenvalues of M⁻¹K on the free DOFs (plus zeros).
-  const Eigen::VectorXd scale =
-      model.free_mask().cwiseProduct(model.dof_mass().cwiseSqrt().cwiseInverse());
+  const Eigen::VectorXd scale = free_mask.cwiseProduct(dof_mass.cwiseSqrt().cwiseInverse());
+  Eigen::VectorXd full(n);
   auto apply_a = [&](const Eigen::VectorXd& x, Eigen::VectorXd& scratch, Eigen::VectorXd& ax) {
     scratch = scale.cwiseProduct(x);
-    model.stiffness().Apply(scratch, ax);
-    ax = scale.cwiseProduct(ax);
+    full.setZero();
+    stiffness.Apply(scratch, full);
+    ax = scale.cwiseProduct(full);
   };
 
   // Deterministic start with every free mode present: a hash-based pattern.
@@ -40,12 +51,11 @@ StabilityEstimate EstimateStability(const ElasticModel& model,
     state ^= state << 13;
     state ^= state >> 7;
     state ^= state << 17;
-    q[i] = ((state >> 11) * 0x1.0p-53 - 0.5) * model.free_mask()[i];
+    q[i] = ((state >> 11) * 0x1.0p-53 - 0.5) * free_mask[i];
   }
   q.normalize();
 
   StabilityEstimate estimate;
-  estimate.element_bound_dt_s = ElementBoundCriticalDt(model);
   Eigen::VectorXd q_previous = Eigen::VectorXd::Zero(n), w(n), scratch(n);
   std::vector<double> alpha, beta;  // the tridiagonal Lanczos matrix T
   double lambda = 0.0;

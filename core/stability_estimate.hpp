@@ -47,6 +47,15 @@ StabilityEstimate EstimateStability(const ElasticModel& model,
                                     const EigenIterationOptions& options = {});
 
 /**
+ * The same estimate for any stiffness operator and lumped mass, on the DOFs where free_mask is 1
+ * (a region alone, with its boundary held). element_bound_dt_s is left 0.
+ */
+StabilityEstimate EstimateStability(const StiffnessOperator& stiffness,
+                                    const Eigen::VectorXd& dof_mass,
+                                    const Eigen::VectorXd& free_mask,
+                                    const EigenIterationOptions& options = {});
+
+/**
  * Element-level bound: ω_max² ≤ max over elements of λ_max(M_e⁻¹ K_e), with M_e the element's
  * share ρh³/8 of each node's lumped mass. Returns 2/√bound, s — never above the true limit.
  */

@@ -147,3 +147,42 @@ TEST(SceneFile, KeyOutsideASectionIsRejected) {
 
 }  // namespace
 }  // namespace hapticsim
+
+namespace hapticsim {
+namespace {
+
+struct BadAdaptivity {
+  std::vector<std::string> assignments;
+  const char* must_mention;
+};
+
+class RejectsBadAdaptivity : public ::testing::TestWithParam<BadAdaptivity> {};
+
+TEST_P(RejectsBadAdaptivity, WithAMessageNamingTheKey) {
+  Scene scene;
+  const std::string message = ErrorMessage([&] { ApplySceneOverrides(&scene, GetParam().assignments); });
+  EXPECT_NE(message.find(GetParam().must_mention), std::string::npos) << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Configurations, RejectsBadAdaptivity,
+    ::testing::Values(
+        BadAdaptivity{{"adaptivity.primary_size=12"}, "adaptivity.primary_size = 12 covers the whole object"},
+        BadAdaptivity{{"adaptivity.primary_size=2", "adaptivity.secondary_lod=5"},
+                      "adaptivity.secondary_lod = 5 does not divide"},
+        BadAdaptivity{{"adaptivity.secondary_rate=0"}, "adaptivity.secondary_rate"},
+        BadAdaptivity{{"adaptivity.secondary_rate=-600"}, "adaptivity.secondary_rate"},
+        BadAdaptivity{{"adaptivity.secondary_rate=nan"}, "adaptivity.secondary_rate"},
+        BadAdaptivity{{"adaptivity.secondary_rate=600.5"}, "adaptivity.secondary_rate"},
+        BadAdaptivity{{"adaptivity.primary_size=2", "adaptivity.secondary_rate=1200"},
+                      "at most the primary rate"},
+        BadAdaptivity{{"adaptivity.primary_size=-1"}, "adaptivity.primary_size"},
+        BadAdaptivity{{"adaptivity.primary_size=2", "solver.dt=0.0003"},
+                      "1 / (a whole number of Hz)"},
+        BadAdaptivity{{"adaptivity.coupling=magic"}, "\"displacement\" or \"force\""}),
+    [](const ::testing::TestParamInfo<BadAdaptivity>& info) {
+      return "case" + std::to_string(info.index);
+    });
+
+}  // namespace
+}  // namespace hapticsim

@@ -111,6 +111,50 @@ TEST(HapticsimCli, SceneOutputReadsBackAsAScene) {
   EXPECT_EQ(json["units"]["material.density"], "kg/m^3");
 }
 
+TEST(HapticsimCli, AdaptiveSimulateComparesWithTheReference) {
+  const auto json = Json(Hapticsim({"simulate", "--json", "--compare-reference", "--set",
+                                    "adaptivity.primary_size=3", "--set",
+                                    "adaptivity.secondary_lod=2", "--set",
+                                    "adaptivity.secondary_rate=600"}));
+  EXPECT_EQ(json["adaptive"], true);
+  EXPECT_EQ(json["predicted_stable"], true);
+  ASSERT_EQ(json["regions"].size(), 2u);
+  EXPECT_EQ(json["regions"][0]["name"], "primary");
+  EXPECT_DOUBLE_EQ(json["regions"][0]["rate_Hz"].get<double>(), 1000);
+  EXPECT_DOUBLE_EQ(json["regions"][1]["rate_Hz"].get<double>(), 600);
+  EXPECT_GT(json["regions"][1]["nodes"].get<int>(), 0);
+  EXPECT_GE(json["regions"][1]["substeps"].get<int>(), 1);
+  const auto& error = json["error"];
+  EXPECT_GT(error["l2_percent"].get<double>(), 0.0);
+  EXPECT_LT(error["l2_percent"].get<double>(), 7.0);
+  EXPECT_TRUE(error.contains("max_magnitude_percent"));
+  EXPECT_TRUE(error.contains("max_direction_deg"));
+}
+
+TEST(HapticsimCli, AdaptiveStabilityReportsEachRegionAndTheCoupledVerdict) {
+  const auto stable = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
+  EXPECT_EQ(stable["stable"], true);
+  EXPECT_LT(stable["coupled_spectral_radius"].get<double>(), 1.0);
+  ASSERT_EQ(stable["regions"].size(), 2u);
+  EXPECT_GT(stable["regions"][1]["critical_dt_s"].get<double>(), 0.0);
+
+  const auto unstable = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2",
+                                        "--set", "adaptivity.secondary_lod=1", "--set",
+                                        "adaptivity.secondary_rate=700", "--set",
+                                        "material.poisson_ratio=0.49"}));
+  EXPECT_EQ(unstable["stable"], false);
+  EXPECT_GT(unstable["coupled_spectral_radius"].get<double>(), 1.0);
+}
+
+TEST(HapticsimCli, AdaptiveSimulateRefusesAPredictedUnstableCoupling) {
+  const auto result = Hapticsim({"simulate", "--set", "adaptivity.primary_size=2", "--set",
+                                 "adaptivity.secondary_lod=1", "--set",
+                                 "adaptivity.secondary_rate=700", "--set",
+                                 "material.poisson_ratio=0.49"});
+  EXPECT_EQ(result.exit_status, 3);
+  EXPECT_NE(result.out.find("refused: predicted unstable"), std::string::npos) << result.out;
+}
+
 struct BadInvocation {
   std::string name;
   std::vector<std::string> args;
@@ -141,7 +185,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadInvocation{"MissingFile", {"simulate", "--scene", "/nonexistent.toml"},
                       "/nonexistent.toml"},
         BadInvocation{"UnknownOption", {"simulate", "--bogus"}, "--bogus"},
-        BadInvocation{"UnknownSubcommand", {"frobnicate"}, "unknown subcommand 'frobnicate'"}),
+        BadInvocation{"UnknownSubcommand", {"frobnicate"}, "unknown subcommand 'frobnicate'"},
+        BadInvocation{"PrimaryTooLarge", {"simulate", "--set", "adaptivity.primary_size=40"},
+                      "adaptivity.primary_size"},
+        BadInvocation{"LodNotDividing", {"simulate", "--set", "adaptivity.primary_size=2", "--set",
+                                         "adaptivity.secondary_lod=5"},
+                      "adaptivity.secondary_lod"},
+        BadInvocation{"NegativeRate", {"stability", "--set", "adaptivity.secondary_rate=-5"},
+                      "adaptivity.secondary_rate"}),
     [](const ::testing::TestParamInfo<BadInvocation>& info) { return info.param.name; });
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/async_regions.hpp"
+#include "core/force_error.hpp"
 #include "core/reference_trial.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
@@ -20,6 +22,7 @@ struct SimulateOptions {
   std::string csv_path;
   std::string plot_path;
   bool allow_unstable = false;
+  bool compare_reference = false;
 };
 
 void WriteCsv(const std::string& path, const TrialResult& result) {
@@ -36,12 +39,71 @@ void WriteCsv(const std::string& path, const TrialResult& result) {
   HAPTICSIM_THROW_UNLESS(out.good(), "writing " + path + " failed (disk full?)");
 }
 
+// Per-region facts of an adaptive run, for the report.
+struct RegionReport {
+  const char* name;
+  int nodes, elements, substeps;
+  double rate_hz, critical_dt_s, cost_us_per_ms;
+};
+
+struct AdaptiveReport {
+  std::vector<RegionReport> regions;
+  CoupledStability coupled;
+};
+
+nlohmann::json ErrorJson(const ForceError& e) {
+  return {{"l2_percent", e.l2_percent},
+          {"max_magnitude_percent", e.max_magnitude_percent},
+          {"max_direction_deg", e.max_direction_deg},
+          {"direction_threshold_fraction_of_peak", ForceError::kDirectionThreshold}};
+}
+
+TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, AdaptiveReport* report) {
+  AsyncRegions regions(scene);
+  report->coupled = regions.EstimateCoupledStability();
+  TrialResult result;
+  if (!report->coupled.stable && !allow_unstable) {
+    result.outcome = TrialOutcome::kPredictedUnstable;
+  } else {
+    result = regions.RunTrial();
+  }
+  const double simulated_ms = std::max<double>(result.steps, 1) * scene.solver.dt_s * 1e3;
+  const auto& p = regions.partition();
+  for (RegionIndex r : {kPrimaryRegion, kSecondaryRegion}) {
+    report->regions.push_back({r == kPrimaryRegion ? "primary" : "secondary", p.num_nodes(r),
+                               p.num_elements(r), regions.schedule(r).substeps,
+                               regions.schedule(r).rate_hz,
+                               regions.schedule(r).alone.critical_dt_s,
+                               regions.compute_seconds(r) * 1e6 / simulated_ms});
+  }
+  return result;
+}
+
 int Run(const SimulateOptions& options) {
   const Scene scene = options.scene.Resolve();
-  const CubeScene cube(scene);
+  const bool adaptive = scene.adaptivity.enabled();
+  AdaptiveReport report;
   TrialOptions trial_options;
   trial_options.run_if_predicted_unstable = options.allow_unstable;
-  const TrialResult result = RunReferenceTrial(cube, trial_options);
+  const TrialResult result = adaptive ? RunAdaptive(scene, options.allow_unstable, &report)
+                                      : RunReferenceTrial(CubeScene(scene), trial_options);
+  std::optional<ForceError> error;
+  std::optional<TrialResult> reference;
+  if (options.compare_reference && !result.samples.empty()) {
+    Scene reference_scene = scene;
+    reference_scene.adaptivity.primary_size = 0;
+    reference = RunReferenceTrial(CubeScene(reference_scene));
+    if (reference->outcome != TrialOutcome::kCompleted) {
+      throw Error("the full-resolution reference of this scene did not complete (" +
+                  std::string(TrialOutcomeName(reference->outcome)) + "); lower solver.dt below " +
+                  std::to_string(reference->stability.critical_dt_s) + " s");
+    }
+    std::vector<ForceSample> matched(reference->samples.begin(),
+                                     reference->samples.begin() +
+                                         static_cast<long>(std::min(reference->samples.size(),
+                                                                    result.samples.size())));
+    error = CompareForces(result.samples, matched);
+  }
 
   const bool wrote_series = !options.csv_path.empty() && !result.samples.empty();
   if (wrote_series) WriteCsv(options.csv_path, result);
@@ -57,12 +119,15 @@ int Run(const SimulateOptions& options) {
   }
   const double simulated_ms = result.steps * scene.solver.dt_s * 1e3;
   const double cost_us_per_ms = simulated_ms > 0 ? result.wall_time_s * 1e6 / simulated_ms : 0;
+  const bool predicted_stable =
+      adaptive ? report.coupled.stable : result.stability.IsStable(scene.solver.dt_s);
 
   if (options.scene.json) {
     nlohmann::json out;
     out["outcome"] = TrialOutcomeName(result.outcome);
     out["diverged"] = result.diverged();
-    out["predicted_stable"] = result.stability.IsStable(scene.solver.dt_s);
+    out["predicted_stable"] = predicted_stable;
+    out["adaptive"] = adaptive;
     out["critical_dt_s"] = result.stability.critical_dt_s;
     out["dt_s"] = scene.solver.dt_s;
     out["duration_s"] = scene.duration_s();
@@ -73,21 +138,54 @@ int Run(const SimulateOptions& options) {
     out["wall_time_s"] = result.wall_time_s;
     out["compute_us_per_simulated_ms"] = cost_us_per_ms;
     out["time_series_csv"] = wrote_series ? nlohmann::json(options.csv_path) : nlohmann::json();
+    if (adaptive) {
+      out["coupled_spectral_radius"] = report.coupled.spectral_radius;
+      out["common_period_s"] = report.coupled.common_period_s;
+      for (const RegionReport& r : report.regions) {
+        out["regions"].push_back({{"name", r.name},
+                                  {"nodes", r.nodes},
+                                  {"elements", r.elements},
+                                  {"rate_Hz", r.rate_hz},
+                                  {"substeps", r.substeps},
+                                  {"critical_dt_s", r.critical_dt_s},
+                                  {"cost_us_per_simulated_ms", r.cost_us_per_ms}});
+      }
+    }
+    if (error) {
+      out["error"] = ErrorJson(*error);
+      out["reference_peak_force_N"] = error->reference_peak_n;
+      out["reference_compute_us_per_simulated_ms"] =
+          reference->wall_time_s * 1e6 / (reference->steps * scene.solver.dt_s * 1e3);
+    }
     std::cout << out.dump(2) << "\n";
   } else {
-    std::cout << "Reference simulation: " << scene.mesh.nodes << "³-node cube, edge "
-              << Quantity(scene.mesh.edge_m, "m") << "; " << WaveformName(scene.input.waveform)
-              << " of " << Quantity(scene.input.amplitude_m, "m") << " at "
+    std::cout << (adaptive ? "Adaptive simulation" : "Reference simulation") << ": "
+              << scene.mesh.nodes << "³-node cube, edge " << Quantity(scene.mesh.edge_m, "m")
+              << "; " << WaveformName(scene.input.waveform) << " of "
+              << Quantity(scene.input.amplitude_m, "m") << " at "
               << Quantity(scene.input.frequency_hz, "Hz") << " for "
               << Duration(scene.duration_s()) << ", dt " << Duration(scene.solver.dt_s) << "\n";
-    std::cout << "  stability: critical dt " << Duration(result.stability.critical_dt_s)
-              << " (Lanczos on M⁻¹K), dt is "
-              << (result.stability.IsStable(scene.solver.dt_s) ? "below it: stable"
-                                                                : "NOT below it: unstable")
-              << "\n";
+    if (adaptive) {
+      for (const RegionReport& r : report.regions) {
+        std::cout << "  " << r.name << " region: " << r.nodes << " nodes, " << r.elements
+                  << " elements, " << Quantity(r.rate_hz, "Hz") << " × " << r.substeps
+                  << " substep(s), own limit " << Duration(r.critical_dt_s) << ", "
+                  << Quantity(r.cost_us_per_ms, "µs") << " per simulated ms\n";
+      }
+      std::cout << "  coupled stability: spectral radius "
+                << Quantity(report.coupled.spectral_radius, "") << "per common period of "
+                << Duration(report.coupled.common_period_s) << ": "
+                << (report.coupled.stable ? "stable" : "UNSTABLE (the linked regions grow)") << "\n";
+    } else {
+      std::cout << "  stability: critical dt " << Duration(result.stability.critical_dt_s)
+                << " (Lanczos on M⁻¹K), dt is "
+                << (predicted_stable ? "below it: stable" : "NOT below it: unstable") << "\n";
+    }
     if (result.outcome == TrialOutcome::kPredictedUnstable) {
-      std::cout << "  refused: predicted unstable. Lower solver.dt below "
-                << Duration(result.stability.critical_dt_s)
+      std::cout << "  refused: predicted unstable. "
+                << (adaptive ? "Choose another adaptive configuration (a higher "
+                               "adaptivity.secondary_rate or adaptivity.primary_size = 0)"
+                             : "Lower solver.dt below " + Duration(result.stability.critical_dt_s))
                 << ", or pass --allow-unstable to watch the run diverge.\n";
     } else {
       if (result.diverged()) {
@@ -98,6 +196,13 @@ int Run(const SimulateOptions& options) {
                 << Duration(peak_time) << "\n";
       std::cout << "  " << result.steps << " steps in " << Duration(result.wall_time_s)
                 << " of compute (" << Quantity(cost_us_per_ms, "µs") << " per simulated ms)\n";
+    }
+    if (error) {
+      std::cout << "  error against the full-resolution reference (peak "
+                << Quantity(error->reference_peak_n, "N") << "): relative L2 "
+                << Quantity(error->l2_percent, "%") << ", worst magnitude "
+                << Quantity(error->max_magnitude_percent, "%") << " of peak, worst direction "
+                << Quantity(error->max_direction_deg, "°") << "\n";
     }
     if (wrote_series) {
       std::cout << "  time series (t, contact displacement, force on the user): "
@@ -127,6 +232,8 @@ Command AddSimulateCommand(CLI::App& parent) {
   app->add_flag("--allow-unstable", options->allow_unstable,
                 "Run even when dt is past the predicted stability limit (divergence is then "
                 "detected and reported)");
+  app->add_flag("--compare-reference", options->compare_reference,
+                "Also run the full-resolution reference and report the force error against it");
   return {app, [options] { return Run(*options); }};
 }
 

@@ -1,0 +1,85 @@
+#include "core/element_set_stiffness.hpp"
+
+#include <algorithm>
+
+namespace hapticsim {
+
+ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material& material,
+                                         std::vector<int> element_ids)
+    : StiffnessOperator(mesh.num_dofs()),
+      mesh_(mesh),
+      element_ids_(std::move(element_ids)),
+      unit_stiffness_(Hex8Element::Stiffness(1.0, material)) {
+  std::vector<char> touched(static_cast<size_t>(mesh.num_independent()), 0);
+  for (int id : element_ids_) {
+    for (int node : mesh.elements()[id].nodes) {
+      const auto [begin, end] = mesh.Gather(node);
+      for (auto* g = begin; g != end; ++g) touched[g->independent] = 1;
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < mesh.num_independent(); ++r) {
+      if (touched[r]) touched_dofs_.push_back(mesh.Dof(r, c));
+    }
+  }
+}
+
+void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+                                Eigen::Ref<Eigen::VectorXd> ku) const {
+  for (int dof : touched_dofs_) ku[dof] = 0.0;
+  const int nr = mesh_.num_independent();
+  const double h = mesh_.options().spacing_m;
+  Eigen::Matrix<double, 24, 1> ue, fe;
+  for (int id : element_ids_) {
+    const HybridElement& e = mesh_.elements()[id];
+    for (int local = 0; local < 8; ++local) {
+      const auto [begin, end] = mesh_.Gather(e.nodes[local]);
+      double x = 0, y = 0, z = 0;
+      for (auto* g = begin; g != end; ++g) {
+        x += g->weight * u[g->independent];
+        y += g->weight * u[nr + g->independent];
+        z += g->weight * u[2 * nr + g->independent];
+      }
+      ue[3 * local] = x;
+      ue[3 * local + 1] = y;
+      ue[3 * local + 2] = z;
+    }
+    fe.noalias() = unit_stiffness_ * ue;
+    fe *= e.size_factor * h;
+    for (int local = 0; local < 8; ++local) {
+      const auto [begin, end] = mesh_.Gather(e.nodes[local]);
+      for (auto* g = begin; g != end; ++g) {
+        ku[g->independent] += g->weight * fe[3 * local];
+        ku[nr + g->independent] += g->weight * fe[3 * local + 1];
+        ku[2 * nr + g->independent] += g->weight * fe[3 * local + 2];
+      }
+    }
+  }
+}
+
+Eigen::VectorXd ElementSetStiffness::Diagonal() const {
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(num_dofs());
+  const int nr = mesh_.num_independent();
+  const double h = mesh_.options().spacing_m;
+  for (int id : element_ids_) {
+    const HybridElement& e = mesh_.elements()[id];
+    for (int a = 0; a < 8; ++a) {
+      for (int b = 0; b < 8; ++b) {
+        const auto [ba, ea] = mesh_.Gather(e.nodes[a]);
+        const auto [bb, eb] = mesh_.Gather(e.nodes[b]);
+        for (auto* ga = ba; ga != ea; ++ga) {
+          for (auto* gb = bb; gb != eb; ++gb) {
+            if (ga->independent != gb->independent) continue;
+            for (int c = 0; c < 3; ++c) {
+              diagonal[c * nr + ga->independent] += ga->weight * gb->weight * e.size_factor * h *
+                                                    unit_stiffness_(3 * a + c, 3 * b + c);
+            }
+          }
+        }
+      }
+    }
+  }
+  return diagonal;
+}
+
+}  // namespace hapticsim

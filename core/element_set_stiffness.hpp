@@ -1,0 +1,38 @@
+#pragma once
+
+#include <vector>
+
+#include "core/hex8_element.hpp"
+#include "core/hybrid_mesh.hpp"
+#include "core/stiffness_operator.hpp"
+
+namespace hapticsim {
+
+/**
+ * Matrix-free K·u over a subset of a HybridMesh's elements (one region, or all of them), on the
+ * mesh's independent DOFs: gather each element's 24 displacements through the hanging-node
+ * weights, multiply by its stiffness h_e·(λA + μB), scatter back with the same weights.
+ *
+ * Apply() writes only the DOFs the subset touches (touched_dofs()) and leaves the rest of `ku`
+ * as it was, so a region can compute its own forces without touching the other's.
+ */
+class ElementSetStiffness final : public StiffnessOperator {
+ public:
+  ElementSetStiffness(const HybridMesh& mesh, const Material& material,
+                      std::vector<int> element_ids);
+
+  void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+             Eigen::Ref<Eigen::VectorXd> ku) const override;
+  Eigen::VectorXd Diagonal() const override;
+
+  /** Independent DOFs this subset's elements reach (sorted). */
+  const std::vector<int>& touched_dofs() const { return touched_dofs_; }
+
+ private:
+  const HybridMesh& mesh_;
+  std::vector<int> element_ids_;
+  Hex8Element::Matrix24 unit_stiffness_;  // λA + μB (stiffness per metre of edge)
+  std::vector<int> touched_dofs_;
+};
+
+}  // namespace hapticsim

@@ -1,0 +1,90 @@
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/stiffness_operator.hpp"
+
+namespace hapticsim {
+
+/**
+ * Central difference for one region: the same per-DOF update as CentralDifferenceIntegrator,
+ *
+ *   u⁺ = [h²/m·(f − (K_region u)) + 2u − (1 − d·h/2)·u⁻] / (1 + d·h/2),
+ *
+ * applied to the DOFs the region owns, with h the region's substep. Its boundary DOFs (the
+ * other region's interface, the contact, supports) are prescribed by the caller; some owned DOFs
+ * may carry an external load (the interface forces of the other region).
+ *
+ * The region keeps its own copy of the whole state vector, so two regions never share memory:
+ * what crosses between them goes through a BoundaryChannel.
+ *
+ * Threads: one thread owns a region. Step() never allocates, locks or throws.
+ */
+class RegionIntegrator {
+ public:
+  /**
+   * @param stiffness  K of this region's elements (writes only the DOFs they touch)
+   * @param dof_mass   lumped mass of every DOF, kg (the whole object's: interface DOFs carry the
+   *                   mass of both sides)
+   * @param owned      DOFs this region updates
+   * @param prescribed DOFs whose values the caller sets every substep
+   * @param loaded     owned DOFs that receive an external load every substep
+   */
+  RegionIntegrator(const StiffnessOperator& stiffness, const Eigen::VectorXd& dof_mass,
+                   double damping_per_s, std::vector<int> owned, std::vector<int> prescribed,
+                   std::vector<int> loaded, double substep_s);
+
+  /** Zero state. */
+  void Reset();
+
+  /** K·u of the current state (cached until the state changes). */
+  const Eigen::VectorXd& Forces() noexcept;
+
+  /**
+   * One substep from t to t + h.
+   * @param prescribed_next values of the prescribed DOFs at t + h, in prescribed() order
+   * @param load            external force on the loaded DOFs at t, N, in loaded() order
+   */
+  void Step(std::span<const double> prescribed_next, std::span<const double> load) noexcept;
+
+  /**
+   * Residual of the equation of motion at prescribed DOF index `k` at the start of the last
+   * step: (K u) + m·a + d·m·v — the force needed to hold the prescribed motion, N.
+   */
+  double PrescribedReaction(int k) const { return prescribed_reaction_[k]; }
+
+  const Eigen::VectorXd& u() const { return *u_; }
+  const Eigen::VectorXd& u_previous() const { return *u_previous_; }
+  const std::vector<int>& owned() const { return owned_; }
+  const std::vector<int>& prescribed() const { return prescribed_; }
+  const std::vector<int>& loaded() const { return loaded_; }
+  double substep() const { return h_; }
+  void set_substep(double substep_s);
+
+  /** Overwrites the state (for free-decay runs and the spectral-radius estimate). */
+  void SetState(const Eigen::VectorXd& u, const Eigen::VectorXd& u_previous);
+  /** Multiplies the whole state by `factor` (power iteration on the period map). */
+  void ScaleState(double factor);
+  /** Σ over owned DOFs of u² + u⁻², for the period-map norm. */
+  double OwnedStateNormSquared() const;
+
+ private:
+  const StiffnessOperator& stiffness_;
+  const Eigen::VectorXd& mass_;
+  double damping_;
+  std::vector<int> owned_, prescribed_, loaded_;
+  double h_ = 0;
+  Eigen::VectorXd buffers_[3];
+  Eigen::VectorXd* u_previous_;
+  Eigen::VectorXd* u_;
+  Eigen::VectorXd* u_next_;
+  Eigen::VectorXd ku_;
+  bool ku_valid_ = false;
+  Eigen::VectorXd external_;  // load per DOF (zero except loaded DOFs)
+  std::vector<double> prescribed_reaction_;
+};
+
+}  // namespace hapticsim
