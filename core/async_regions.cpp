@@ -20,6 +20,7 @@ Eigen::VectorXd MaskOf(int size, const std::vector<int>& dofs) {
 }
 
 // Value at time t on the line through two snapshots (the newer one alone if they coincide).
+// Callers clamp t: a late writer must never be extrapolated far (see StepPrimary).
 inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
                      int i, double t) {
   const double span = newer.time_s - older.time_s;
@@ -178,7 +179,10 @@ std::array<double, 3> AsyncRegions::StepPrimary(const std::array<double, 3>& con
 
   std::array<double, 3> reaction{};
   for (int q = 1; q <= substeps; ++q) {
-    const double t = t0 + q * h;
+    // The schedule keeps the secondary ahead, so Γ is interpolated. If it is late (a stalled
+    // thread), Γ is held at its newest state rather than extrapolated: holding is what keeps the
+    // primary bounded while the secondary catches up.
+    const double t = std::min(t0 + q * h, displacement_newer_.time_s);
     const double fraction = static_cast<double>(q) / substeps;
     for (int c = 0; c < 3; ++c) {
       primary_prescribed_[c] = contact_now_[c] + fraction * (contact_next[c] - contact_now_[c]);
@@ -207,8 +211,11 @@ void AsyncRegions::StepSecondary() noexcept {
   const double t0 = static_cast<double>(state_ticks_[kSecondaryRegion]) / ticks_per_second_;
   const double h = secondary_->substep();
   (void)interface_force_.TryReadLatestTwo(&force_newer_, &force_older_);
+  // The schedule puts the primary's newest state less than one primary period behind; never
+  // extrapolate further than that, should the primary be late.
+  const double newest_allowed = force_newer_.time_s + 1.0 / schedules_[kPrimaryRegion].rate_hz;
   for (int q = 0; q < substeps; ++q) {
-    const double t = t0 + q * h;
+    const double t = std::min(t0 + q * h, newest_allowed);
     if (coupling_ == Coupling::kForce) {
       for (size_t i = 0; i < gamma.size(); ++i) {
         secondary_load_[i] = -OnLine(force_older_, force_newer_, static_cast<int>(i), t);

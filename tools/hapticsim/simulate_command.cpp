@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/async_regions.hpp"
 #include "core/force_error.hpp"
+#include "core/realtime_schedule.hpp"
 #include "core/reference_trial.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
@@ -23,6 +24,7 @@ struct SimulateOptions {
   std::string plot_path;
   bool allow_unstable = false;
   bool compare_reference = false;
+  bool threads = false;
 };
 
 void WriteCsv(const std::string& path, const TrialResult& result) {
@@ -49,7 +51,19 @@ struct RegionReport {
 struct AdaptiveReport {
   std::vector<RegionReport> regions;
   CoupledStability coupled;
+  std::optional<DeadlineStats> deadlines[2];  // with --threads
+  std::optional<ForceError> threaded_vs_virtual;
 };
+
+nlohmann::json DeadlineJson(const DeadlineStats& d) {
+  return {{"period_s", d.period_s},
+          {"cycles", d.cycles},
+          {"misses", d.misses},
+          {"worst_lateness_s", d.worst_lateness_s},
+          {"execution_p50_s", d.execution_p50_s},
+          {"execution_p99_s", d.execution_p99_s},
+          {"execution_max_s", d.execution_max_s}};
+}
 
 nlohmann::json ErrorJson(const ForceError& e) {
   return {{"l2_percent", e.l2_percent},
@@ -58,12 +72,22 @@ nlohmann::json ErrorJson(const ForceError& e) {
           {"direction_threshold_fraction_of_peak", ForceError::kDirectionThreshold}};
 }
 
-TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, AdaptiveReport* report) {
+TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, bool threads,
+                        AdaptiveReport* report) {
   AsyncRegions regions(scene);
   report->coupled = regions.EstimateCoupledStability();
   TrialResult result;
   if (!report->coupled.stable && !allow_unstable) {
     result.outcome = TrialOutcome::kPredictedUnstable;
+  } else if (threads) {
+    const TrialResult virtual_time = regions.RunTrial();
+    RealTimeSchedule schedule(regions);
+    result = schedule.RunTrial();
+    report->deadlines[kPrimaryRegion] = schedule.primary_stats();
+    report->deadlines[kSecondaryRegion] = schedule.secondary_stats();
+    if (result.samples.size() == virtual_time.samples.size()) {
+      report->threaded_vs_virtual = CompareForces(result.samples, virtual_time.samples);
+    }
   } else {
     result = regions.RunTrial();
   }
@@ -85,8 +109,13 @@ int Run(const SimulateOptions& options) {
   AdaptiveReport report;
   TrialOptions trial_options;
   trial_options.run_if_predicted_unstable = options.allow_unstable;
-  const TrialResult result = adaptive ? RunAdaptive(scene, options.allow_unstable, &report)
-                                      : RunReferenceTrial(CubeScene(scene), trial_options);
+  if (options.threads && !adaptive) {
+    throw Error("--threads runs the asynchronous regions on real threads: set "
+                "adaptivity.primary_size >= 1 too");
+  }
+  const TrialResult result =
+      adaptive ? RunAdaptive(scene, options.allow_unstable, options.threads, &report)
+               : RunReferenceTrial(CubeScene(scene), trial_options);
   std::optional<ForceError> error;
   std::optional<TrialResult> reference;
   if (options.compare_reference && !result.samples.empty()) {
@@ -141,7 +170,8 @@ int Run(const SimulateOptions& options) {
     if (adaptive) {
       out["coupled_spectral_radius"] = report.coupled.spectral_radius;
       out["common_period_s"] = report.coupled.common_period_s;
-      for (const RegionReport& r : report.regions) {
+      for (size_t i = 0; i < report.regions.size(); ++i) {
+        const RegionReport& r = report.regions[i];
         out["regions"].push_back({{"name", r.name},
                                   {"nodes", r.nodes},
                                   {"elements", r.elements},
@@ -149,6 +179,10 @@ int Run(const SimulateOptions& options) {
                                   {"substeps", r.substeps},
                                   {"critical_dt_s", r.critical_dt_s},
                                   {"cost_us_per_simulated_ms", r.cost_us_per_ms}});
+        if (report.deadlines[i]) out["regions"][i]["deadlines"] = DeadlineJson(*report.deadlines[i]);
+      }
+      if (report.threaded_vs_virtual) {
+        out["threaded_vs_virtual"] = ErrorJson(*report.threaded_vs_virtual);
       }
     }
     if (error) {
@@ -171,6 +205,19 @@ int Run(const SimulateOptions& options) {
                   << " elements, " << Quantity(r.rate_hz, "Hz") << " × " << r.substeps
                   << " substep(s), own limit " << Duration(r.critical_dt_s) << ", "
                   << Quantity(r.cost_us_per_ms, "µs") << " per simulated ms\n";
+      }
+      for (size_t i = 0; i < 2; ++i) {
+        if (!report.deadlines[i]) continue;
+        const DeadlineStats& d = *report.deadlines[i];
+        std::cout << "  " << report.regions[i].name << " thread: " << d.cycles << " cycles of "
+                  << Duration(d.period_s) << ", " << d.misses << " deadline misses, worst "
+                  << "wake-up lateness " << Duration(d.worst_lateness_s) << ", step time p50 "
+                  << Duration(d.execution_p50_s) << " / p99 " << Duration(d.execution_p99_s)
+                  << " / max " << Duration(d.execution_max_s) << "\n";
+      }
+      if (report.threaded_vs_virtual) {
+        std::cout << "  threaded run against the virtual-time run: relative L2 "
+                  << Quantity(report.threaded_vs_virtual->l2_percent, "%") << "\n";
       }
       std::cout << "  coupled stability: spectral radius "
                 << Quantity(report.coupled.spectral_radius, "") << "per common period of "
@@ -234,6 +281,9 @@ Command AddSimulateCommand(CLI::App& parent) {
                 "detected and reported)");
   app->add_flag("--compare-reference", options->compare_reference,
                 "Also run the full-resolution reference and report the force error against it");
+  app->add_flag("--threads", options->threads,
+                "Run the asynchronous regions on real threads (one per region, on real clocks) "
+                "and report deadlines and the difference from the virtual-time run");
   return {app, [options] { return Run(*options); }};
 }
 

@@ -1,0 +1,133 @@
+#include "core/realtime_schedule.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+namespace hapticsim {
+namespace {
+
+std::int64_t NowNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+void SleepUntilNs(std::int64_t wake_ns) {
+  timespec ts{};
+  ts.tv_sec = wake_ns / 1'000'000'000;
+  ts.tv_nsec = wake_ns % 1'000'000'000;
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// Per-thread record of one periodic loop, preallocated before the loop starts.
+struct LoopRecord {
+  std::vector<double> execution_s;
+  std::int64_t misses = 0;
+  double worst_lateness_s = 0;
+
+  DeadlineStats Summarise(double period_s) {
+    DeadlineStats stats;
+    stats.period_s = period_s;
+    stats.cycles = static_cast<std::int64_t>(execution_s.size());
+    stats.misses = misses;
+    stats.worst_lateness_s = worst_lateness_s;
+    if (!execution_s.empty()) {
+      std::vector<double> sorted = execution_s;
+      std::sort(sorted.begin(), sorted.end());
+      auto at = [&](double q) { return sorted[static_cast<size_t>(q * (sorted.size() - 1))]; };
+      stats.execution_p50_s = at(0.5);
+      stats.execution_p99_s = at(0.99);
+      stats.execution_max_s = sorted.back();
+    }
+    return stats;
+  }
+};
+
+}  // namespace
+
+TrialResult RealTimeSchedule::RunTrial() {
+  const Scene& scene = regions_.partition().scene();
+  const ContactTrajectory trajectory(scene.input);
+  const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
+  const long steps = scene.num_steps();
+  const double tick_ns = 1e9 / static_cast<double>(regions_.ticks_per_second());
+  const std::int64_t primary_period_ticks = regions_.period_ticks(kPrimaryRegion);
+  const std::int64_t secondary_period_ticks = regions_.period_ticks(kSecondaryRegion);
+  regions_.Reset();
+
+  TrialResult result;
+  result.stability = regions_.schedule(kPrimaryRegion).alone;
+  result.samples.resize(static_cast<size_t>(steps) + 1);
+  LoopRecord records[2];
+  records[0].execution_s.reserve(static_cast<size_t>(steps) + 1);
+  const auto secondary_steps = static_cast<size_t>(
+      std::ceil((steps + 2) * static_cast<double>(primary_period_ticks) / secondary_period_ticks) + 2);
+  records[1].execution_s.reserve(secondary_steps);
+
+  // Wall-clock origin of simulation time 0, far enough ahead for the secondary's early release.
+  const std::int64_t origin_ns = NowNs() + 20'000'000;
+  const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
+  std::atomic<bool> primary_done{false};
+
+  std::thread secondary([&] {
+    LoopRecord& record = records[1];
+    const auto lead_ns = static_cast<std::int64_t>(1.25 * primary_period_ticks * tick_ns);
+    while (!primary_done.load(std::memory_order_acquire)) {
+      const std::int64_t state = regions_.state_ticks(kSecondaryRegion);
+      if (state >= end_ticks + secondary_period_ticks) break;
+      const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns;
+      SleepUntilNs(release);
+      const std::int64_t woke = NowNs();
+      regions_.StepSecondary();
+      const std::int64_t done = NowNs();
+      const double period_ns = secondary_period_ticks * tick_ns;
+      record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
+      if (woke - release > period_ns || done > release + period_ns) ++record.misses;
+      if (record.execution_s.size() < record.execution_s.capacity()) {
+        record.execution_s.push_back((done - woke) * 1e-9);
+      }
+    }
+  });
+
+  for (long n = 0; n <= steps; ++n) {
+    LoopRecord& record = records[0];
+    const std::int64_t release = origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
+    SleepUntilNs(release);
+    const std::int64_t woke = NowNs();
+    const double t = n * dt;
+    const double depth_next = trajectory.DepthAt(t + dt);
+    const std::array<double, 3> r = regions_.StepPrimary({0.0, 0.0, depth_next});
+    const std::int64_t done = NowNs();
+    const double period_ns = primary_period_ticks * tick_ns;
+    record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
+    if (woke - release > period_ns || done > release + period_ns) ++record.misses;
+    record.execution_s.push_back((done - woke) * 1e-9);
+
+    ForceSample& sample = result.samples[static_cast<size_t>(n)];
+    sample.t_s = t;
+    sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
+    for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
+    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+    result.steps = n + 1;
+    result.stopped_at_s = t;
+    if (!std::isfinite(r[0] + r[1] + r[2])) {
+      result.outcome = TrialOutcome::kDivergedNonFinite;
+      break;
+    }
+  }
+  primary_done.store(true, std::memory_order_release);
+  secondary.join();
+  result.samples.resize(static_cast<size_t>(result.steps));
+  result.wall_time_s = regions_.compute_seconds(kPrimaryRegion) + regions_.compute_seconds(kSecondaryRegion);
+  stats_[kPrimaryRegion] = records[0].Summarise(dt);
+  stats_[kSecondaryRegion] =
+      records[1].Summarise(1.0 / regions_.schedule(kSecondaryRegion).rate_hz);
+  return result;
+}
+
+}  // namespace hapticsim

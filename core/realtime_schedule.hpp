@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/async_regions.hpp"
+#include "core/contact_trajectory.hpp"
+
+namespace hapticsim {
+
+/** Deadline statistics of one periodic thread. */
+struct DeadlineStats {
+  double period_s = 0;
+  std::int64_t cycles = 0;
+  std::int64_t misses = 0;          ///< cycles that started late by more than one period or
+                                    ///< finished after their next release
+  double worst_lateness_s = 0;      ///< worst wake-up lateness after the release time, s
+  double execution_p50_s = 0, execution_p99_s = 0, execution_max_s = 0;  ///< step compute time
+};
+
+/**
+ * Runs AsyncRegions on real clocks: one thread per region, each releasing its steps on absolute
+ * CLOCK_MONOTONIC times (clock_nanosleep TIMER_ABSTIME, so lateness never accumulates), sharing
+ * the interface only through the regions' lock-free BoundaryChannels. The primary thread never
+ * waits for the secondary: it takes whatever Γ snapshots are newest.
+ *
+ * Phases follow the virtual-time schedule: the primary's step over [tᵢ, tᵢ₊₁] is released at
+ * wall time tᵢ (its force at tᵢ is out at once); the secondary's step over [Tⱼ, Tⱼ₊₁] is released
+ * 1.25 primary periods before Tⱼ, so its Γ at Tⱼ₊₁ is published before any primary step needs it.
+ * The extra quarter period keeps the two threads from waking at the same instant, so the
+ * secondary deterministically reads the primary state just before Tⱼ and extrapolates — which is
+ * where a threaded run may differ from the virtual-time one (the virtual schedule uses the
+ * primary state at Tⱼ itself when Tⱼ falls on the primary's grid).
+ *
+ * Threads: Run() starts and joins the two region threads; call it from one thread.
+ */
+class RealTimeSchedule {
+ public:
+  explicit RealTimeSchedule(AsyncRegions& regions) : regions_(regions) {}
+
+  /** Runs the scene's trial in real time and returns the forces like AsyncRegions::RunTrial. */
+  TrialResult RunTrial();
+
+  const DeadlineStats& primary_stats() const { return stats_[kPrimaryRegion]; }
+  const DeadlineStats& secondary_stats() const { return stats_[kSecondaryRegion]; }
+
+ private:
+  AsyncRegions& regions_;
+  DeadlineStats stats_[2];
+};
+
+}  // namespace hapticsim
