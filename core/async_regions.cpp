@@ -20,7 +20,7 @@ Eigen::VectorXd MaskOf(int size, const std::vector<int>& dofs) {
 }
 
 // Value at time t on the line through two snapshots (the newer one alone if they coincide).
-// Callers clamp t: a late writer must never be extrapolated far (see StepPrimary).
+// Callers clamp t: a late writer must never be extrapolated far.
 inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
                      int i, double t) {
   const double span = newer.time_s - older.time_s;
@@ -28,280 +28,325 @@ inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChann
   return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
 }
 
-}  // namespace
-
-namespace {
-
-// The primary elements that touch Γ, and their DOFs off Γ.
-std::vector<int> BandElements(const RegionPartition& p) {
-  std::vector<char> on_gamma(static_cast<size_t>(p.mesh().num_independent()), 0);
-  const int nr = p.mesh().num_independent();
-  for (int dof : p.interface_dofs()) on_gamma[dof % nr] = 1;
-  std::vector<int> band;
-  for (int e = 0; e < static_cast<int>(p.mesh().elements().size()); ++e) {
-    const HybridElement& element = p.mesh().elements()[e];
-    if (element.region != kPrimaryRegion) continue;
-    bool touches = false;
-    for (int node : element.nodes) {
-      const auto [begin, end] = p.mesh().Gather(node);
-      for (auto* g = begin; g != end; ++g) touches = touches || on_gamma[g->independent];
-    }
-    if (touches) band.push_back(e);
-  }
-  return band;
+BoundaryChannel::Snapshot SnapshotOf(int width) {
+  BoundaryChannel::Snapshot snapshot;
+  snapshot.values = Eigen::VectorXd::Zero(width);
+  return snapshot;
 }
 
 }  // namespace
+
+// Everything one region's thread touches. The link to the next region outwards (if any) is
+// stored here: `inward` is written by the outer region, `outward` by this one.
+struct AsyncRegions::Region {
+  RegionSchedule schedule;
+  std::int64_t period_ticks = 0;
+  std::int64_t state_ticks = 0;
+  const RegionDofs* dofs = nullptr;
+  std::unique_ptr<RegionIntegrator> integrator;
+  std::vector<double> prescribed_values;  // [contact (primary only)] [fixed] [outer Γ]
+  size_t outer_offset = 0;
+  double compute_s = 0;
+
+  // Link with the region outwards: this region is its inner side.
+  std::unique_ptr<BoundaryChannel> inward;   // outer → this: outer Γ displacements
+  std::unique_ptr<BoundaryChannel> outward;  // this → outer: band displacements or Γ forces
+  std::unique_ptr<ElementSetStiffness> band;  // this region's elements next to its outer Γ
+  std::vector<int> band_layer;                // their DOFs off the outer Γ
+  BoundaryChannel::Snapshot outer_newer, outer_older;  // read by this region's thread
+  std::vector<double> outward_values;                  // written by this region's thread
+
+  // Link with the region inwards: this region is its outer side (owns that Γ).
+  BoundaryChannel::Snapshot inner_newer, inner_older;  // read by this region's thread
+  std::vector<double> inward_values, load_values;
+  Eigen::VectorXd band_u, band_ku;  // for evaluating the inner region's band
+
+  // Primary only.
+  std::array<double, 3> contact_now{};
+};
+
+AsyncRegions::~AsyncRegions() = default;
+
+const RegionSchedule& AsyncRegions::schedule(RegionIndex region) const {
+  return regions_[region]->schedule;
+}
+std::int64_t AsyncRegions::period_ticks(RegionIndex region) const {
+  return regions_[region]->period_ticks;
+}
+std::int64_t AsyncRegions::state_ticks(RegionIndex region) const {
+  return regions_[region]->state_ticks;
+}
+double AsyncRegions::compute_seconds(RegionIndex region) const { return regions_[region]->compute_s; }
 
 AsyncRegions::AsyncRegions(const Scene& scene)
     : partition_(scene),
-      coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement : Coupling::kForce),
-      band_stiffness_(std::make_unique<ElementSetStiffness>(partition_.mesh(), scene.material,
-                                                            BandElements(partition_))),
-      band_layer_([&] {
-        std::vector<int> layer;
-        const auto& gamma = partition_.interface_dofs();
-        for (int dof : band_stiffness_->touched_dofs()) {
-          if (!std::binary_search(gamma.begin(), gamma.end(), dof)) layer.push_back(dof);
-        }
-        return layer;
-      }()),
-      interface_displacement_(static_cast<int>(partition_.interface_dofs().size())),
-      interface_force_(static_cast<int>(coupling_ == Coupling::kForce
-                                            ? partition_.interface_dofs().size()
-                                            : band_layer_.size())) {
+      coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement : Coupling::kForce) {
   const RegionPartition& p = partition_;
   const int n = p.mesh().num_dofs();
-  band_u_ = Eigen::VectorXd::Zero(n);
-  band_ku_ = Eigen::VectorXd::Zero(n);
-  const auto rate_p = static_cast<std::int64_t>(std::llround(PrimaryRateHz(scene)));
-  const auto rate_s = static_cast<std::int64_t>(std::llround(scene.adaptivity.secondary_rate_hz));
-  ticks_per_second_ = std::lcm(rate_p, rate_s);
-  period_ticks_[kPrimaryRegion] = ticks_per_second_ / rate_p;
-  period_ticks_[kSecondaryRegion] = ticks_per_second_ / rate_s;
-  common_period_ticks_ = ticks_per_second_ / std::gcd(rate_p, rate_s);
-
-  // Each region's own limit, its boundary held: the primary with Γ, contact and supports
-  // prescribed; the secondary with its supports fixed and Γ free (carrying both sides' mass).
-  schedules_[kPrimaryRegion].rate_hz = static_cast<double>(rate_p);
-  schedules_[kSecondaryRegion].rate_hz = static_cast<double>(rate_s);
-  schedules_[kPrimaryRegion].alone =
-      EstimateStability(p.primary_stiffness(), p.dof_mass(), MaskOf(n, p.primary_owned()));
-  schedules_[kSecondaryRegion].alone =
-      EstimateStability(p.secondary_stiffness(), p.dof_mass(), MaskOf(n, p.secondary_owned()));
-  for (RegionSchedule& s : schedules_) {
-    const double period = 1.0 / s.rate_hz;
-    s.substeps = std::max(1, static_cast<int>(std::ceil(period / (kSubstepSafety * s.alone.critical_dt_s))));
+  const int count = p.num_regions();
+  std::vector<std::int64_t> rates;
+  for (int a = 0; a < count; ++a) {
+    const double rate = a == 0 ? PrimaryRateHz(scene)
+                        : a == 1 ? scene.adaptivity.secondary_rate_hz
+                                 : scene.adaptivity.outer_rate_hz;
+    rates.push_back(static_cast<std::int64_t>(std::llround(rate)));
   }
+  ticks_per_second_ = 1;
+  for (std::int64_t rate : rates) ticks_per_second_ = std::lcm(ticks_per_second_, rate);
+  common_period_ticks_ = 1;
 
-  std::vector<int> primary_prescribed(p.contact_dofs().begin(), p.contact_dofs().end());
-  primary_prescribed.insert(primary_prescribed.end(), p.primary_fixed().begin(), p.primary_fixed().end());
-  primary_prescribed.insert(primary_prescribed.end(), p.interface_dofs().begin(), p.interface_dofs().end());
-  const double damping = scene.material.damping_per_s;
-  primary_ = std::make_unique<RegionIntegrator>(
-      p.primary_stiffness(), p.dof_mass(), damping, p.primary_owned(), primary_prescribed,
-      std::vector<int>{}, 1.0 / (static_cast<double>(rate_p) * schedules_[kPrimaryRegion].substeps));
-  secondary_ = std::make_unique<RegionIntegrator>(
-      p.secondary_stiffness(), p.dof_mass(), damping, p.secondary_owned(), p.secondary_fixed(),
-      p.interface_dofs(), 1.0 / (static_cast<double>(rate_s) * schedules_[kSecondaryRegion].substeps));
+  for (int a = 0; a < count; ++a) {
+    auto region = std::make_unique<Region>();
+    const RegionDofs& dofs = p.dofs(a);
+    region->dofs = &dofs;
+    region->period_ticks = ticks_per_second_ / rates[a];
+    common_period_ticks_ = std::lcm(common_period_ticks_, region->period_ticks);
+    region->schedule.rate_hz = static_cast<double>(rates[a]);
+    // The region's own limit with its boundary held (outer Γ, contact, supports prescribed; the
+    // inner Γ free, carrying the mass of both sides).
+    region->schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, dofs.owned));
+    const double period = 1.0 / region->schedule.rate_hz;
+    region->schedule.substeps = std::max(
+        1, static_cast<int>(std::ceil(period / (kSubstepSafety * region->schedule.alone.critical_dt_s))));
 
-  const int width = static_cast<int>(p.interface_dofs().size());
-  for (auto* snapshot : {&displacement_newer_, &displacement_older_}) {
-    snapshot->values = Eigen::VectorXd::Zero(width);
+    std::vector<int> prescribed;
+    if (a == kPrimaryRegion) prescribed.assign(p.contact_dofs().begin(), p.contact_dofs().end());
+    prescribed.insert(prescribed.end(), dofs.fixed.begin(), dofs.fixed.end());
+    region->outer_offset = prescribed.size();
+    prescribed.insert(prescribed.end(), dofs.outer_interface.begin(), dofs.outer_interface.end());
+    region->prescribed_values.assign(prescribed.size(), 0.0);
+    region->integrator = std::make_unique<RegionIntegrator>(
+        p.stiffness(a), p.dof_mass(), scene.material.damping_per_s, dofs.owned, prescribed,
+        dofs.inner_interface, period / region->schedule.substeps);
+
+    if (a + 1 < count) {
+      region->band = std::make_unique<ElementSetStiffness>(p.mesh(), scene.material,
+                                                           p.outer_band_elements(a));
+      for (int dof : region->band->touched_dofs()) {
+        if (!std::binary_search(dofs.outer_interface.begin(), dofs.outer_interface.end(), dof)) {
+          region->band_layer.push_back(dof);
+        }
+      }
+      const int gamma = static_cast<int>(dofs.outer_interface.size());
+      const int outward_width =
+          coupling_ == Coupling::kForce ? gamma : static_cast<int>(region->band_layer.size());
+      region->inward = std::make_unique<BoundaryChannel>(gamma);
+      region->outward = std::make_unique<BoundaryChannel>(outward_width);
+      region->outer_newer = SnapshotOf(gamma);
+      region->outer_older = SnapshotOf(gamma);
+      region->outward_values.assign(static_cast<size_t>(outward_width), 0.0);
+    }
+    if (a > 0) {
+      const Region& inner = *regions_[a - 1];
+      region->inner_newer = SnapshotOf(inner.outward->width());
+      region->inner_older = SnapshotOf(inner.outward->width());
+      region->inward_values.assign(dofs.inner_interface.size(), 0.0);
+      region->load_values.assign(dofs.inner_interface.size(), 0.0);
+      region->band_u = Eigen::VectorXd::Zero(n);
+      region->band_ku = Eigen::VectorXd::Zero(n);
+    }
+    regions_.push_back(std::move(region));
   }
-  for (auto* snapshot : {&force_newer_, &force_older_}) {
-    snapshot->values = Eigen::VectorXd::Zero(interface_force_.width());
-  }
-  primary_prescribed_.assign(primary_prescribed.size(), 0.0);
-  secondary_prescribed_.assign(p.secondary_fixed().size(), 0.0);
-  secondary_load_.assign(static_cast<size_t>(width), 0.0);
-  interface_values_.assign(static_cast<size_t>(width), 0.0);
-  force_values_.assign(static_cast<size_t>(interface_force_.width()), 0.0);
   Reset();
 }
 
-void AsyncRegions::PublishInitialSnapshots() {
-  const auto& gamma = partition_.interface_dofs();
-  const Eigen::VectorXd& us = secondary_->u();
-  for (size_t i = 0; i < gamma.size(); ++i) interface_values_[i] = us[gamma[i]];
-  interface_displacement_.Publish(0.0, interface_values_);
-  PublishPrimarySide(0.0);
+void AsyncRegions::PublishInward(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  const Eigen::VectorXd& u = region.integrator->u();
+  const auto& gamma = region.dofs->inner_interface;
+  for (size_t i = 0; i < gamma.size(); ++i) region.inward_values[i] = u[gamma[i]];
+  regions_[a - 1]->inward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
+                                   region.inward_values);
 }
 
-void AsyncRegions::PublishPrimarySide(double time_s) noexcept {
+void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
   if (coupling_ == Coupling::kForce) {
-    const auto& gamma = partition_.interface_dofs();
-    const Eigen::VectorXd& kp = primary_->Forces();
-    for (size_t i = 0; i < gamma.size(); ++i) force_values_[i] = kp[gamma[i]];
+    const Eigen::VectorXd& ku = region.integrator->Forces();
+    const auto& gamma = region.dofs->outer_interface;
+    for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
   } else {
-    const Eigen::VectorXd& up = primary_->u();
-    for (size_t i = 0; i < band_layer_.size(); ++i) force_values_[i] = up[band_layer_[i]];
+    const Eigen::VectorXd& u = region.integrator->u();
+    for (size_t i = 0; i < region.band_layer.size(); ++i) region.outward_values[i] = u[region.band_layer[i]];
   }
-  interface_force_.Publish(time_s, force_values_);
+  region.outward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
+                          region.outward_values);
+}
+
+void AsyncRegions::PublishInitialSnapshots() {
+  for (int a = 0; a < num_regions(); ++a) {
+    if (a > 0) PublishInward(a);
+    if (a + 1 < num_regions()) PublishOutward(a);
+  }
 }
 
 void AsyncRegions::Reset() {
-  primary_->Reset();
-  secondary_->Reset();
-  interface_displacement_.Clear();
-  interface_force_.Clear();
-  state_ticks_[0] = state_ticks_[1] = 0;
-  contact_now_ = {0, 0, 0};
-  compute_s_[0] = compute_s_[1] = 0;
+  for (auto& region : regions_) {
+    region->integrator->Reset();
+    if (region->inward) region->inward->Clear();
+    if (region->outward) region->outward->Clear();
+    region->state_ticks = 0;
+    region->compute_s = 0;
+    region->contact_now = {0, 0, 0};
+  }
   PublishInitialSnapshots();
 }
 
 void AsyncRegions::SetRandomState(unsigned seed) {
   Reset();
-  const int n = partition_.mesh().num_dofs();
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uniform(-1e-4, 1e-4);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
-  for (int dof : partition_.primary_owned()) u[dof] = uniform(rng);
-  for (int dof : partition_.secondary_owned()) u[dof] = uniform(rng);
-  // Both copies hold the same values (Γ included); each region reads only its own DOFs.
-  primary_->SetState(u, u);
-  secondary_->SetState(u, u);
-  interface_displacement_.Clear();
-  interface_force_.Clear();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(partition_.mesh().num_dofs());
+  for (int a = 0; a < num_regions(); ++a) {
+    for (int dof : partition_.dofs(a).owned) u[dof] = uniform(rng);
+  }
+  // Every copy holds the same values (each Γ included); each region reads only its own DOFs.
+  for (auto& region : regions_) {
+    region->integrator->SetState(u, u);
+    if (region->inward) region->inward->Clear();
+    if (region->outward) region->outward->Clear();
+  }
   PublishInitialSnapshots();
 }
 
-std::array<double, 3> AsyncRegions::StepPrimary(const std::array<double, 3>& contact_next) noexcept {
+void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* contact_next,
+                                std::array<double, 3>* reaction) noexcept {
   const auto start = Clock::now();
-  const auto& gamma = partition_.interface_dofs();
-  const int substeps = schedules_[kPrimaryRegion].substeps;
-  const double t0 = static_cast<double>(state_ticks_[kPrimaryRegion]) / ticks_per_second_;
-  const double h = primary_->substep();
-  // A failed read (writer racing ahead) keeps the previous snapshots: still a consistent pair.
-  (void)interface_displacement_.TryReadLatestTwo(&displacement_newer_, &displacement_older_);
-  const size_t fixed_end = 3 + partition_.primary_fixed().size();
+  Region& region = *regions_[a];
+  RegionIntegrator& integrator = *region.integrator;
+  const int substeps = region.schedule.substeps;
+  const double t0 = static_cast<double>(region.state_ticks) / ticks_per_second_;
+  const double h = integrator.substep();
+  const bool has_outer = region.inward != nullptr;
+  // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
+  if (has_outer) (void)region.inward->TryReadLatestTwo(&region.outer_newer, &region.outer_older);
+  const Region* inner = a > 0 ? regions_[a - 1].get() : nullptr;
+  double newest_inner_allowed = 0;
+  if (inner != nullptr) {
+    (void)inner->outward->TryReadLatestTwo(&region.inner_newer, &region.inner_older);
+    // The schedule keeps the inner region less than one of its periods behind; never
+    // extrapolate further than that, should it be late.
+    newest_inner_allowed = region.inner_newer.time_s + 1.0 / inner->schedule.rate_hz;
+  }
+  const auto& outer_gamma = region.dofs->outer_interface;
+  const auto& inner_gamma = region.dofs->inner_interface;
 
-  std::array<double, 3> reaction{};
   for (int q = 1; q <= substeps; ++q) {
-    // The schedule keeps the secondary ahead, so Γ is interpolated. If it is late (a stalled
-    // thread), Γ is held at its newest state rather than extrapolated: holding is what keeps the
-    // primary bounded while the secondary catches up.
-    const double t = std::min(t0 + q * h, displacement_newer_.time_s);
-    const double fraction = static_cast<double>(q) / substeps;
-    for (int c = 0; c < 3; ++c) {
-      primary_prescribed_[c] = contact_now_[c] + fraction * (contact_next[c] - contact_now_[c]);
+    if (contact_next != nullptr) {
+      const double fraction = static_cast<double>(q) / substeps;
+      for (int c = 0; c < 3; ++c) {
+        region.prescribed_values[c] =
+            region.contact_now[c] + fraction * ((*contact_next)[c] - region.contact_now[c]);
+      }
     }
-    for (size_t i = 0; i < gamma.size(); ++i) {
-      primary_prescribed_[fixed_end + i] =
-          OnLine(displacement_older_, displacement_newer_, static_cast<int>(i), t);
+    if (has_outer) {
+      // The outer region is ahead: interpolate. If it is late, hold its newest state.
+      const double t = std::min(t0 + q * h, region.outer_newer.time_s);
+      for (size_t i = 0; i < outer_gamma.size(); ++i) {
+        region.prescribed_values[region.outer_offset + i] =
+            OnLine(region.outer_older, region.outer_newer, static_cast<int>(i), t);
+      }
     }
-    primary_->Step(primary_prescribed_, {});
-    if (q == 1) {
-      for (int c = 0; c < 3; ++c) reaction[c] = primary_->PrescribedReaction(c);
+    if (inner != nullptr) {
+      const double t = std::min(t0 + (q - 1) * h, newest_inner_allowed);
+      if (coupling_ == Coupling::kForce) {
+        for (size_t i = 0; i < inner_gamma.size(); ++i) {
+          region.load_values[i] = -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+        }
+      } else {
+        // The inner region's force on Γ from its band: its displacements next to Γ on the line
+        // through its newest two states, Γ itself as this region has it now.
+        for (size_t i = 0; i < inner->band_layer.size(); ++i) {
+          region.band_u[inner->band_layer[i]] =
+              OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+        }
+        const Eigen::VectorXd& u = integrator.u();
+        for (int dof : inner_gamma) region.band_u[dof] = u[dof];
+        inner->band->Apply(region.band_u, region.band_ku);
+        for (size_t i = 0; i < inner_gamma.size(); ++i) region.load_values[i] = -region.band_ku[inner_gamma[i]];
+      }
+    }
+    integrator.Step(region.prescribed_values, region.load_values);
+    if (reaction != nullptr && q == 1) {
+      for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
     }
   }
-  contact_now_ = contact_next;
-  state_ticks_[kPrimaryRegion] += period_ticks_[kPrimaryRegion];
+  if (contact_next != nullptr) region.contact_now = *contact_next;
+  region.state_ticks += region.period_ticks;
+  if (a > 0) PublishInward(a);
+  if (has_outer) PublishOutward(a);
+  region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
+}
 
-  PublishPrimarySide(static_cast<double>(state_ticks_[kPrimaryRegion]) / ticks_per_second_);
-  compute_s_[kPrimaryRegion] += std::chrono::duration<double>(Clock::now() - start).count();
+std::array<double, 3> AsyncRegions::StepPrimary(const std::array<double, 3>& contact_next) noexcept {
+  std::array<double, 3> reaction{};
+  StepRegionAt(kPrimaryRegion, &contact_next, &reaction);
   return reaction;
 }
 
-void AsyncRegions::StepSecondary() noexcept {
-  const auto start = Clock::now();
-  const auto& gamma = partition_.interface_dofs();
-  const int substeps = schedules_[kSecondaryRegion].substeps;
-  const double t0 = static_cast<double>(state_ticks_[kSecondaryRegion]) / ticks_per_second_;
-  const double h = secondary_->substep();
-  (void)interface_force_.TryReadLatestTwo(&force_newer_, &force_older_);
-  // The schedule puts the primary's newest state less than one primary period behind; never
-  // extrapolate further than that, should the primary be late.
-  const double newest_allowed = force_newer_.time_s + 1.0 / schedules_[kPrimaryRegion].rate_hz;
-  for (int q = 0; q < substeps; ++q) {
-    const double t = std::min(t0 + q * h, newest_allowed);
-    if (coupling_ == Coupling::kForce) {
-      for (size_t i = 0; i < gamma.size(); ++i) {
-        secondary_load_[i] = -OnLine(force_older_, force_newer_, static_cast<int>(i), t);
-      }
-    } else {
-      // (K_p u)_Γ from the band of primary elements on Γ: the primary's displacements next to Γ
-      // on the line through its newest two states, Γ itself as the secondary has it now.
-      for (size_t i = 0; i < band_layer_.size(); ++i) {
-        band_u_[band_layer_[i]] = OnLine(force_older_, force_newer_, static_cast<int>(i), t);
-      }
-      const Eigen::VectorXd& us = secondary_->u();
-      for (int dof : gamma) band_u_[dof] = us[dof];
-      band_stiffness_->Apply(band_u_, band_ku_);
-      for (size_t i = 0; i < gamma.size(); ++i) secondary_load_[i] = -band_ku_[gamma[i]];
-    }
-    secondary_->Step(secondary_prescribed_, secondary_load_);
+void AsyncRegions::StepRegion(RegionIndex region) noexcept { StepRegionAt(region, nullptr, nullptr); }
+
+void AsyncRegions::AdvanceRegionTo(RegionIndex a, std::int64_t ticks) noexcept {
+  Region& region = *regions_[a];
+  while (region.state_ticks < ticks) {
+    // Before this region steps to t + P, the region outwards must supply Γ at t + P.
+    if (a + 1 < num_regions()) AdvanceRegionTo(a + 1, region.state_ticks + region.period_ticks);
+    StepRegion(a);
   }
-  state_ticks_[kSecondaryRegion] += period_ticks_[kSecondaryRegion];
-  const Eigen::VectorXd& us = secondary_->u();
-  for (size_t i = 0; i < gamma.size(); ++i) interface_values_[i] = us[gamma[i]];
-  interface_displacement_.Publish(
-      static_cast<double>(state_ticks_[kSecondaryRegion]) / ticks_per_second_, interface_values_);
-  compute_s_[kSecondaryRegion] += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void AsyncRegions::AdvanceSecondariesTo(std::int64_t ticks) noexcept {
+  if (num_regions() > 1) AdvanceRegionTo(1, ticks);
+}
+
+void AsyncRegions::AdvancePrimaryTo(std::int64_t ticks) noexcept {
+  const std::array<double, 3> held{0, 0, 0};
+  Region& primary = *regions_[kPrimaryRegion];
+  while (primary.state_ticks < ticks) {
+    AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
+    StepPrimary(held);
+  }
 }
 
 double AsyncRegions::KineticEnergy() const noexcept {
   double kinetic = 0;
   const Eigen::VectorXd& m = partition_.dof_mass();
-  for (const RegionIntegrator* region : {primary_.get(), secondary_.get()}) {
-    const Eigen::VectorXd& u = region->u();
-    const Eigen::VectorXd& up = region->u_previous();
-    const double h = region->substep();
-    for (int i : region->owned()) kinetic += m[i] * (u[i] - up[i]) * (u[i] - up[i]) / (h * h);
+  for (const auto& region : regions_) {
+    const Eigen::VectorXd& u = region->integrator->u();
+    const Eigen::VectorXd& up = region->integrator->u_previous();
+    const double h = region->integrator->substep();
+    for (int i : region->dofs->owned) kinetic += m[i] * (u[i] - up[i]) * (u[i] - up[i]) / (h * h);
   }
   return 0.5 * kinetic;
 }
 
 double AsyncRegions::Energy() noexcept {
-  double kinetic = 0, strain = 0;
-  auto add = [&](RegionIntegrator& region) {
-    const Eigen::VectorXd& ku = region.Forces();
-    const Eigen::VectorXd& u = region.u();
-    const Eigen::VectorXd& up = region.u_previous();
-    const Eigen::VectorXd& m = partition_.dof_mass();
-    const double h = region.substep();
-    for (int i : region.owned()) kinetic += m[i] * (u[i] - up[i]) * (u[i] - up[i]) / (h * h);
-    // Each DOF's strain term counted once overall: Γ by the secondary, the rest by its owner.
-    for (int i : region.owned()) strain += u[i] * ku[i];
-  };
-  add(*primary_);
-  add(*secondary_);
-  // Γ rows: the primary's share of (K u)_Γ was left out above (Γ is owned by the secondary).
-  const Eigen::VectorXd& kp = primary_->Forces();
-  const Eigen::VectorXd& up = primary_->u();
-  for (int i : partition_.interface_dofs()) strain += up[i] * kp[i];
-  return 0.5 * (kinetic + strain);
-}
-
-void AsyncRegions::AdvanceSchedule(std::int64_t primary_target_ticks) {
-  const std::array<double, 3> held{0, 0, 0};
-  while (state_ticks_[kPrimaryRegion] < primary_target_ticks) {
-    while (state_ticks_[kSecondaryRegion] <
-           state_ticks_[kPrimaryRegion] + period_ticks_[kPrimaryRegion]) {
-      StepSecondary();
-    }
-    StepPrimary(held);
+  double strain = 0;
+  for (auto& region : regions_) {
+    const Eigen::VectorXd& ku = region->integrator->Forces();
+    const Eigen::VectorXd& u = region->integrator->u();
+    // Owned rows, plus this region's share of the outer Γ rows (owned by the next region).
+    for (int i : region->dofs->owned) strain += u[i] * ku[i];
+    for (int i : region->dofs->outer_interface) strain += u[i] * ku[i];
   }
+  return KineticEnergy() + 0.5 * strain;
 }
 
 TrialResult AsyncRegions::RunTrial() {
   const Scene& scene = partition_.scene();
   TrialResult result;
-  result.stability = schedules_[kPrimaryRegion].alone;
+  result.stability = regions_[kPrimaryRegion]->schedule.alone;
   Reset();
   const ContactTrajectory trajectory(scene.input);
-  const double dt = 1.0 / schedules_[kPrimaryRegion].rate_hz;
+  const double dt = 1.0 / regions_[kPrimaryRegion]->schedule.rate_hz;
   const long steps = scene.num_steps();
   result.samples.reserve(static_cast<size_t>(steps) + 1);
   const double budget = Energy();  // 0 from rest
   double work = 0;
   const auto start = Clock::now();
+  Region& primary = *regions_[kPrimaryRegion];
   for (long n = 0; n <= steps; ++n) {
-    while (state_ticks_[kSecondaryRegion] <
-           state_ticks_[kPrimaryRegion] + period_ticks_[kPrimaryRegion]) {
-      StepSecondary();
-    }
+    AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
     const double t = n * dt;
     const double depth_next = trajectory.DepthAt(t + dt);
     const std::array<double, 3> r = StepPrimary({0.0, 0.0, depth_next});
@@ -330,24 +375,29 @@ TrialResult AsyncRegions::RunTrial() {
   return result;
 }
 
+double AsyncRegions::StateNorm() const {
+  double sum = 0;
+  for (const auto& region : regions_) sum += region->integrator->OwnedStateNormSquared();
+  return std::sqrt(sum);
+}
+
+void AsyncRegions::ScaleAll(double factor) {
+  for (auto& region : regions_) {
+    region->integrator->ScaleState(factor);
+    if (region->inward) region->inward->ScaleAll(factor);
+    if (region->outward) region->outward->ScaleAll(factor);
+  }
+}
+
 CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int window_periods) {
   CoupledStability out;
   out.common_period_s = static_cast<double>(common_period_ticks_) / ticks_per_second_;
   SetRandomState(7);
-  auto norm = [&] {
-    return std::sqrt(primary_->OwnedStateNormSquared() + secondary_->OwnedStateNormSquared());
-  };
-  auto rescale = [&](double factor) {
-    primary_->ScaleState(factor);
-    secondary_->ScaleState(factor);
-    interface_displacement_.ScaleAll(factor);
-    interface_force_.ScaleAll(factor);
-  };
-  rescale(1.0 / norm());
+  ScaleAll(1.0 / StateNorm());
   double log_growth = 0;
   for (int period = 1; period <= burn_in_periods + window_periods; ++period) {
-    AdvanceSchedule(period * common_period_ticks_);
-    const double size = norm();
+    AdvancePrimaryTo(period * common_period_ticks_);
+    const double size = StateNorm();
     out.periods = period;
     if (!std::isfinite(size) || size > 1e100) {
       out.spectral_radius = INFINITY;
@@ -356,7 +406,7 @@ CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int
       return out;
     }
     if (period > burn_in_periods) log_growth += std::log(size);
-    rescale(1.0 / size);
+    ScaleAll(1.0 / size);
   }
   out.spectral_radius = std::exp(log_growth / window_periods);
   out.stable = out.spectral_radius < CoupledStability::kStableBelow;
@@ -369,7 +419,7 @@ std::vector<double> AsyncRegions::FreeDecayEnergies(int periods_per_checkpoint, 
   SetRandomState(seed);
   std::vector<double> energies{Energy()};
   for (int c = 1; c <= checkpoints; ++c) {
-    AdvanceSchedule(static_cast<std::int64_t>(c) * periods_per_checkpoint * common_period_ticks_);
+    AdvancePrimaryTo(static_cast<std::int64_t>(c) * periods_per_checkpoint * common_period_ticks_);
     energies.push_back(Energy());
   }
   Reset();

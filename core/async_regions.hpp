@@ -24,7 +24,7 @@ struct RegionSchedule {
 /** The spectral radius of the map that advances the coupled state by one common period. */
 struct CoupledStability {
   double spectral_radius = 0;  ///< per common period; < 1 decays, > 1 grows
-  double common_period_s = 0;  ///< 1 / gcd(rates)
+  double common_period_s = 0;  ///< the shortest time after which every region's schedule repeats
   int periods = 0;             ///< periods of power iteration used
   bool stable = false;         ///< spectral_radius < kStableBelow
   /** Margin below 1 that counts as stable: a mode decaying slower than this is refused. */
@@ -32,30 +32,33 @@ struct CoupledStability {
 };
 
 /**
- * The object solved as two asynchronous regions (see RegionPartition): the primary at the
- * primary rate 1/solver.dt, the secondary at adaptivity.secondary_rate, each with the substeps
- * its own stability limit requires, linked through two BoundaryChannels:
+ * The object solved as asynchronous regions (see RegionPartition): the primary at the primary
+ * rate 1/solver.dt, the first secondary shell at adaptivity.secondary_rate, further shells at
+ * adaptivity.outer_rate, each with the substeps its own stability limit requires. Neighbouring
+ * regions a (inner) and a + 1 (outer, which owns their interface Γ) are linked through two
+ * BoundaryChannels:
  *
- *   secondary → primary: Γ displacements at the secondary's step times. The primary takes Γ at
- *                        each of its substep times on the line through the newest two
- *                        (interpolation when the secondary is ahead, as the virtual-time
- *                        schedule guarantees; extrapolation if it is late).
- *   primary → secondary: the primary's forces on Γ, (K_p u)_Γ, at the primary's step times. The
- *                        secondary extrapolates them linearly to each of its substep times.
+ *   outer → inner: Γ displacements at the outer region's step times. The inner region takes Γ at
+ *                  each of its substep times on the line between the newest two (interpolation:
+ *                  the schedule keeps the outer region ahead; a late one is held, never
+ *                  extrapolated).
+ *   inner → outer: with adaptivity.coupling = "displacement", the inner region's displacements
+ *                  on its band of elements next to Γ; the outer region evaluates the inner
+ *                  region's force on Γ itself from them (extrapolated linearly to its own time)
+ *                  and its own current Γ, so only the cross-coupling lags. With "force", the
+ *                  inner region's forces on Γ, extrapolated.
  *
- * Why this exchange (docs/regions.md): the secondary owns Γ with the mass of both sides, so at
- * equal rates the scheme is exactly monolithic central difference (k = 1 reproduces the
- * reference to round-off). With unequal rates a lagged interface force acts as negative
- * damping; extrapolating the force to the secondary's time instead of averaging or holding it
- * removes the first-order lag. Whether what remains is stable depends on the configuration, so
- * every configuration's coupled spectral radius is computed before it may run.
+ * At equal rates the scheme is exactly monolithic central difference (k = 1 reproduces the
+ * reference to round-off). With unequal rates the lagged coupling acts as negative damping; whether
+ * it is stable depends on the configuration, so the coupled spectral radius is computed before a
+ * configuration may run (docs/regions.md).
  *
- * StepPrimary() and StepSecondary() are the only code that advances the simulation. The
- * virtual-time schedule (RunTrial, EstimateCoupledStability) calls them in a deterministic order;
- * a real-time schedule calls them from one thread each.
+ * StepPrimary() and StepRegion() are the only code that advances the simulation. The virtual-time
+ * schedule (RunTrial, EstimateCoupledStability) calls them in a deterministic order; the
+ * real-time schedule calls them from one thread per region.
  *
- * Threads: StepPrimary from one thread, StepSecondary from one (possibly other) thread; neither
- * allocates, locks or throws. Everything else: one thread, while no steps run.
+ * Threads: each region's step from one thread; steps never allocate, lock or throw. Everything
+ * else: one thread, while no steps run.
  */
 class AsyncRegions {
  public:
@@ -64,29 +67,27 @@ class AsyncRegions {
   /** Substeps keep each region's step at most this fraction of its own critical step. */
   static constexpr double kSubstepSafety = 0.95;
 
-  /** What the primary sends the secondary for Γ. */
-  enum class Coupling {
-    kForce,         ///< the primary's Γ forces (K_p u)_Γ, extrapolated to the secondary's time
-    kDisplacement,  ///< the primary's displacements next to Γ; the secondary evaluates (K_p u)_Γ
-                    ///< itself with its own current Γ, so only the cross-coupling is lagged
-  };
+  /** What an inner region sends the outer one for Γ. */
+  enum class Coupling { kForce, kDisplacement };
 
-  /** @throws Error for invalid adaptivity settings. The coupling is adaptivity.coupling. */
+  /** @throws Error for invalid adaptivity settings. */
   explicit AsyncRegions(const Scene& scene);
+  ~AsyncRegions();
 
   const RegionPartition& partition() const { return partition_; }
-  const RegionSchedule& schedule(RegionIndex region) const { return schedules_[region]; }
+  int num_regions() const { return partition_.num_regions(); }
+  const RegionSchedule& schedule(RegionIndex region) const;
 
   /** Integer ticks of the virtual-time clock: 1 tick = 1 / ticks_per_second() s. */
   std::int64_t ticks_per_second() const { return ticks_per_second_; }
-  std::int64_t period_ticks(RegionIndex region) const { return period_ticks_[region]; }
+  std::int64_t period_ticks(RegionIndex region) const;
   std::int64_t common_period_ticks() const { return common_period_ticks_; }
-  /** Time of each region's current state, ticks. */
-  std::int64_t state_ticks(RegionIndex region) const { return state_ticks_[region]; }
+  /** Time of a region's current state, ticks. Read by the thread stepping that region. */
+  std::int64_t state_ticks(RegionIndex region) const;
 
   /** Zero state at t = 0 with the initial snapshots published. */
   void Reset();
-  /** A reproducible random state (free DOFs), consistent on Γ, at t = 0. */
+  /** A reproducible random state (free DOFs), consistent on every Γ, at t = 0. */
   void SetRandomState(unsigned seed);
 
   /**
@@ -95,10 +96,15 @@ class AsyncRegions {
    * contact at the period's start time, N (the force on the user is −R).
    */
   std::array<double, 3> StepPrimary(const std::array<double, 3>& contact_next) noexcept;
-  /** Secondary thread: one secondary period. */
-  void StepSecondary() noexcept;
+  /** A secondary region's thread: one period of region `region` ≥ 1. */
+  void StepRegion(RegionIndex region) noexcept;
+  /**
+   * Virtual time: steps the secondary regions (outermost first, recursively) until region 1 can
+   * supply Γ at `ticks`, as the primary's next step needs.
+   */
+  void AdvanceSecondariesTo(std::int64_t ticks) noexcept;
 
-  /** Positive-definite energy of the coupled state (both regions), J. */
+  /** Positive-definite energy of the coupled state (all regions), J. */
   double Energy() noexcept;
   /** Its kinetic part, ½ Σ m v² over the owned DOFs (no K·u needed), J. */
   double KineticEnergy() const noexcept;
@@ -116,34 +122,25 @@ class AsyncRegions {
   std::vector<double> FreeDecayEnergies(int periods_per_checkpoint, int checkpoints,
                                         unsigned seed = 11);
 
-  /** Compute time spent in each region's steps since Reset, s. */
-  double compute_seconds(RegionIndex region) const { return compute_s_[region]; }
+  /** Compute time spent in a region's steps since Reset, s. */
+  double compute_seconds(RegionIndex region) const;
 
  private:
+  struct Region;
   void PublishInitialSnapshots();
-  void PublishPrimarySide(double time_s) noexcept;
-  void AdvanceSchedule(std::int64_t primary_target_ticks);
+  void PublishInward(RegionIndex region) noexcept;
+  void PublishOutward(RegionIndex region) noexcept;
+  void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
+                    std::array<double, 3>* reaction) noexcept;
+  void AdvanceRegionTo(RegionIndex region, std::int64_t ticks) noexcept;
+  void AdvancePrimaryTo(std::int64_t ticks) noexcept;
+  void ScaleAll(double factor);
+  double StateNorm() const;
 
   RegionPartition partition_;
   Coupling coupling_;
-  std::unique_ptr<ElementSetStiffness> band_stiffness_;  // primary elements touching Γ
-  std::vector<int> band_layer_;  // their DOFs that are not on Γ
-  Eigen::VectorXd band_u_, band_ku_;
-  RegionSchedule schedules_[2];
+  std::vector<std::unique_ptr<Region>> regions_;
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
-  std::int64_t period_ticks_[2] = {0, 0};
-  std::int64_t state_ticks_[2] = {0, 0};
-  std::unique_ptr<RegionIntegrator> primary_, secondary_;
-  BoundaryChannel interface_displacement_;  // secondary → primary
-  BoundaryChannel interface_force_;         // primary → secondary (forces or band displacements)
-
-  // Preallocated work space of the two step functions (each used by one thread only).
-  BoundaryChannel::Snapshot displacement_newer_, displacement_older_;
-  BoundaryChannel::Snapshot force_newer_, force_older_;
-  std::vector<double> primary_prescribed_, secondary_prescribed_, secondary_load_;
-  std::vector<double> interface_values_, force_values_;
-  std::array<double, 3> contact_now_{};
-  double compute_s_[2] = {0, 0};
 };
 
 }  // namespace hapticsim

@@ -1,6 +1,7 @@
 #include "core/hybrid_mesh.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <string>
 
 #include "core/error.hpp"
@@ -46,6 +47,28 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
         cell_region[id] = primary ? kPrimaryRegion : kSecondaryRegion;
       }
     }
+  }
+  // Secondary shells: Chebyshev distance (in coarse cells) to the nearest primary cell.
+  if (options.secondary_regions > 1) {
+    std::vector<std::array<int, 3>> primary_cells;
+    for (int cz = 0; cz < nc; ++cz)
+      for (int cy = 0; cy < nc; ++cy)
+        for (int cx = 0; cx < nc; ++cx)
+          if (cell_region[cell_index(cx, cy, cz)] == kPrimaryRegion) primary_cells.push_back({cx, cy, cz});
+    for (int cz = 0; cz < nc; ++cz)
+      for (int cy = 0; cy < nc; ++cy)
+        for (int cx = 0; cx < nc; ++cx) {
+          const int id = cell_index(cx, cy, cz);
+          if (cell_region[id] == kPrimaryRegion) continue;
+          int distance = nc;
+          for (const auto& c : primary_cells) {
+            distance = std::min(distance, std::max({std::abs(cx - c[0]), std::abs(cy - c[1]),
+                                                    std::abs(cz - c[2])}));
+          }
+          const int shell = std::min(options.secondary_regions - 1,
+                                     (distance - 1) / std::max(1, options.shell_cells));
+          cell_region[id] = kSecondaryRegion + shell;
+        }
   }
 
   // 2. Nodes and elements. A refined cell contributes its k³ fine elements, an unrefined one a
@@ -148,6 +171,7 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
 
   region_mask_.assign(independent_lattice_.size(), 0u);
   for (const HybridElement& e : elements_) {
+    num_regions_ = std::max(num_regions_, e.region + 1);
     for (int node : e.nodes) {
       const auto [begin, end] = Gather(node);
       for (auto* g = begin; g != end; ++g) region_mask_[g->independent] |= 1u << e.region;

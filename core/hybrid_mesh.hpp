@@ -9,7 +9,7 @@
 
 namespace hapticsim {
 
-/** Which region an element belongs to: 0 is the primary region, 1 the secondary. */
+/** Which region an element belongs to: 0 is the primary region, 1… the secondary shells. */
 using RegionIndex = int;
 constexpr RegionIndex kPrimaryRegion = 0;
 constexpr RegionIndex kSecondaryRegion = 1;
@@ -52,6 +52,10 @@ class HybridMesh {
     std::array<int, 3> primary_lo{}, primary_hi{};  ///< primary box, lattice indices (closed)
     std::vector<std::array<int, 3>> supports;       ///< lattice indices of fixed nodes
     int support_layers = 1;    ///< coarse cells refined around each support, per direction
+    /// Secondary cells split into this many nested shells around the primary cells (regions
+    /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.
+    int secondary_regions = 1;
+    int shell_cells = 1;
   };
 
   /** @throws Error when k does not divide n − 1. */
@@ -77,6 +81,8 @@ class HybridMesh {
   /** Lumped mass of each independent DOF for density ρ, kg (component-blocked). */
   Eigen::VectorXd DofMass(double density_kg_m3) const;
 
+  /** Number of regions that have elements (primary + secondary shells). */
+  int num_regions() const { return num_regions_; }
   /** Bit r set when elements of region r touch the independent node (through its gathers). */
   const std::vector<unsigned>& region_mask() const { return region_mask_; }
 
@@ -90,6 +96,7 @@ class HybridMesh {
   std::vector<std::array<int, 3>> independent_lattice_;
   std::vector<unsigned> region_mask_;
   int num_hanging_ = 0;
+  int num_regions_ = 0;
 };
 
 }  // namespace hapticsim

@@ -53,57 +53,65 @@ struct LoopRecord {
 TrialResult RealTimeSchedule::RunTrial() {
   const Scene& scene = regions_.partition().scene();
   const ContactTrajectory trajectory(scene.input);
+  const int count = regions_.num_regions();
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();
   const double tick_ns = 1e9 / static_cast<double>(regions_.ticks_per_second());
   const std::int64_t primary_period_ticks = regions_.period_ticks(kPrimaryRegion);
-  const std::int64_t secondary_period_ticks = regions_.period_ticks(kSecondaryRegion);
+  const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
   regions_.Reset();
 
   TrialResult result;
   result.stability = regions_.schedule(kPrimaryRegion).alone;
   result.samples.resize(static_cast<size_t>(steps) + 1);
-  LoopRecord records[2];
-  records[0].execution_s.reserve(static_cast<size_t>(steps) + 1);
-  const auto secondary_steps = static_cast<size_t>(
-      std::ceil((steps + 2) * static_cast<double>(primary_period_ticks) / secondary_period_ticks) + 2);
-  records[1].execution_s.reserve(secondary_steps);
+  std::vector<LoopRecord> records(static_cast<size_t>(count));
+  std::vector<std::int64_t> lead_ns(static_cast<size_t>(count), 0);
+  for (int a = 0; a < count; ++a) {
+    const std::int64_t period = regions_.period_ticks(a);
+    records[a].execution_s.reserve(static_cast<size_t>(end_ticks / period + 4));
+    if (a > 0) {
+      lead_ns[a] = lead_ns[a - 1] +
+                   static_cast<std::int64_t>(1.25 * regions_.period_ticks(a - 1) * tick_ns);
+    }
+  }
 
-  // Wall-clock origin of simulation time 0, far enough ahead for the secondary's early release.
-  const std::int64_t origin_ns = NowNs() + 20'000'000;
-  const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
+  // Wall-clock origin of simulation time 0, far enough ahead for the outer regions' leads.
+  const std::int64_t origin_ns = NowNs() + 20'000'000 + lead_ns.back();
   std::atomic<bool> primary_done{false};
 
-  std::thread secondary([&] {
-    LoopRecord& record = records[1];
-    const auto lead_ns = static_cast<std::int64_t>(1.25 * primary_period_ticks * tick_ns);
-    while (!primary_done.load(std::memory_order_acquire)) {
-      const std::int64_t state = regions_.state_ticks(kSecondaryRegion);
-      if (state >= end_ticks + secondary_period_ticks) break;
-      const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns;
-      SleepUntilNs(release);
-      const std::int64_t woke = NowNs();
-      regions_.StepSecondary();
-      const std::int64_t done = NowNs();
-      const double period_ns = secondary_period_ticks * tick_ns;
-      record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
-      if (woke - release > period_ns || done > release + period_ns) ++record.misses;
-      if (record.execution_s.size() < record.execution_s.capacity()) {
-        record.execution_s.push_back((done - woke) * 1e-9);
+  std::vector<std::thread> threads;
+  for (int a = 1; a < count; ++a) {
+    threads.emplace_back([&, a] {
+      LoopRecord& record = records[a];
+      const std::int64_t period = regions_.period_ticks(a);
+      const double period_ns = period * tick_ns;
+      while (!primary_done.load(std::memory_order_acquire)) {
+        const std::int64_t state = regions_.state_ticks(a);
+        if (state >= end_ticks + period) break;
+        const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns[a];
+        SleepUntilNs(release);
+        const std::int64_t woke = NowNs();
+        regions_.StepRegion(a);
+        const std::int64_t done = NowNs();
+        record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
+        if (woke - release > period_ns || done > release + period_ns) ++record.misses;
+        if (record.execution_s.size() < record.execution_s.capacity()) {
+          record.execution_s.push_back((done - woke) * 1e-9);
+        }
       }
-    }
-  });
+    });
+  }
 
+  LoopRecord& record = records[kPrimaryRegion];
+  const double period_ns = primary_period_ticks * tick_ns;
   for (long n = 0; n <= steps; ++n) {
-    LoopRecord& record = records[0];
-    const std::int64_t release = origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
+    const std::int64_t release =
+        origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
     SleepUntilNs(release);
     const std::int64_t woke = NowNs();
     const double t = n * dt;
-    const double depth_next = trajectory.DepthAt(t + dt);
-    const std::array<double, 3> r = regions_.StepPrimary({0.0, 0.0, depth_next});
+    const std::array<double, 3> r = regions_.StepPrimary({0.0, 0.0, trajectory.DepthAt(t + dt)});
     const std::int64_t done = NowNs();
-    const double period_ns = primary_period_ticks * tick_ns;
     record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
     if (woke - release > period_ns || done > release + period_ns) ++record.misses;
     record.execution_s.push_back((done - woke) * 1e-9);
@@ -121,12 +129,13 @@ TrialResult RealTimeSchedule::RunTrial() {
     }
   }
   primary_done.store(true, std::memory_order_release);
-  secondary.join();
+  for (std::thread& thread : threads) thread.join();
   result.samples.resize(static_cast<size_t>(result.steps));
-  result.wall_time_s = regions_.compute_seconds(kPrimaryRegion) + regions_.compute_seconds(kSecondaryRegion);
-  stats_[kPrimaryRegion] = records[0].Summarise(dt);
-  stats_[kSecondaryRegion] =
-      records[1].Summarise(1.0 / regions_.schedule(kSecondaryRegion).rate_hz);
+  stats_.clear();
+  for (int a = 0; a < count; ++a) {
+    result.wall_time_s += regions_.compute_seconds(a);
+    stats_.push_back(records[a].Summarise(1.0 / regions_.schedule(a).rate_hz));
+  }
   return result;
 }
 

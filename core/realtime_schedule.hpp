@@ -25,12 +25,13 @@ struct DeadlineStats {
  * waits for the secondary: it takes whatever Γ snapshots are newest.
  *
  * Phases follow the virtual-time schedule: the primary's step over [tᵢ, tᵢ₊₁] is released at
- * wall time tᵢ (its force at tᵢ is out at once); the secondary's step over [Tⱼ, Tⱼ₊₁] is released
- * 1.25 primary periods before Tⱼ, so its Γ at Tⱼ₊₁ is published before any primary step needs it.
- * The extra quarter period keeps the two threads from waking at the same instant, so the
- * secondary deterministically reads the primary state just before Tⱼ and extrapolates — which is
- * where a threaded run may differ from the virtual-time one (the virtual schedule uses the
- * primary state at Tⱼ itself when Tⱼ falls on the primary's grid).
+ * wall time tᵢ (its force at tᵢ is out at once); region a's step over [Tⱼ, Tⱼ₊₁] is released
+ * lead(a) before Tⱼ, with lead(a) = lead(a − 1) + 1.25 periods of region a − 1, so its Γ at Tⱼ₊₁
+ * is published before the region inwards needs it. The extra quarter period keeps neighbours
+ * from waking at the same instant, so the outer region deterministically reads the inner state
+ * just before Tⱼ and extrapolates — which is where a threaded run may differ from the
+ * virtual-time one (the virtual schedule uses the inner state at Tⱼ itself when Tⱼ falls on the
+ * inner region's grid).
  *
  * Threads: Run() starts and joins the two region threads; call it from one thread.
  */
@@ -41,12 +42,12 @@ class RealTimeSchedule {
   /** Runs the scene's trial in real time and returns the forces like AsyncRegions::RunTrial. */
   TrialResult RunTrial();
 
-  const DeadlineStats& primary_stats() const { return stats_[kPrimaryRegion]; }
-  const DeadlineStats& secondary_stats() const { return stats_[kSecondaryRegion]; }
+  /** Deadline statistics of each region's thread after RunTrial(). */
+  const DeadlineStats& stats(RegionIndex region) const { return stats_[region]; }
 
  private:
   AsyncRegions& regions_;
-  DeadlineStats stats_[2];
+  std::vector<DeadlineStats> stats_;
 };
 
 }  // namespace hapticsim

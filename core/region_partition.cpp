@@ -24,19 +24,28 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
   }
   options.supports = {{0, 0, last}, {last, 0, last}, {0, last, last}, {last, last, last}};
   options.support_layers = scene.adaptivity.support_layers;
+  options.secondary_regions = scene.adaptivity.secondary_regions;
+  options.shell_cells = scene.adaptivity.shell_cells;
   mesh_ = std::make_unique<HybridMesh>(options);
   dof_mass_ = mesh_->DofMass(scene.material.density_kg_m3);
 
-  std::vector<int> primary_elements, secondary_elements;
+  const int regions = 1 + scene.adaptivity.secondary_regions;
+  std::vector<std::vector<int>> elements(static_cast<size_t>(regions));
   for (int e = 0; e < static_cast<int>(mesh_->elements().size()); ++e) {
-    (mesh_->elements()[e].region == kPrimaryRegion ? primary_elements : secondary_elements).push_back(e);
+    elements[mesh_->elements()[e].region].push_back(e);
   }
-  HAPTICSIM_THROW_UNLESS(!secondary_elements.empty(),
-                         "adaptivity.primary_size = " + std::to_string(r) +
-                             " leaves no secondary region");
-  primary_stiffness_ = std::make_unique<ElementSetStiffness>(*mesh_, scene.material, primary_elements);
-  secondary_stiffness_ =
-      std::make_unique<ElementSetStiffness>(*mesh_, scene.material, secondary_elements);
+  for (int region = 1; region < regions; ++region) {
+    HAPTICSIM_THROW_UNLESS(!elements[region].empty(),
+                           "adaptivity.primary_size = " + std::to_string(r) +
+                               (regions == 2 ? std::string(" leaves no secondary region")
+                                             : " leaves secondary region " + std::to_string(region) +
+                                                   " of adaptivity.secondary_regions = " +
+                                                   std::to_string(regions - 1) +
+                                                   " empty: use fewer or thinner shells"));
+  }
+  for (int region = 0; region < regions; ++region) {
+    stiffness_.push_back(std::make_unique<ElementSetStiffness>(*mesh_, scene.material, elements[region]));
+  }
 
   const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
   HAPTICSIM_THROW_UNLESS(contact_node >= 0, "internal: the contact node is not independent");
@@ -50,28 +59,44 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
 
   const auto& mask = mesh_->region_mask();
   const int nr = mesh_->num_independent();
-  auto is_fixed = [&](int dof) { return std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(), dof); };
-  auto is_contact = [&](int dof) {
-    return std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end();
-  };
   HAPTICSIM_THROW_UNLESS(mask[contact_node] == 1u,
                          "internal: the contact must lie inside the primary region");
+  dofs_.resize(static_cast<size_t>(regions));
   for (int c = 0; c < 3; ++c) {
     for (int node = 0; node < nr; ++node) {
+      const unsigned m = mask[node];
       const int dof = c * nr + node;
-      const bool in_primary = mask[node] & 1u, in_secondary = mask[node] & 2u;
-      if (is_fixed(dof)) {
-        if (in_primary) primary_fixed_.push_back(dof);
-        if (in_secondary) secondary_fixed_.push_back(dof);
+      // Nested shells: a node belongs to one region or to two neighbours.
+      const int outermost = 31 - __builtin_clz(m);
+      const int innermost = __builtin_ctz(m);
+      HAPTICSIM_THROW_UNLESS(outermost - innermost <= 1,
+                             "internal: regions " + std::to_string(innermost) + " and " +
+                                 std::to_string(outermost) + " touch without the shell between");
+      if (std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(), dof)) {
+        for (int region = innermost; region <= outermost; ++region) dofs_[region].fixed.push_back(dof);
         continue;
       }
-      if (is_contact(dof)) continue;
-      if (in_primary && in_secondary) interface_dofs_.push_back(dof);
-      if (in_secondary) {
-        secondary_owned_.push_back(dof);
-      } else if (in_primary) {
-        primary_owned_.push_back(dof);
+      if (std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end()) continue;
+      dofs_[outermost].owned.push_back(dof);
+      if (outermost != innermost) {
+        dofs_[outermost].inner_interface.push_back(dof);
+        dofs_[innermost].outer_interface.push_back(dof);
       }
+    }
+  }
+
+  // The band of each region next to its outer interface.
+  band_.resize(static_cast<size_t>(regions));
+  for (int region = 0; region + 1 < regions; ++region) {
+    std::vector<char> on_gamma(static_cast<size_t>(nr), 0);
+    for (int dof : dofs_[region].outer_interface) on_gamma[dof % nr] = 1;
+    for (int e : elements[region]) {
+      bool touches = false;
+      for (int node : mesh_->elements()[e].nodes) {
+        const auto [begin, end] = mesh_->Gather(node);
+        for (auto* g = begin; g != end; ++g) touches = touches || on_gamma[g->independent];
+      }
+      if (touches) band_[region].push_back(e);
     }
   }
 }
@@ -84,6 +109,12 @@ int RegionPartition::num_elements(RegionIndex region) const {
 int RegionPartition::num_nodes(RegionIndex region) const {
   return static_cast<int>(std::count_if(mesh_->region_mask().begin(), mesh_->region_mask().end(),
                                         [&](unsigned m) { return (m >> region) & 1u; }));
+}
+
+std::string RegionPartition::RegionName(RegionIndex region) const {
+  if (region == kPrimaryRegion) return "primary";
+  if (num_regions() == 2) return "secondary";
+  return "secondary " + std::to_string(region);
 }
 
 }  // namespace hapticsim

@@ -159,6 +159,18 @@ const std::vector<KeyAccess>& KeyTable() {
                             "coarse cells refined around each fixed node (the supports are "
                             "singular: a coarse cell there is far too stiff)"},
                            [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
+    keys.push_back(Integer({"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
+                            "secondary regions: nested shells around the primary, each with its "
+                            "own thread"},
+                           [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
+    keys.push_back(Integer({"adaptivity.shell_cells", "", "a whole number from 1 to 100",
+                            "thickness of each secondary shell but the last, in coarse cells"},
+                           [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
+    keys.push_back(Real({"adaptivity.outer_rate", "Hz",
+                         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+                         "update rate of the secondary shells beyond the first"},
+                        [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
+                        [](double v) { return v >= 1 && v == std::floor(v); }));
     keys.push_back(KeyAccess{
         {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
          "what the primary sends the secondary: its displacements next to the interface "
@@ -213,10 +225,13 @@ void ValidateAdaptivity(const Scene& scene) {
                 FormatReal(primary_rate) +
                 " Hz: with adaptivity on, solver.dt must be 1 / (a whole number of Hz), e.g. 0.001");
   }
-  if (a.secondary_rate_hz > std::round(primary_rate)) {
-    throw Error("adaptivity.secondary_rate = " + FormatReal(a.secondary_rate_hz) +
-                " Hz is not allowed: adaptivity.secondary_rate must be at most the primary rate " +
-                "1/solver.dt = " + FormatReal(std::round(primary_rate)) + " Hz");
+  for (const auto& [key, rate] : {std::pair{"adaptivity.secondary_rate", a.secondary_rate_hz},
+                                   std::pair{"adaptivity.outer_rate", a.outer_rate_hz}}) {
+    if (rate > std::round(primary_rate)) {
+      throw Error(std::string(key) + " = " + FormatReal(rate) + " Hz is not allowed: " + key +
+                  " must be at most the primary rate 1/solver.dt = " +
+                  FormatReal(std::round(primary_rate)) + " Hz");
+    }
   }
   if (PrimaryBoxCoversObject(scene, a.primary_size)) {
     int largest = 0;

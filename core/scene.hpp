@@ -39,6 +39,9 @@ struct AdaptivitySettings {
   int secondary_lod = 2;         ///< secondary spacing factor k (adaptivity.secondary_lod)
   double secondary_rate_hz = 600;  ///< secondary region rate, Hz (adaptivity.secondary_rate)
   int support_layers = 1;        ///< coarse cells refined around each fixed node (adaptivity.support_layers)
+  int secondary_regions = 1;     ///< nested secondary shells, one thread each (adaptivity.secondary_regions)
+  int shell_cells = 1;           ///< thickness of each inner shell, coarse cells (adaptivity.shell_cells)
+  double outer_rate_hz = 600;    ///< rate of the shells beyond the first, Hz (adaptivity.outer_rate)
   /// What the primary sends the secondary for the interface (adaptivity.coupling):
   /// true = its displacements next to Γ ("displacement", the default), false = its Γ forces.
   bool displacement_coupling = true;

@@ -33,6 +33,36 @@ TEST(AsyncRegions, EqualRatesAtFullResolutionReproduceTheReference) {
   }
 }
 
+TEST(AsyncRegions, NestedSecondaryShellsAtEqualRatesReproduceTheReference) {
+  for (int shells : {2, 3}) {
+    Scene scene = Adaptive(1, 1, 1000);
+    scene.adaptivity.secondary_regions = shells;
+    scene.adaptivity.outer_rate_hz = 1000;
+    scene.adaptivity.shell_cells = 2;
+    AsyncRegions dut(scene);
+    ASSERT_EQ(dut.num_regions(), 1 + shells);
+    const TrialResult result = dut.RunTrial();
+    ASSERT_EQ(result.outcome, TrialOutcome::kCompleted);
+    EXPECT_LT(CompareForces(result.samples, DefaultReference().samples).l2_percent, 1e-9)
+        << shells << " shells";
+  }
+}
+
+TEST(AsyncRegions, NestedShellsAtTheirOwnRatesStayStableAndAccurate) {
+  Scene scene = Adaptive(2, 2, 800);
+  scene.adaptivity.secondary_regions = 2;
+  scene.adaptivity.outer_rate_hz = 500;
+  AsyncRegions dut(scene);
+  ASSERT_EQ(dut.num_regions(), 3);
+  EXPECT_EQ(dut.period_ticks(2), 2 * dut.period_ticks(0));
+  EXPECT_TRUE(dut.EstimateCoupledStability().stable);
+  const TrialResult result = dut.RunTrial();
+  ASSERT_EQ(result.outcome, TrialOutcome::kCompleted);
+  // The outer shell is as coarse as in the two-region run (2.67 %); its slower rate must not
+  // add more than a fraction of that.
+  EXPECT_LT(CompareForces(result.samples, DefaultReference().samples).l2_percent, 3.5);
+}
+
 TEST(AsyncRegions, BestPrimarySizeAtTwiceTheSpacingAnd600HzIsBelowTheJnd) {
   double best = INFINITY;
   for (int r = 1; r <= 4; ++r) {

@@ -16,12 +16,13 @@ Scene Adaptive(int primary_size, int lod, double rate_hz) {
 }
 
 // Real threads on real clocks against the deterministic virtual-time schedule of the same
-// configuration. They differ only where the secondary reads the primary's state: the threaded
-// secondary is released 1.25 primary periods early and extrapolates from the state just before
-// its own time, where the virtual schedule may use the state at that time exactly. That changes
-// the force by about 0.01 % here; the bound, 0.1 % relative L2, is far below both the smallest
-// adaptive error on this scene (0.4 %) and the 7 % JND. A run with a missed deadline reads older
-// snapshots still, so it is retried (the machine is shared) and must then be clean.
+// configuration. They differ only in when a region reads its inner neighbour's state: a threaded
+// region is released a fixed lead before its time and extrapolates from the inner state just
+// before it, where the virtual schedule may use the state at that time exactly. Measured: 0.006 %
+// relative L2 for two regions, 0.18 % for three (800 / 500 Hz shells). The bound, 0.5 %, is 14×
+// below the 7 % JND and well below what the adaptivity itself costs on these configurations
+// (0.4–2.8 %). A run with a missed deadline reads older snapshots still, so it is retried (the
+// machine is shared) and must then be clean.
 #if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;  // slowed down many times: deadlines are not the point here
 #else
@@ -30,21 +31,31 @@ constexpr bool kSanitized = false;
 
 TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
   if (kSanitized) GTEST_SKIP() << "timing test; the sanitizer run covers the threads below";
-  for (const Scene& scene : {Adaptive(3, 2, 600), Adaptive(2, 3, 700)}) {
+  Scene shells = Adaptive(2, 2, 800);
+  shells.adaptivity.secondary_regions = 2;
+  shells.adaptivity.outer_rate_hz = 500;
+  for (const Scene& scene : {Adaptive(3, 2, 600), Adaptive(2, 3, 700), shells}) {
     AsyncRegions regions(scene);
     const TrialResult virtual_time = regions.RunTrial();
     bool clean = false;
-    for (int attempt = 0; attempt < 3 && !clean; ++attempt) {
+    std::string misses;
+    for (int attempt = 0; attempt < 5 && !clean; ++attempt) {
       RealTimeSchedule dut(regions);
       const TrialResult threaded = dut.RunTrial();
       ASSERT_EQ(threaded.samples.size(), virtual_time.samples.size());
-      if (dut.primary_stats().misses > 0 || dut.secondary_stats().misses > 0) continue;
+      bool missed = false;
+      for (int r = 0; r < regions.num_regions(); ++r) {
+        missed = missed || dut.stats(r).misses > 0;
+        misses += " " + std::to_string(dut.stats(r).misses);
+      }
+      misses += ";";
+      if (missed) continue;
       clean = true;
-      EXPECT_EQ(dut.primary_stats().cycles, static_cast<long>(virtual_time.samples.size()));
-      EXPECT_GT(dut.secondary_stats().cycles, 0);
-      EXPECT_LT(CompareForces(threaded.samples, virtual_time.samples).l2_percent, 0.1);
+      EXPECT_EQ(dut.stats(kPrimaryRegion).cycles, static_cast<long>(virtual_time.samples.size()));
+      for (int r = 1; r < regions.num_regions(); ++r) EXPECT_GT(dut.stats(r).cycles, 0);
+      EXPECT_LT(CompareForces(threaded.samples, virtual_time.samples).l2_percent, 0.5);
     }
-    EXPECT_TRUE(clean) << "every attempt missed a deadline";
+    EXPECT_TRUE(clean) << "every attempt missed a deadline (misses per region:" << misses << ")";
   }
 }
 

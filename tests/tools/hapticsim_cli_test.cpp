@@ -192,7 +192,13 @@ INSTANTIATE_TEST_SUITE_P(
                                          "adaptivity.secondary_lod=5"},
                       "adaptivity.secondary_lod"},
         BadInvocation{"NegativeRate", {"stability", "--set", "adaptivity.secondary_rate=-5"},
-                      "adaptivity.secondary_rate"}),
+                      "adaptivity.secondary_rate"},
+        BadInvocation{"EmptyShell", {"simulate", "--set", "adaptivity.primary_size=4", "--set",
+                                     "adaptivity.secondary_regions=8"},
+                      "adaptivity.secondary_regions = 8"},
+        BadInvocation{"OuterRateTooHigh", {"simulate", "--set", "adaptivity.primary_size=2", "--set",
+                                           "adaptivity.outer_rate=2000"},
+                      "adaptivity.outer_rate"}),
     [](const ::testing::TestParamInfo<BadInvocation>& info) { return info.param.name; });
 
 }  // namespace

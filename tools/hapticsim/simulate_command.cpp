@@ -43,7 +43,7 @@ void WriteCsv(const std::string& path, const TrialResult& result) {
 
 // Per-region facts of an adaptive run, for the report.
 struct RegionReport {
-  const char* name;
+  std::string name;
   int nodes, elements, substeps;
   double rate_hz, critical_dt_s, cost_us_per_ms;
 };
@@ -51,7 +51,7 @@ struct RegionReport {
 struct AdaptiveReport {
   std::vector<RegionReport> regions;
   CoupledStability coupled;
-  std::optional<DeadlineStats> deadlines[2];  // with --threads
+  std::vector<std::optional<DeadlineStats>> deadlines;  // per region, with --threads
   std::optional<ForceError> threaded_vs_virtual;
 };
 
@@ -83,8 +83,7 @@ TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, bool threads,
     const TrialResult virtual_time = regions.RunTrial();
     RealTimeSchedule schedule(regions);
     result = schedule.RunTrial();
-    report->deadlines[kPrimaryRegion] = schedule.primary_stats();
-    report->deadlines[kSecondaryRegion] = schedule.secondary_stats();
+    for (int r = 0; r < regions.num_regions(); ++r) report->deadlines.push_back(schedule.stats(r));
     if (result.samples.size() == virtual_time.samples.size()) {
       report->threaded_vs_virtual = CompareForces(result.samples, virtual_time.samples);
     }
@@ -93,8 +92,9 @@ TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, bool threads,
   }
   const double simulated_ms = std::max<double>(result.steps, 1) * scene.solver.dt_s * 1e3;
   const auto& p = regions.partition();
-  for (RegionIndex r : {kPrimaryRegion, kSecondaryRegion}) {
-    report->regions.push_back({r == kPrimaryRegion ? "primary" : "secondary", p.num_nodes(r),
+  report->deadlines.resize(static_cast<size_t>(regions.num_regions()));
+  for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
+    report->regions.push_back({p.RegionName(r), p.num_nodes(r),
                                p.num_elements(r), regions.schedule(r).substeps,
                                regions.schedule(r).rate_hz,
                                regions.schedule(r).alone.critical_dt_s,
@@ -206,7 +206,7 @@ int Run(const SimulateOptions& options) {
                   << " substep(s), own limit " << Duration(r.critical_dt_s) << ", "
                   << Quantity(r.cost_us_per_ms, "µs") << " per simulated ms\n";
       }
-      for (size_t i = 0; i < 2; ++i) {
+      for (size_t i = 0; i < report.deadlines.size(); ++i) {
         if (!report.deadlines[i]) continue;
         const DeadlineStats& d = *report.deadlines[i];
         std::cout << "  " << report.regions[i].name << " thread: " << d.cycles << " cycles of "

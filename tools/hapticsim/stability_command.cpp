@@ -26,9 +26,9 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     out["coupled_spectral_radius"] = coupled.spectral_radius;
     out["common_period_s"] = coupled.common_period_s;
     out["power_iteration_periods"] = coupled.periods;
-    for (RegionIndex r : {kPrimaryRegion, kSecondaryRegion}) {
+    for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
       const RegionSchedule& s = regions.schedule(r);
-      out["regions"].push_back({{"name", r == kPrimaryRegion ? "primary" : "secondary"},
+      out["regions"].push_back({{"name", p.RegionName(r)},
                                 {"nodes", p.num_nodes(r)},
                                 {"elements", p.num_elements(r)},
                                 {"rate_Hz", s.rate_hz},
@@ -39,9 +39,9 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << "Stability of the asynchronous regions: " << scene.mesh.nodes << "³-node cube\n";
-    for (RegionIndex r : {kPrimaryRegion, kSecondaryRegion}) {
+    for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
       const RegionSchedule& s = regions.schedule(r);
-      std::cout << "  " << (r == kPrimaryRegion ? "primary  " : "secondary") << ": own limit "
+      std::cout << "  " << p.RegionName(r) << ": own limit "
                 << Duration(s.alone.critical_dt_s) << " (boundary held), "
                 << Quantity(s.rate_hz, "Hz") << " × " << s.substeps << " substep(s) = step "
                 << Duration(1.0 / (s.rate_hz * s.substeps)) << ": stable alone\n";
