@@ -84,6 +84,31 @@ KeyAccess Integer(SceneKeyInfo info, Ref ref, long lo, long hi) {
                    }};
 }
 
+// A key with a fixed set of names, written quoted ("press"); `get` and `set` map the scene
+// field to and from the name's index.
+template <typename Get, typename Set>
+KeyAccess Choice(SceneKeyInfo info, std::vector<std::string_view> names, Get get, Set set) {
+  return KeyAccess{info,
+                   [names, get](const Scene& scene) {
+                     // Built piecewise: g++ 12 misreports "\"" + string + "\"" under -Wrestrict
+                     // (PR 105651).
+                     std::string text(1, '"');
+                     text += names[static_cast<size_t>(get(scene))];
+                     text += '"';
+                     return text;
+                   },
+                   [info, names, set](Scene* scene, std::string_view text) {
+                     std::string_view bare = text;
+                     if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
+                       bare = bare.substr(1, bare.size() - 2);
+                     }
+                     for (size_t i = 0; i < names.size(); ++i) {
+                       if (bare == names[i]) return set(*scene, static_cast<int>(i));
+                     }
+                     Reject(info.name, text, info.allowed, info.unit);
+                   }};
+}
+
 const std::vector<KeyAccess>& KeyTable() {
   static const std::vector<KeyAccess> table = [] {
     std::vector<KeyAccess> keys;
@@ -114,29 +139,13 @@ const std::vector<KeyAccess>& KeyTable() {
     keys.push_back(Real({"input.frequency", "Hz", "finite and > 0", "input frequency f"},
                         [](Scene& s) -> double& { return s.input.frequency_hz; },
                         [](double v) { return v > 0; }));
-    keys.push_back(KeyAccess{
-        {"input.waveform", "", "\"press\" or \"sine\"",
-         "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-        [](const Scene& s) {
-          // Built piecewise: g++ 12 misreports "\"" + string + "\"" under -Wrestrict (PR 105651).
-          std::string text(1, '"');
-          text += WaveformName(s.input.waveform);
-          text += '"';
-          return text;
-        },
-        [](Scene* s, std::string_view text) {
-          std::string_view bare = text;
-          if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
-            bare = bare.substr(1, bare.size() - 2);
-          }
-          if (bare == "press") {
-            s->input.waveform = Waveform::kPress;
-          } else if (bare == "sine") {
-            s->input.waveform = Waveform::kSine;
-          } else {
-            Reject("input.waveform", text, "\"press\" or \"sine\"", "");
-          }
-        }});
+    keys.push_back(Choice({"input.waveform", "", "\"press\" or \"sine\"",
+                           "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
+                          {"press", "sine"},
+                          [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
+                          [](Scene& s, int i) {
+                            s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine;
+                          }));
     keys.push_back(Real({"input.periods", "", "finite and > 0", "trial length in input periods"},
                         [](Scene& s) -> double& { return s.input.periods; },
                         [](double v) { return v > 0; }));
@@ -171,29 +180,13 @@ const std::vector<KeyAccess>& KeyTable() {
                          "update rate of the secondary shells beyond the first"},
                         [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
                         [](double v) { return v >= 1 && v == std::floor(v); }));
-    keys.push_back(KeyAccess{
-        {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
-         "what the primary sends the secondary: its displacements next to the interface "
-         "(displacement) or its interface forces (force); see docs/regions.md"},
-        [](const Scene& s) {
-          std::string text(1, '"');
-          text += s.adaptivity.displacement_coupling ? "displacement" : "force";
-          text += '"';
-          return text;
-        },
-        [](Scene* s, std::string_view text) {
-          std::string_view bare = text;
-          if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
-            bare = bare.substr(1, bare.size() - 2);
-          }
-          if (bare == "displacement") {
-            s->adaptivity.displacement_coupling = true;
-          } else if (bare == "force") {
-            s->adaptivity.displacement_coupling = false;
-          } else {
-            Reject("adaptivity.coupling", text, "\"displacement\" or \"force\"", "");
-          }
-        }});
+    keys.push_back(Choice({"adaptivity.coupling", "", "\"displacement\" or \"force\"",
+                           "what an inner region sends the outer one: its displacements next to "
+                           "the interface (displacement) or its interface forces (force); see "
+                           "docs/regions.md"},
+                          {"displacement", "force"},
+                          [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
+                          [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
     return keys;
   }();
   return table;
