@@ -19,11 +19,11 @@ struct KeyAccess {
   std::function<void(Scene*, std::string_view)> set;
 };
 
+// The shortest text that reads back to exactly `value`.
 std::string FormatReal(double value) {
-  std::ostringstream out;
-  out.precision(17);
-  out << value;
-  std::string text = out.str();
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
   // Keep reals recognisable as reals in TOML ("10000.0", not "10000").
   if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
   return text;

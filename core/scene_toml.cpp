@@ -1,5 +1,6 @@
 #include "core/scene_toml.hpp"
 
+#include <charconv>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -17,10 +18,9 @@ std::string Location(const std::string& path, const toml::source_region& where) 
 std::string ValueText(const toml::node& node, const std::string& key, const std::string& where) {
   if (const auto* v = node.as_integer()) return std::to_string(v->get());
   if (const auto* v = node.as_floating_point()) {
-    std::ostringstream out;
-    out.precision(17);
-    out << v->get();
-    return out.str();
+    char buffer[32];
+    const auto result = std::to_chars(buffer, buffer + sizeof buffer, v->get());
+    return std::string(buffer, result.ptr);
   }
   if (const auto* v = node.as_string()) return "\"" + v->get() + "\"";
   std::ostringstream type;

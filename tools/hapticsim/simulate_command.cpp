@@ -268,7 +268,8 @@ Command AddSimulateCommand(CLI::App& parent) {
   auto options = std::make_shared<SimulateOptions>();
   CLI::App* app = parent.add_subcommand(
       "simulate",
-      "Run the full-resolution reference simulation of a scene and report the force on the user");
+      "Simulate a scene and report the force on the user: the full-resolution reference, or the "
+      "asynchronous regions when adaptivity.primary_size >= 1");
   AddSceneOptions(app, &options->scene);
   app->add_option("--out", options->csv_path,
                   "Write the time series as CSV: t_s, contact displacement (m), force on the "
