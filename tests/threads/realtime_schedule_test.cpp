@@ -46,7 +46,8 @@ TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
       bool missed = false;
       for (int r = 0; r < regions.num_regions(); ++r) {
         missed = missed || dut.stats(r).misses > 0;
-        misses += " " + std::to_string(dut.stats(r).misses);
+        misses += ' ';
+        misses += std::to_string(dut.stats(r).misses);
       }
       misses += ";";
       if (missed) continue;
