@@ -30,7 +30,8 @@ struct TrialResult {
   TrialOutcome outcome = TrialOutcome::kCompleted;
   StabilityEstimate stability;
   std::vector<ForceSample> samples;  ///< t = 0, dt, …, duration (fewer if it diverged)
-  long steps = 0;                    ///< time steps taken
+  long steps = 0;                    ///< periods of solver.dt simulated (= samples)
+  int substeps = 1;                  ///< integrator steps per period
   double stopped_at_s = 0;           ///< time of the last completed step
   double peak_force_n = 0;           ///< max |feedback force| over the samples, N
   double wall_time_s = 0;            ///< compute time of the stepping loop, s
@@ -43,6 +44,12 @@ struct TrialResult {
 struct TrialOptions {
   /** Run even when the prediction says dt is past the stability limit (to watch detection). */
   bool run_if_predicted_unstable = false;
+  /**
+   * The reference of an error comparison: when solver.dt is past the stability limit, take as
+   * many equal substeps per dt as keep each at most 0.95 of the limit, and still report one
+   * sample per dt. (The paper: "a sufficiently low time-step to maintain stability".)
+   */
+  bool substep_to_stability = false;
 };
 
 /**

@@ -107,6 +107,35 @@ TEST(CentralDifference, RunPastTheLimitFromRestIsDetected) {
   EXPECT_EQ(refused.steps, 0);
 }
 
+TEST(CentralDifference, ReferenceSubstepsPastTheLimitEqualAFinerTimeStep) {
+  // A stiff scene whose 1 ms step is past the limit: the reference of an error comparison takes
+  // two 0.5 ms substeps per sample, which must be exactly the run at dt = 0.5 ms, sampled every
+  // other step.
+  Scene stiff = SmallCube(9);
+  stiff.material.youngs_modulus_pa = 60e3;
+  stiff.material.poisson_ratio = 0.49;
+  stiff.material.density_kg_m3 = 800;
+  TrialOptions options;
+  options.substep_to_stability = true;
+  const TrialResult substepped = RunReferenceTrial(CubeScene(stiff), options);
+  ASSERT_EQ(substepped.outcome, TrialOutcome::kCompleted);
+  ASSERT_EQ(substepped.substeps, 2);
+  Scene fine = stiff;
+  fine.solver.dt_s = 0.5e-3;
+  const TrialResult direct = RunReferenceTrial(CubeScene(fine));
+  ASSERT_EQ(direct.outcome, TrialOutcome::kCompleted);
+  ASSERT_EQ(direct.samples.size(), 2 * substepped.samples.size() - 1);
+  // Equal up to the rounding of the sample times (n·dt + h against (2n + 1)·h).
+  double worst = 0;
+  for (size_t i = 0; i < substepped.samples.size(); ++i) {
+    worst = std::max(worst, std::abs(substepped.samples[i].feedback_force_n[2] -
+                                     direct.samples[2 * i].feedback_force_n[2]));
+  }
+  EXPECT_LT(worst, 1e-12 * direct.peak_force_n);
+  // Without the option the same scene is refused, as before.
+  EXPECT_EQ(RunReferenceTrial(CubeScene(stiff)).outcome, TrialOutcome::kPredictedUnstable);
+}
+
 TEST(CentralDifference, ResponseIsExactlyLinearInTheInputAmplitude) {
   Scene small = SmallCube(7);
   small.input.amplitude_m = 0.005;

@@ -121,7 +121,9 @@ int Run(const SimulateOptions& options) {
   if (options.compare_reference && !result.samples.empty()) {
     Scene reference_scene = scene;
     reference_scene.adaptivity.primary_size = 0;
-    reference = RunReferenceTrial(CubeScene(reference_scene));
+    TrialOptions reference_options;
+    reference_options.substep_to_stability = true;
+    reference = RunReferenceTrial(CubeScene(reference_scene), reference_options);
     if (reference->outcome != TrialOutcome::kCompleted) {
       throw Error("the full-resolution reference of this scene did not complete (" +
                   std::string(TrialOutcomeName(reference->outcome)) + "); lower solver.dt below " +
@@ -161,6 +163,7 @@ int Run(const SimulateOptions& options) {
     out["dt_s"] = scene.solver.dt_s;
     out["duration_s"] = scene.duration_s();
     out["steps"] = result.steps;
+    out["substeps"] = result.substeps;
     out["stopped_at_s"] = result.stopped_at_s;
     out["peak_force_N"] = result.peak_force_n;
     out["peak_force_time_s"] = peak_time;
