@@ -61,8 +61,6 @@ struct AsyncRegions::Region {
   std::vector<double> inward_values, load_values;
   Eigen::VectorXd band_u, band_ku;  // for evaluating the inner region's band
 
-  // Primary only.
-  std::array<double, 3> contact_now{};
 };
 
 AsyncRegions::~AsyncRegions() = default;
@@ -91,24 +89,32 @@ AsyncRegions::AsyncRegions(const Scene& scene)
                                  : scene.adaptivity.outer_rate_hz;
     rates.push_back(static_cast<std::int64_t>(std::llround(rate)));
   }
+  // Each region's own limit with its boundary held (outer Γ, contact, supports prescribed; the
+  // inner Γ free, carrying the mass of both sides), and the substeps that keeps it inside.
+  // Substeps are whole steps of the schedule: every substep exchanges its interfaces, so equal
+  // rates with equal substeps stay exactly monolithic.
+  std::vector<RegionSchedule> schedules(static_cast<size_t>(count));
   ticks_per_second_ = 1;
-  for (std::int64_t rate : rates) ticks_per_second_ = std::lcm(ticks_per_second_, rate);
+  for (int a = 0; a < count; ++a) {
+    RegionSchedule& schedule = schedules[a];
+    schedule.rate_hz = static_cast<double>(rates[a]);
+    schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, p.dofs(a).owned));
+    schedule.substeps = std::max(1, static_cast<int>(std::ceil(
+                                        1.0 / schedule.rate_hz /
+                                        (kSubstepSafety * schedule.alone.critical_dt_s))));
+    ticks_per_second_ = std::lcm(ticks_per_second_, rates[a] * schedule.substeps);
+  }
   common_period_ticks_ = 1;
 
   for (int a = 0; a < count; ++a) {
     auto region = std::make_unique<Region>();
     const RegionDofs& dofs = p.dofs(a);
     region->dofs = &dofs;
-    region->period_ticks = ticks_per_second_ / rates[a];
-    common_period_ticks_ = std::lcm(common_period_ticks_, region->period_ticks);
-    region->schedule.rate_hz = static_cast<double>(rates[a]);
-    // The region's own limit with its boundary held (outer Γ, contact, supports prescribed; the
-    // inner Γ free, carrying the mass of both sides).
-    region->schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, dofs.owned));
+    region->schedule = schedules[a];
+    region->period_ticks = ticks_per_second_ / (rates[a] * schedules[a].substeps);
+    // The schedule repeats once every region has completed whole nominal periods.
+    common_period_ticks_ = std::lcm(common_period_ticks_, ticks_per_second_ / rates[a]);
     const double period = 1.0 / region->schedule.rate_hz;
-    region->schedule.substeps = std::max(
-        1, static_cast<int>(std::ceil(period / (kSubstepSafety * region->schedule.alone.critical_dt_s))));
-
     std::vector<int> prescribed;
     if (a == kPrimaryRegion) prescribed.assign(p.contact_dofs().begin(), p.contact_dofs().end());
     prescribed.insert(prescribed.end(), dofs.fixed.begin(), dofs.fixed.end());
@@ -187,7 +193,6 @@ void AsyncRegions::Reset() {
     if (region->outward) region->outward->Clear();
     region->state_ticks = 0;
     region->compute_s = 0;
-    region->contact_now = {0, 0, 0};
   }
   PublishInitialSnapshots();
 }
@@ -214,67 +219,54 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   const auto start = Clock::now();
   Region& region = *regions_[a];
   RegionIntegrator& integrator = *region.integrator;
-  const int substeps = region.schedule.substeps;
   const double t0 = static_cast<double>(region.state_ticks) / ticks_per_second_;
   const double h = integrator.substep();
-  const bool has_outer = region.inward != nullptr;
-  // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
-  if (has_outer) (void)region.inward->TryReadLatestTwo(&region.outer_newer, &region.outer_older);
-  const Region* inner = a > 0 ? regions_[a - 1].get() : nullptr;
-  double newest_inner_allowed = 0;
-  if (inner != nullptr) {
-    (void)inner->outward->TryReadLatestTwo(&region.inner_newer, &region.inner_older);
-    // The schedule keeps the inner region less than one of its periods behind; never
-    // extrapolate further than that, should it be late.
-    newest_inner_allowed = region.inner_newer.time_s + 1.0 / inner->schedule.rate_hz;
-  }
   const auto& outer_gamma = region.dofs->outer_interface;
   const auto& inner_gamma = region.dofs->inner_interface;
 
-  for (int q = 1; q <= substeps; ++q) {
-    if (contact_next != nullptr) {
-      const double fraction = static_cast<double>(q) / substeps;
-      for (int c = 0; c < 3; ++c) {
-        region.prescribed_values[c] =
-            region.contact_now[c] + fraction * ((*contact_next)[c] - region.contact_now[c]);
-      }
-    }
-    if (has_outer) {
-      // The outer region is ahead: interpolate. If it is late, hold its newest state.
-      const double t = std::min(t0 + q * h, region.outer_newer.time_s);
-      for (size_t i = 0; i < outer_gamma.size(); ++i) {
-        region.prescribed_values[region.outer_offset + i] =
-            OnLine(region.outer_older, region.outer_newer, static_cast<int>(i), t);
-      }
-    }
-    if (inner != nullptr) {
-      const double t = std::min(t0 + (q - 1) * h, newest_inner_allowed);
-      if (coupling_ == Coupling::kForce) {
-        for (size_t i = 0; i < inner_gamma.size(); ++i) {
-          region.load_values[i] = -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
-        }
-      } else {
-        // The inner region's force on Γ from its band: its displacements next to Γ on the line
-        // through its newest two states, Γ itself as this region has it now.
-        for (size_t i = 0; i < inner->band_layer.size(); ++i) {
-          region.band_u[inner->band_layer[i]] =
-              OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
-        }
-        const Eigen::VectorXd& u = integrator.u();
-        for (int dof : inner_gamma) region.band_u[dof] = u[dof];
-        inner->band->Apply(region.band_u, region.band_ku);
-        for (size_t i = 0; i < inner_gamma.size(); ++i) region.load_values[i] = -region.band_ku[inner_gamma[i]];
-      }
-    }
-    integrator.Step(region.prescribed_values, region.load_values);
-    if (reaction != nullptr && q == 1) {
-      for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
+  if (contact_next != nullptr) {
+    for (int c = 0; c < 3; ++c) region.prescribed_values[c] = (*contact_next)[c];
+  }
+  // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
+  if (region.inward) {
+    (void)region.inward->TryReadLatestTwo(&region.outer_newer, &region.outer_older);
+    // The outer region is ahead: interpolate. If it is late, hold its newest state.
+    const double t = std::min(t0 + h, region.outer_newer.time_s);
+    for (size_t i = 0; i < outer_gamma.size(); ++i) {
+      region.prescribed_values[region.outer_offset + i] =
+          OnLine(region.outer_older, region.outer_newer, static_cast<int>(i), t);
     }
   }
-  if (contact_next != nullptr) region.contact_now = *contact_next;
+  if (a > 0) {
+    const Region& inner = *regions_[a - 1];
+    (void)inner.outward->TryReadLatestTwo(&region.inner_newer, &region.inner_older);
+    // The schedule keeps the inner region less than one of its nominal periods behind; never
+    // extrapolate further than that, should it be late.
+    const double t = std::min(t0, region.inner_newer.time_s + 1.0 / inner.schedule.rate_hz);
+    if (coupling_ == Coupling::kForce) {
+      for (size_t i = 0; i < inner_gamma.size(); ++i) {
+        region.load_values[i] = -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+      }
+    } else {
+      // The inner region's force on Γ from its band: its displacements next to Γ on the line
+      // through its newest two states, Γ itself as this region has it now.
+      for (size_t i = 0; i < inner.band_layer.size(); ++i) {
+        region.band_u[inner.band_layer[i]] =
+            OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+      }
+      const Eigen::VectorXd& u = integrator.u();
+      for (int dof : inner_gamma) region.band_u[dof] = u[dof];
+      inner.band->Apply(region.band_u, region.band_ku);
+      for (size_t i = 0; i < inner_gamma.size(); ++i) region.load_values[i] = -region.band_ku[inner_gamma[i]];
+    }
+  }
+  integrator.Step(region.prescribed_values, region.load_values);
+  if (reaction != nullptr) {
+    for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
+  }
   region.state_ticks += region.period_ticks;
   if (a > 0) PublishInward(a);
-  if (has_outer) PublishOutward(a);
+  if (region.inward) PublishOutward(a);
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
 }
 
@@ -345,13 +337,19 @@ TrialResult AsyncRegions::RunTrial() {
   double work = 0;
   const auto start = Clock::now();
   Region& primary = *regions_[kPrimaryRegion];
+  const int substeps = primary.schedule.substeps;
+  const double h = dt / substeps;
   for (long n = 0; n <= steps; ++n) {
-    AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
     const double t = n * dt;
-    const double depth_next = trajectory.DepthAt(t + dt);
-    const std::array<double, 3> r = StepPrimary({0.0, 0.0, depth_next});
-    const double increment = r[2] * (depth_next - trajectory.DepthAt(t - dt)) / 2.0;
-    if (increment > 0) work += increment;
+    std::array<double, 3> r{};
+    for (int q = 1; q <= substeps; ++q) {
+      AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
+      const double depth_next = trajectory.DepthAt(t + q * h);
+      const std::array<double, 3> rq = StepPrimary({0.0, 0.0, depth_next});
+      if (q == 1) r = rq;
+      const double increment = rq[2] * (depth_next - trajectory.DepthAt(t + (q - 2) * h)) / 2.0;
+      if (increment > 0) work += increment;
+    }
     // The kinetic part alone is bounded by the same passivity budget and needs no extra K·u.
     const double energy = KineticEnergy();
     if (!std::isfinite(energy) || !std::isfinite(r[0] + r[1] + r[2])) {

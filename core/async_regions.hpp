@@ -80,6 +80,7 @@ class AsyncRegions {
 
   /** Integer ticks of the virtual-time clock: 1 tick = 1 / ticks_per_second() s. */
   std::int64_t ticks_per_second() const { return ticks_per_second_; }
+  /** One step of the region (its nominal period / its substeps), ticks. */
   std::int64_t period_ticks(RegionIndex region) const;
   std::int64_t common_period_ticks() const { return common_period_ticks_; }
   /** Time of a region's current state, ticks. Read by the thread stepping that region. */
@@ -91,12 +92,12 @@ class AsyncRegions {
   void SetRandomState(unsigned seed);
 
   /**
-   * Primary thread: one primary period. contact_next is the contact displacement at the end of
-   * the period (m, object frame); substeps interpolate it linearly. Returns the reaction R at the
-   * contact at the period's start time, N (the force on the user is −R).
+   * Primary thread: one primary step (a period, or one of its substeps). contact_next is the
+   * contact displacement at the end of the step (m, object frame). Returns the reaction R at the
+   * contact at the step's start time, N (the force on the user is −R).
    */
   std::array<double, 3> StepPrimary(const std::array<double, 3>& contact_next) noexcept;
-  /** A secondary region's thread: one period of region `region` ≥ 1. */
+  /** A secondary region's thread: one step of region `region` ≥ 1. */
   void StepRegion(RegionIndex region) noexcept;
   /**
    * Virtual time: steps the secondary regions (outermost first, recursively) until region 1 can

@@ -57,21 +57,23 @@ TrialResult RealTimeSchedule::RunTrial() {
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();
   const double tick_ns = 1e9 / static_cast<double>(regions_.ticks_per_second());
-  const std::int64_t primary_period_ticks = regions_.period_ticks(kPrimaryRegion);
+  const int primary_substeps = regions_.schedule(kPrimaryRegion).substeps;
+  const std::int64_t primary_period_ticks = regions_.period_ticks(kPrimaryRegion) * primary_substeps;
   const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
   regions_.Reset();
 
   TrialResult result;
   result.stability = regions_.schedule(kPrimaryRegion).alone;
   result.samples.resize(static_cast<size_t>(steps) + 1);
+  // Each thread wakes once per nominal period and takes that period's substeps in a row.
   std::vector<LoopRecord> records(static_cast<size_t>(count));
   std::vector<std::int64_t> lead_ns(static_cast<size_t>(count), 0);
+  std::vector<std::int64_t> nominal_ticks(static_cast<size_t>(count), 0);
   for (int a = 0; a < count; ++a) {
-    const std::int64_t period = regions_.period_ticks(a);
-    records[a].execution_s.reserve(static_cast<size_t>(end_ticks / period + 4));
+    nominal_ticks[a] = regions_.period_ticks(a) * regions_.schedule(a).substeps;
+    records[a].execution_s.reserve(static_cast<size_t>(end_ticks / nominal_ticks[a] + 4));
     if (a > 0) {
-      lead_ns[a] = lead_ns[a - 1] +
-                   static_cast<std::int64_t>(1.25 * regions_.period_ticks(a - 1) * tick_ns);
+      lead_ns[a] = lead_ns[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ticks[a - 1] * tick_ns);
     }
   }
 
@@ -83,7 +85,8 @@ TrialResult RealTimeSchedule::RunTrial() {
   for (int a = 1; a < count; ++a) {
     threads.emplace_back([&, a] {
       LoopRecord& record = records[a];
-      const std::int64_t period = regions_.period_ticks(a);
+      const std::int64_t period = nominal_ticks[a];
+      const int substeps = regions_.schedule(a).substeps;
       const double period_ns = period * tick_ns;
       while (!primary_done.load(std::memory_order_acquire)) {
         const std::int64_t state = regions_.state_ticks(a);
@@ -91,7 +94,7 @@ TrialResult RealTimeSchedule::RunTrial() {
         const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns[a];
         SleepUntilNs(release);
         const std::int64_t woke = NowNs();
-        regions_.StepRegion(a);
+        for (int q = 0; q < substeps; ++q) regions_.StepRegion(a);
         const std::int64_t done = NowNs();
         record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
         if (woke - release > period_ns || done > release + period_ns) ++record.misses;
@@ -110,7 +113,12 @@ TrialResult RealTimeSchedule::RunTrial() {
     SleepUntilNs(release);
     const std::int64_t woke = NowNs();
     const double t = n * dt;
-    const std::array<double, 3> r = regions_.StepPrimary({0.0, 0.0, trajectory.DepthAt(t + dt)});
+    std::array<double, 3> r{};
+    for (int q = 1; q <= primary_substeps; ++q) {
+      const std::array<double, 3> rq = regions_.StepPrimary(
+          {0.0, 0.0, trajectory.DepthAt(t + q * dt / primary_substeps)});
+      if (q == 1) r = rq;
+    }
     const std::int64_t done = NowNs();
     record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
     if (woke - release > period_ns || done > release + period_ns) ++record.misses;
