@@ -49,8 +49,8 @@ struct AsyncRegions::Region {
   double compute_s = 0;
 
   // Link with the region outwards: this region is its inner side.
-  std::unique_ptr<BoundaryChannel> inward;   // outer → this: outer Γ displacements
-  std::unique_ptr<BoundaryChannel> outward;  // this → outer: band displacements or Γ forces
+  std::unique_ptr<BoundaryChannel> inward;    // outer → this: outer Γ displacements
+  std::unique_ptr<BoundaryChannel> outward;   // this → outer: band displacements or Γ forces
   std::unique_ptr<ElementSetStiffness> band;  // this region's elements next to its outer Γ
   std::vector<int> band_layer;                // their DOFs off the outer Γ
   BoundaryChannel::Snapshot outer_newer, outer_older;  // read by this region's thread
@@ -60,7 +60,6 @@ struct AsyncRegions::Region {
   BoundaryChannel::Snapshot inner_newer, inner_older;  // read by this region's thread
   std::vector<double> inward_values, load_values;
   Eigen::VectorXd band_u, band_ku;  // for evaluating the inner region's band
-
 };
 
 AsyncRegions::~AsyncRegions() = default;
@@ -74,17 +73,20 @@ std::int64_t AsyncRegions::period_ticks(RegionIndex region) const {
 std::int64_t AsyncRegions::state_ticks(RegionIndex region) const {
   return regions_[region]->state_ticks;
 }
-double AsyncRegions::compute_seconds(RegionIndex region) const { return regions_[region]->compute_s; }
+double AsyncRegions::compute_seconds(RegionIndex region) const {
+  return regions_[region]->compute_s;
+}
 
 AsyncRegions::AsyncRegions(const Scene& scene)
     : partition_(scene),
-      coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement : Coupling::kForce) {
+      coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement
+                                                       : Coupling::kForce) {
   const RegionPartition& p = partition_;
   const int n = p.mesh().num_dofs();
   const int count = p.num_regions();
   std::vector<std::int64_t> rates;
   for (int a = 0; a < count; ++a) {
-    const double rate = a == 0 ? PrimaryRateHz(scene)
+    const double rate = a == 0   ? PrimaryRateHz(scene)
                         : a == 1 ? scene.adaptivity.secondary_rate_hz
                                  : scene.adaptivity.outer_rate_hz;
     rates.push_back(static_cast<std::int64_t>(std::llround(rate)));
@@ -99,9 +101,9 @@ AsyncRegions::AsyncRegions(const Scene& scene)
     RegionSchedule& schedule = schedules[a];
     schedule.rate_hz = static_cast<double>(rates[a]);
     schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, p.dofs(a).owned));
-    schedule.substeps = std::max(1, static_cast<int>(std::ceil(
-                                        1.0 / schedule.rate_hz /
-                                        (kSubstepSafety * schedule.alone.critical_dt_s))));
+    schedule.substeps =
+        std::max(1, static_cast<int>(std::ceil(1.0 / schedule.rate_hz /
+                                               (kSubstepSafety * schedule.alone.critical_dt_s))));
     ticks_per_second_ = std::lcm(ticks_per_second_, rates[a] * schedule.substeps);
   }
   common_period_ticks_ = 1;
@@ -126,8 +128,8 @@ AsyncRegions::AsyncRegions(const Scene& scene)
         dofs.inner_interface, period / region->schedule.substeps);
 
     if (a + 1 < count) {
-      region->band = std::make_unique<ElementSetStiffness>(p.mesh(), scene.material,
-                                                           p.outer_band_elements(a));
+      region->band =
+          std::make_unique<ElementSetStiffness>(p.mesh(), scene.material, p.outer_band_elements(a));
       for (int dof : region->band->touched_dofs()) {
         if (!std::binary_search(dofs.outer_interface.begin(), dofs.outer_interface.end(), dof)) {
           region->band_layer.push_back(dof);
@@ -173,7 +175,8 @@ void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
     for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
   } else {
     const Eigen::VectorXd& u = region.integrator->u();
-    for (size_t i = 0; i < region.band_layer.size(); ++i) region.outward_values[i] = u[region.band_layer[i]];
+    for (size_t i = 0; i < region.band_layer.size(); ++i)
+      region.outward_values[i] = u[region.band_layer[i]];
   }
   region.outward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
                           region.outward_values);
@@ -245,7 +248,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     const double t = std::min(t0, region.inner_newer.time_s + 1.0 / inner.schedule.rate_hz);
     if (coupling_ == Coupling::kForce) {
       for (size_t i = 0; i < inner_gamma.size(); ++i) {
-        region.load_values[i] = -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+        region.load_values[i] =
+            -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
       }
     } else {
       // The inner region's force on Γ from its band: its displacements next to Γ on the line
@@ -257,7 +261,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
       const Eigen::VectorXd& u = integrator.u();
       for (int dof : inner_gamma) region.band_u[dof] = u[dof];
       inner.band->Apply(region.band_u, region.band_ku);
-      for (size_t i = 0; i < inner_gamma.size(); ++i) region.load_values[i] = -region.band_ku[inner_gamma[i]];
+      for (size_t i = 0; i < inner_gamma.size(); ++i)
+        region.load_values[i] = -region.band_ku[inner_gamma[i]];
     }
   }
   integrator.Step(region.prescribed_values, region.load_values);
@@ -270,13 +275,16 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::array<double, 3> AsyncRegions::StepPrimary(const std::array<double, 3>& contact_next) noexcept {
+std::array<double, 3> AsyncRegions::StepPrimary(
+    const std::array<double, 3>& contact_next) noexcept {
   std::array<double, 3> reaction{};
   StepRegionAt(kPrimaryRegion, &contact_next, &reaction);
   return reaction;
 }
 
-void AsyncRegions::StepRegion(RegionIndex region) noexcept { StepRegionAt(region, nullptr, nullptr); }
+void AsyncRegions::StepRegion(RegionIndex region) noexcept {
+  StepRegionAt(region, nullptr, nullptr);
+}
 
 void AsyncRegions::AdvanceRegionTo(RegionIndex a, std::int64_t ticks) noexcept {
   Region& region = *regions_[a];
@@ -364,7 +372,8 @@ TrialResult AsyncRegions::RunTrial() {
     sample.t_s = t;
     sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
     for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
-    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+    result.peak_force_n =
+        std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
     result.samples.push_back(sample);
     result.stopped_at_s = t;
     result.steps = n + 1;

@@ -32,7 +32,8 @@ bool BoundaryChannel::TryReadSlot(std::uint64_t generation, Snapshot* out) const
     if (before & 1u) continue;  // being written
     const std::uint64_t stored = slot.generation.load(std::memory_order_relaxed);
     const double time = slot.time_s.load(std::memory_order_relaxed);
-    for (int i = 0; i < width_; ++i) out->values[i] = slot.values[i].load(std::memory_order_relaxed);
+    for (int i = 0; i < width_; ++i)
+      out->values[i] = slot.values[i].load(std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (slot.sequence.load(std::memory_order_relaxed) != before) continue;  // torn: retry
     if (stored != generation) return false;  // overwritten by a newer publication

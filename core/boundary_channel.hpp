@@ -1,11 +1,10 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
-
-#include <Eigen/Core>
 
 namespace hapticsim {
 

@@ -20,8 +20,8 @@ CentralDifferenceIntegrator::CentralDifferenceIntegrator(const ElasticModel& mod
   u_ = &buffers_[1];
   u_next_ = &buffers_[2];
   ku_ = Eigen::VectorXd::Zero(n);
-  driven_reaction_ = Eigen::VectorXd::Zero(
-      static_cast<Eigen::Index>(model.constraints().driven_dofs.size()));
+  driven_reaction_ =
+      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.constraints().driven_dofs.size()));
 }
 
 void CentralDifferenceIntegrator::Reset() {

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <span>
-
 #include <Eigen/Core>
+#include <span>
 
 #include "core/elastic_model.hpp"
 

@@ -22,10 +22,7 @@ DofConstraints CubeConstraints(const HexGrid& grid, int contact_node,
 }  // namespace
 
 CubeScene::CubeScene(const Scene& scene)
-    : scene_(scene),
-      contact_node_(0),
-      fixed_nodes_{},
-      model_([&] {
+    : scene_(scene), contact_node_(0), fixed_nodes_{}, model_([&] {
         const HexGrid grid = CubeGrid(scene);
         const int last = scene.mesh.nodes - 1;
         const int middle = last / 2;

@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/hex_grid.hpp"
 #include "core/material.hpp"

@@ -18,7 +18,7 @@ class Error : public std::runtime_error {
 }  // namespace hapticsim
 
 /// Throws hapticsim::Error with `message` unless `condition` holds. For caller errors.
-#define HAPTICSIM_THROW_UNLESS(condition, message)      \
-  do {                                                  \
+#define HAPTICSIM_THROW_UNLESS(condition, message)       \
+  do {                                                   \
     if (!(condition)) throw ::hapticsim::Error(message); \
   } while (false)

@@ -9,7 +9,9 @@
 namespace hapticsim {
 namespace {
 
-double Norm(const std::array<double, 3>& f) { return std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]); }
+double Norm(const std::array<double, 3>& f) {
+  return std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+}
 
 }  // namespace
 
@@ -21,7 +23,8 @@ ForceError CompareForces(const std::vector<ForceSample>& adaptive,
                              std::to_string(reference.size()) + ")");
   ForceError error;
   error.samples = static_cast<int>(reference.size());
-  for (const ForceSample& s : reference) error.reference_peak_n = std::max(error.reference_peak_n, Norm(s.feedback_force_n));
+  for (const ForceSample& s : reference)
+    error.reference_peak_n = std::max(error.reference_peak_n, Norm(s.feedback_force_n));
   double difference2 = 0, reference2 = 0;
   for (size_t i = 0; i < reference.size(); ++i) {
     const auto& a = adaptive[i].feedback_force_n;
@@ -38,8 +41,10 @@ ForceError CompareForces(const std::vector<ForceSample>& adaptive,
           std::max(error.max_magnitude_percent, 100.0 * std::abs(na - nr) / error.reference_peak_n);
     }
     if (nr >= ForceError::kDirectionThreshold * error.reference_peak_n && nr > 0 && na > 0) {
-      const double cosine = std::clamp((a[0] * r[0] + a[1] * r[1] + a[2] * r[2]) / (na * nr), -1.0, 1.0);
-      error.max_direction_deg = std::max(error.max_direction_deg, std::acos(cosine) * 180.0 / std::numbers::pi);
+      const double cosine =
+          std::clamp((a[0] * r[0] + a[1] * r[1] + a[2] * r[2]) / (na * nr), -1.0, 1.0);
+      error.max_direction_deg =
+          std::max(error.max_direction_deg, std::acos(cosine) * 180.0 / std::numbers::pi);
     }
   }
   error.l2_percent = reference2 > 0 ? 100.0 * std::sqrt(difference2 / reference2) : 0.0;

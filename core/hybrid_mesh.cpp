@@ -39,7 +39,8 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
         const int reach = options.support_layers * k;
         for (const auto& s : options.supports) {
           bool near = reach > 0;
-          for (int a = 0; a < 3; ++a) near = near && CellOverlaps(c[a], k, s[a] - reach, s[a] + reach);
+          for (int a = 0; a < 3; ++a)
+            near = near && CellOverlaps(c[a], k, s[a] - reach, s[a] + reach);
           near_support = near_support || near;
         }
         const int id = cell_index(cx, cy, cz);
@@ -54,7 +55,8 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
     for (int cz = 0; cz < nc; ++cz)
       for (int cy = 0; cy < nc; ++cy)
         for (int cx = 0; cx < nc; ++cx)
-          if (cell_region[cell_index(cx, cy, cz)] == kPrimaryRegion) primary_cells.push_back({cx, cy, cz});
+          if (cell_region[cell_index(cx, cy, cz)] == kPrimaryRegion)
+            primary_cells.push_back({cx, cy, cz});
     for (int cz = 0; cz < nc; ++cz)
       for (int cy = 0; cy < nc; ++cy)
         for (int cx = 0; cx < nc; ++cx) {
@@ -62,8 +64,9 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
           if (cell_region[id] == kPrimaryRegion) continue;
           int distance = nc;
           for (const auto& c : primary_cells) {
-            distance = std::min(distance, std::max({std::abs(cx - c[0]), std::abs(cy - c[1]),
-                                                    std::abs(cz - c[2])}));
+            distance =
+                std::min(distance,
+                         std::max({std::abs(cx - c[0]), std::abs(cy - c[1]), std::abs(cz - c[2])}));
           }
           const int shell = std::min(options.secondary_regions - 1,
                                      (distance - 1) / std::max(1, options.shell_cells));
@@ -123,7 +126,8 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
     for (int a = 0; a < 3; ++a) {
       const int j = std::min(p[a] / k, nc - 1);
       candidates[a][counts[a]++] = j;
-      if (p[a] % k == 0 && p[a] / k - 1 >= 0 && p[a] / k - 1 != j) candidates[a][counts[a]++] = p[a] / k - 1;
+      if (p[a] % k == 0 && p[a] / k - 1 >= 0 && p[a] / k - 1 != j)
+        candidates[a][counts[a]++] = p[a] / k - 1;
     }
     bool found = false;
     for (int ia = 0; ia < counts[0] && !found; ++ia)
@@ -143,7 +147,8 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
               corner[a] = (c[a] + bit) * k;
             }
             if (w > 1e-14) {
-              masters[node].push_back({node_at_lattice_[lattice_index(corner[0], corner[1], corner[2])], w});
+              masters[node].push_back(
+                  {node_at_lattice_[lattice_index(corner[0], corner[1], corner[2])], w});
             }
           }
         }

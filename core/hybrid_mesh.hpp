@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/material.hpp"
 
@@ -46,12 +45,12 @@ struct GatherTerm {
 class HybridMesh {
  public:
   struct Options {
-    int nodes_per_axis = 13;   ///< fine lattice points per axis (n)
-    double spacing_m = 0.25 / 12;  ///< fine spacing h, m
-    int coarse_factor = 2;     ///< k, must divide n − 1
+    int nodes_per_axis = 13;                        ///< fine lattice points per axis (n)
+    double spacing_m = 0.25 / 12;                   ///< fine spacing h, m
+    int coarse_factor = 2;                          ///< k, must divide n − 1
     std::array<int, 3> primary_lo{}, primary_hi{};  ///< primary box, lattice indices (closed)
     std::vector<std::array<int, 3>> supports;       ///< lattice indices of fixed nodes
-    int support_layers = 1;    ///< coarse cells refined around each support, per direction
+    int support_layers = 1;  ///< coarse cells refined around each support, per direction
     /// Secondary cells split into this many nested shells around the primary cells (regions
     /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.
     int secondary_regions = 1;
@@ -64,18 +63,23 @@ class HybridMesh {
   const Options& options() const { return options_; }
   int num_independent() const { return static_cast<int>(independent_lattice_.size()); }
   int num_dofs() const { return 3 * num_independent(); }
-  int Dof(int independent, int component) const { return component * num_independent() + independent; }
+  int Dof(int independent, int component) const {
+    return component * num_independent() + independent;
+  }
   const std::vector<HybridElement>& elements() const { return elements_; }
   int num_hanging() const { return num_hanging_; }
 
   /** Independent index of the node at a lattice point, or −1 (no node there, or hanging). */
   int IndependentAt(int ix, int iy, int iz) const;
   /** Lattice indices of an independent node. */
-  const std::array<int, 3>& LatticeOf(int independent) const { return independent_lattice_[independent]; }
+  const std::array<int, 3>& LatticeOf(int independent) const {
+    return independent_lattice_[independent];
+  }
 
   /** The gather terms of mesh node `node` (one term of weight 1 for an independent node). */
   std::pair<const GatherTerm*, const GatherTerm*> Gather(int node) const {
-    return {gather_terms_.data() + gather_start_[node], gather_terms_.data() + gather_start_[node + 1]};
+    return {gather_terms_.data() + gather_start_[node],
+            gather_terms_.data() + gather_start_[node + 1]};
   }
 
   /** Lumped mass of each independent DOF for density ρ, kg (component-blocked). */

@@ -58,7 +58,8 @@ TrialResult RealTimeSchedule::RunTrial() {
   const long steps = scene.num_steps();
   const double tick_ns = 1e9 / static_cast<double>(regions_.ticks_per_second());
   const int primary_substeps = regions_.schedule(kPrimaryRegion).substeps;
-  const std::int64_t primary_period_ticks = regions_.period_ticks(kPrimaryRegion) * primary_substeps;
+  const std::int64_t primary_period_ticks =
+      regions_.period_ticks(kPrimaryRegion) * primary_substeps;
   const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
   regions_.Reset();
 
@@ -73,7 +74,8 @@ TrialResult RealTimeSchedule::RunTrial() {
     nominal_ticks[a] = regions_.period_ticks(a) * regions_.schedule(a).substeps;
     records[a].execution_s.reserve(static_cast<size_t>(end_ticks / nominal_ticks[a] + 4));
     if (a > 0) {
-      lead_ns[a] = lead_ns[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ticks[a - 1] * tick_ns);
+      lead_ns[a] =
+          lead_ns[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ticks[a - 1] * tick_ns);
     }
   }
 
@@ -115,8 +117,8 @@ TrialResult RealTimeSchedule::RunTrial() {
     const double t = n * dt;
     std::array<double, 3> r{};
     for (int q = 1; q <= primary_substeps; ++q) {
-      const std::array<double, 3> rq = regions_.StepPrimary(
-          {0.0, 0.0, trajectory.DepthAt(t + q * dt / primary_substeps)});
+      const std::array<double, 3> rq =
+          regions_.StepPrimary({0.0, 0.0, trajectory.DepthAt(t + q * dt / primary_substeps)});
       if (q == 1) r = rq;
     }
     const std::int64_t done = NowNs();
@@ -128,7 +130,8 @@ TrialResult RealTimeSchedule::RunTrial() {
     sample.t_s = t;
     sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
     for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
-    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+    result.peak_force_n =
+        std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
     result.steps = n + 1;
     result.stopped_at_s = t;
     if (!std::isfinite(r[0] + r[1] + r[2])) {

@@ -12,9 +12,9 @@ namespace hapticsim {
 struct DeadlineStats {
   double period_s = 0;
   std::int64_t cycles = 0;
-  std::int64_t misses = 0;          ///< cycles that started late by more than one period or
-                                    ///< finished after their next release
-  double worst_lateness_s = 0;      ///< worst wake-up lateness after the release time, s
+  std::int64_t misses = 0;      ///< cycles that started late by more than one period or
+                                ///< finished after their next release
+  double worst_lateness_s = 0;  ///< worst wake-up lateness after the release time, s
   double execution_p50_s = 0, execution_p99_s = 0, execution_max_s = 0;  ///< step compute time
 };
 

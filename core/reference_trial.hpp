@@ -12,9 +12,9 @@ namespace hapticsim {
 /** How a run ended. */
 enum class TrialOutcome {
   kCompleted,
-  kPredictedUnstable,   ///< refused before the first step: dt ≥ the critical step
-  kDivergedNonFinite,   ///< detected during the run: a non-finite value
-  kDivergedEnergy,      ///< detected during the run: energy beyond the passivity budget
+  kPredictedUnstable,  ///< refused before the first step: dt ≥ the critical step
+  kDivergedNonFinite,  ///< detected during the run: a non-finite value
+  kDivergedEnergy,     ///< detected during the run: energy beyond the passivity budget
 };
 
 std::string_view TrialOutcomeName(TrialOutcome outcome);

@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <span>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/stiffness_operator.hpp"
 

@@ -11,7 +11,8 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
   ValidateScene(scene);
   HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
                          "asynchronous regions need adaptivity.primary_size >= 1");
-  const int n = scene.mesh.nodes, last = n - 1, middle = last / 2, r = scene.adaptivity.primary_size;
+  const int n = scene.mesh.nodes, last = n - 1, middle = last / 2,
+            r = scene.adaptivity.primary_size;
   const std::array<int, 3> contact{middle, middle, 0};
 
   HybridMesh::Options options;
@@ -35,16 +36,18 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
     elements[mesh_->elements()[e].region].push_back(e);
   }
   for (int region = 1; region < regions; ++region) {
-    HAPTICSIM_THROW_UNLESS(!elements[region].empty(),
-                           "adaptivity.primary_size = " + std::to_string(r) +
-                               (regions == 2 ? std::string(" leaves no secondary region")
-                                             : " leaves secondary region " + std::to_string(region) +
-                                                   " of adaptivity.secondary_regions = " +
-                                                   std::to_string(regions - 1) +
-                                                   " empty: use fewer or thinner shells"));
+    HAPTICSIM_THROW_UNLESS(
+        !elements[region].empty(),
+        "adaptivity.primary_size = " + std::to_string(r) +
+            (regions == 2
+                 ? std::string(" leaves no secondary region")
+                 : " leaves secondary region " + std::to_string(region) +
+                       " of adaptivity.secondary_regions = " + std::to_string(regions - 1) +
+                       " empty: use fewer or thinner shells"));
   }
   for (int region = 0; region < regions; ++region) {
-    stiffness_.push_back(std::make_unique<ElementSetStiffness>(*mesh_, scene.material, elements[region]));
+    stiffness_.push_back(
+        std::make_unique<ElementSetStiffness>(*mesh_, scene.material, elements[region]));
   }
 
   const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
@@ -73,10 +76,12 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
                              "internal: regions " + std::to_string(innermost) + " and " +
                                  std::to_string(outermost) + " touch without the shell between");
       if (std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(), dof)) {
-        for (int region = innermost; region <= outermost; ++region) dofs_[region].fixed.push_back(dof);
+        for (int region = innermost; region <= outermost; ++region)
+          dofs_[region].fixed.push_back(dof);
         continue;
       }
-      if (std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end()) continue;
+      if (std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end())
+        continue;
       dofs_[outermost].owned.push_back(dof);
       if (outermost != innermost) {
         dofs_[outermost].inner_interface.push_back(dof);
@@ -102,8 +107,9 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
 }
 
 int RegionPartition::num_elements(RegionIndex region) const {
-  return static_cast<int>(std::count_if(mesh_->elements().begin(), mesh_->elements().end(),
-                                        [&](const HybridElement& e) { return e.region == region; }));
+  return static_cast<int>(
+      std::count_if(mesh_->elements().begin(), mesh_->elements().end(),
+                    [&](const HybridElement& e) { return e.region == region; }));
 }
 
 int RegionPartition::num_nodes(RegionIndex region) const {

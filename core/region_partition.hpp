@@ -1,10 +1,9 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <memory>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/element_set_stiffness.hpp"
 #include "core/hybrid_mesh.hpp"

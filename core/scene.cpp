@@ -31,8 +31,8 @@ std::string FormatReal(double value) {
 
 [[noreturn]] void Reject(std::string_view key, std::string_view value, std::string_view allowed,
                          std::string_view unit) {
-  std::string message = std::string(key) + " = " + std::string(value) + " is not allowed: " +
-                        std::string(key) + " must be " + std::string(allowed);
+  std::string message = std::string(key) + " = " + std::string(value) +
+                        " is not allowed: " + std::string(key) + " must be " + std::string(allowed);
   if (!unit.empty()) message += " (in " + std::string(unit) + ")";
   throw Error(message);
 }
@@ -60,28 +60,27 @@ long ParseInteger(std::string_view key, std::string_view text) {
 // A real-valued key: `ref` selects the field, `allowed` is the range check.
 template <typename Ref>
 KeyAccess Real(SceneKeyInfo info, Ref ref, std::function<bool(double)> allowed) {
-  return KeyAccess{
-      info,
-      [ref](const Scene& scene) { return FormatReal(ref(const_cast<Scene&>(scene))); },
-      [info, ref, allowed](Scene* scene, std::string_view text) {
-        const double value = ParseReal(info.name, text);
-        if (!std::isfinite(value) || !allowed(value)) {
-          Reject(info.name, text, info.allowed, info.unit);
-        }
-        ref(*scene) = value;
-      }};
+  return KeyAccess{info,
+                   [ref](const Scene& scene) { return FormatReal(ref(const_cast<Scene&>(scene))); },
+                   [info, ref, allowed](Scene* scene, std::string_view text) {
+                     const double value = ParseReal(info.name, text);
+                     if (!std::isfinite(value) || !allowed(value)) {
+                       Reject(info.name, text, info.allowed, info.unit);
+                     }
+                     ref(*scene) = value;
+                   }};
 }
 
 // A whole-number key in [lo, hi].
 template <typename Ref>
 KeyAccess Integer(SceneKeyInfo info, Ref ref, long lo, long hi) {
-  return KeyAccess{info,
-                   [ref](const Scene& scene) { return std::to_string(ref(const_cast<Scene&>(scene))); },
-                   [info, ref, lo, hi](Scene* scene, std::string_view text) {
-                     const long value = ParseInteger(info.name, text);
-                     if (value < lo || value > hi) Reject(info.name, text, info.allowed, info.unit);
-                     ref(*scene) = static_cast<int>(value);
-                   }};
+  return KeyAccess{
+      info, [ref](const Scene& scene) { return std::to_string(ref(const_cast<Scene&>(scene))); },
+      [info, ref, lo, hi](Scene* scene, std::string_view text) {
+        const long value = ParseInteger(info.name, text);
+        if (value < lo || value > hi) Reject(info.name, text, info.allowed, info.unit);
+        ref(*scene) = static_cast<int>(value);
+      }};
 }
 
 // A key with a fixed set of names, written quoted ("press"); `get` and `set` map the scene
@@ -112,81 +111,89 @@ KeyAccess Choice(SceneKeyInfo info, std::vector<std::string_view> names, Get get
 const std::vector<KeyAccess>& KeyTable() {
   static const std::vector<KeyAccess> table = [] {
     std::vector<KeyAccess> keys;
-    keys.push_back(Integer({"mesh.nodes", "", "a whole number from 2 to 401",
-                            "nodes per axis of the cube"},
-                           [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
-    keys.push_back(Real({"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
-                        [](Scene& s) -> double& { return s.mesh.edge_m; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Real({"material.youngs_modulus", "Pa", "finite and > 0", "Young's modulus E"},
-                        [](Scene& s) -> double& { return s.material.youngs_modulus_pa; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Real({"material.poisson_ratio", "", "in the open interval (-1, 0.5)",
-                         "Poisson's ratio ν"},
-                        [](Scene& s) -> double& { return s.material.poisson_ratio; },
-                        [](double v) { return v > -1.0 && v < 0.5; }));
-    keys.push_back(Real({"material.density", "kg/m^3", "finite and > 0", "mass density ρ"},
-                        [](Scene& s) -> double& { return s.material.density_kg_m3; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Real({"material.damping", "1/s", "finite and >= 0",
-                         "mass-proportional damping d in C = d·M"},
-                        [](Scene& s) -> double& { return s.material.damping_per_s; },
-                        [](double v) { return v >= 0; }));
-    keys.push_back(Real({"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
-                         "amplitude s of the contact node's motion along +z"},
-                        [](Scene& s) -> double& { return s.input.amplitude_m; },
-                        [](double v) { return v >= 0; }));
-    keys.push_back(Real({"input.frequency", "Hz", "finite and > 0", "input frequency f"},
-                        [](Scene& s) -> double& { return s.input.frequency_hz; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Choice({"input.waveform", "", "\"press\" or \"sine\"",
-                           "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-                          {"press", "sine"},
-                          [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
-                          [](Scene& s, int i) {
-                            s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine;
-                          }));
-    keys.push_back(Real({"input.periods", "", "finite and > 0", "trial length in input periods"},
-                        [](Scene& s) -> double& { return s.input.periods; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Real({"solver.dt", "s", "finite and > 0", "time step of the simulation"},
-                        [](Scene& s) -> double& { return s.solver.dt_s; },
-                        [](double v) { return v > 0; }));
-    keys.push_back(Integer({"adaptivity.primary_size", "",
-                            "a whole number from 0 to 1000 (0 = no adaptivity)",
-                            "primary region: nodes from the contact in every direction (0 = off)"},
-                           [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
-    keys.push_back(Integer({"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
-                            "secondary spacing factor k (× the finest spacing)"},
-                           [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
-    keys.push_back(Real({"adaptivity.secondary_rate", "Hz",
-                         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-                         "update rate of the secondary region"},
-                        [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
-                        [](double v) { return v >= 1 && v == std::floor(v); }));
-    keys.push_back(Integer({"adaptivity.support_layers", "", "a whole number from 0 to 100",
-                            "coarse cells refined around each fixed node (the supports are "
-                            "singular: a coarse cell there is far too stiff)"},
-                           [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
-    keys.push_back(Integer({"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
-                            "secondary regions: nested shells around the primary, each with its "
-                            "own thread"},
-                           [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
-    keys.push_back(Integer({"adaptivity.shell_cells", "", "a whole number from 1 to 100",
-                            "thickness of each secondary shell but the last, in coarse cells"},
-                           [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
-    keys.push_back(Real({"adaptivity.outer_rate", "Hz",
-                         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-                         "update rate of the secondary shells beyond the first"},
-                        [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
-                        [](double v) { return v >= 1 && v == std::floor(v); }));
-    keys.push_back(Choice({"adaptivity.coupling", "", "\"displacement\" or \"force\"",
-                           "what an inner region sends the outer one: its displacements next to "
-                           "the interface (displacement) or its interface forces (force); see "
-                           "docs/regions.md"},
-                          {"displacement", "force"},
-                          [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
-                          [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
+    keys.push_back(Integer(
+        {"mesh.nodes", "", "a whole number from 2 to 401", "nodes per axis of the cube"},
+        [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
+    keys.push_back(Real(
+        {"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
+        [](Scene& s) -> double& { return s.mesh.edge_m; }, [](double v) { return v > 0; }));
+    keys.push_back(Real(
+        {"material.youngs_modulus", "Pa", "finite and > 0", "Young's modulus E"},
+        [](Scene& s) -> double& { return s.material.youngs_modulus_pa; },
+        [](double v) { return v > 0; }));
+    keys.push_back(Real(
+        {"material.poisson_ratio", "", "in the open interval (-1, 0.5)", "Poisson's ratio ν"},
+        [](Scene& s) -> double& { return s.material.poisson_ratio; },
+        [](double v) { return v > -1.0 && v < 0.5; }));
+    keys.push_back(Real(
+        {"material.density", "kg/m^3", "finite and > 0", "mass density ρ"},
+        [](Scene& s) -> double& { return s.material.density_kg_m3; },
+        [](double v) { return v > 0; }));
+    keys.push_back(Real(
+        {"material.damping", "1/s", "finite and >= 0", "mass-proportional damping d in C = d·M"},
+        [](Scene& s) -> double& { return s.material.damping_per_s; },
+        [](double v) { return v >= 0; }));
+    keys.push_back(Real(
+        {"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
+         "amplitude s of the contact node's motion along +z"},
+        [](Scene& s) -> double& { return s.input.amplitude_m; }, [](double v) { return v >= 0; }));
+    keys.push_back(Real(
+        {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
+        [](Scene& s) -> double& { return s.input.frequency_hz; }, [](double v) { return v > 0; }));
+    keys.push_back(Choice(
+        {"input.waveform", "", "\"press\" or \"sine\"",
+         "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
+        {"press", "sine"},
+        [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
+        [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
+    keys.push_back(Real(
+        {"input.periods", "", "finite and > 0", "trial length in input periods"},
+        [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
+    keys.push_back(Real(
+        {"solver.dt", "s", "finite and > 0", "time step of the simulation"},
+        [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
+    keys.push_back(Integer(
+        {"adaptivity.primary_size", "", "a whole number from 0 to 1000 (0 = no adaptivity)",
+         "primary region: nodes from the contact in every direction (0 = off)"},
+        [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
+    keys.push_back(Integer(
+        {"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
+         "secondary spacing factor k (× the finest spacing)"},
+        [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
+    keys.push_back(Real(
+        {"adaptivity.secondary_rate", "Hz",
+         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+         "update rate of the secondary region"},
+        [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
+        [](double v) { return v >= 1 && v == std::floor(v); }));
+    keys.push_back(Integer(
+        {"adaptivity.support_layers", "", "a whole number from 0 to 100",
+         "coarse cells refined around each fixed node (the supports are "
+         "singular: a coarse cell there is far too stiff)"},
+        [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
+    keys.push_back(Integer(
+        {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
+         "secondary regions: nested shells around the primary, each with its "
+         "own thread"},
+        [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
+    keys.push_back(Integer(
+        {"adaptivity.shell_cells", "", "a whole number from 1 to 100",
+         "thickness of each secondary shell but the last, in coarse cells"},
+        [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
+    keys.push_back(Real(
+        {"adaptivity.outer_rate", "Hz",
+         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+         "update rate of the secondary shells beyond the first"},
+        [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
+        [](double v) { return v >= 1 && v == std::floor(v); }));
+    keys.push_back(Choice(
+        {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
+         "what an inner region sends the outer one: its displacements next to "
+         "the interface (displacement) or its interface forces (force); see "
+         "docs/regions.md"},
+        {"displacement", "force"},
+        [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
+        [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
     return keys;
   }();
   return table;
@@ -214,12 +221,13 @@ void ValidateAdaptivity(const Scene& scene) {
   }
   const double primary_rate = 1.0 / scene.solver.dt_s;
   if (std::abs(primary_rate - std::round(primary_rate)) > 1e-9 * primary_rate) {
-    throw Error("solver.dt = " + FormatReal(scene.solver.dt_s) + " s gives a primary rate of " +
-                FormatReal(primary_rate) +
-                " Hz: with adaptivity on, solver.dt must be 1 / (a whole number of Hz), e.g. 0.001");
+    throw Error(
+        "solver.dt = " + FormatReal(scene.solver.dt_s) + " s gives a primary rate of " +
+        FormatReal(primary_rate) +
+        " Hz: with adaptivity on, solver.dt must be 1 / (a whole number of Hz), e.g. 0.001");
   }
   for (const auto& [key, rate] : {std::pair{"adaptivity.secondary_rate", a.secondary_rate_hz},
-                                   std::pair{"adaptivity.outer_rate", a.outer_rate_hz}}) {
+                                  std::pair{"adaptivity.outer_rate", a.outer_rate_hz}}) {
     if (rate > std::round(primary_rate)) {
       throw Error(std::string(key) + " = " + FormatReal(rate) + " Hz is not allowed: " + key +
                   " must be at most the primary rate 1/solver.dt = " +
@@ -231,7 +239,9 @@ void ValidateAdaptivity(const Scene& scene) {
     while (largest + 1 < a.primary_size && !PrimaryBoxCoversObject(scene, largest + 1)) ++largest;
     throw Error("adaptivity.primary_size = " + std::to_string(a.primary_size) +
                 " covers the whole object, leaving no secondary region: adaptivity.primary_size "
-                "must be from 1 to " + std::to_string(largest) + " for this mesh and "
+                "must be from 1 to " +
+                std::to_string(largest) +
+                " for this mesh and "
                 "adaptivity.secondary_lod, or 0 to switch adaptivity off");
   }
 }
@@ -277,8 +287,7 @@ void ValidateScene(const Scene& scene) {
     throw Error("solver.dt = " + FormatReal(scene.solver.dt_s) + " s gives " +
                 FormatReal(std::round(steps)) +
                 " steps for the trial of input.periods / input.frequency = " +
-                FormatReal(scene.duration_s()) +
-                " s: solver.dt must give between 1 and 1e8 steps");
+                FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }

@@ -20,10 +20,10 @@ struct MeshSettings {
 };
 
 struct InputSettings {
-  double amplitude_m = 0.01;           ///< s, m (input.amplitude)
-  double frequency_hz = 1.0;           ///< f, Hz (input.frequency)
+  double amplitude_m = 0.01;             ///< s, m (input.amplitude)
+  double frequency_hz = 1.0;             ///< f, Hz (input.frequency)
   Waveform waveform = Waveform::kPress;  ///< input.waveform
-  double periods = 1.0;                ///< trial length in periods of f (input.periods)
+  double periods = 1.0;                  ///< trial length in periods of f (input.periods)
 };
 
 struct SolverSettings {
@@ -35,13 +35,15 @@ struct SolverSettings {
  * the whole object is then solved on the finest mesh at the primary rate (the reference).
  */
 struct AdaptivitySettings {
-  int primary_size = 0;          ///< nodes from the contact in every direction (adaptivity.primary_size)
-  int secondary_lod = 2;         ///< secondary spacing factor k (adaptivity.secondary_lod)
+  int primary_size = 0;   ///< nodes from the contact in every direction (adaptivity.primary_size)
+  int secondary_lod = 2;  ///< secondary spacing factor k (adaptivity.secondary_lod)
   double secondary_rate_hz = 600;  ///< secondary region rate, Hz (adaptivity.secondary_rate)
-  int support_layers = 1;        ///< coarse cells refined around each fixed node (adaptivity.support_layers)
-  int secondary_regions = 1;     ///< nested secondary shells, one thread each (adaptivity.secondary_regions)
-  int shell_cells = 1;           ///< thickness of each inner shell, coarse cells (adaptivity.shell_cells)
-  double outer_rate_hz = 600;    ///< rate of the shells beyond the first, Hz (adaptivity.outer_rate)
+  int support_layers =
+      1;  ///< coarse cells refined around each fixed node (adaptivity.support_layers)
+  int secondary_regions =
+      1;                ///< nested secondary shells, one thread each (adaptivity.secondary_regions)
+  int shell_cells = 1;  ///< thickness of each inner shell, coarse cells (adaptivity.shell_cells)
+  double outer_rate_hz = 600;  ///< rate of the shells beyond the first, Hz (adaptivity.outer_rate)
   /// What the primary sends the secondary for the interface (adaptivity.coupling):
   /// true = its displacements next to Γ ("displacement", the default), false = its Γ forces.
   bool displacement_coupling = true;

@@ -1,9 +1,9 @@
 #include "core/scene_toml.hpp"
 
+#include <toml++/toml.h>
+
 #include <charconv>
 #include <sstream>
-
-#include <toml++/toml.h>
 
 #include "core/error.hpp"
 

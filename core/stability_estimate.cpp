@@ -1,9 +1,8 @@
 #include "core/stability_estimate.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdint>
-
-#include <Eigen/Eigenvalues>
 
 #include "core/hex8_element.hpp"
 
@@ -12,10 +11,10 @@ namespace hapticsim {
 double ElementBoundCriticalDt(const ElasticModel& model) {
   const double h = model.grid().spacing();
   const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(h, model.material());
-  const double lambda_ke = Eigen::SelfAdjointEigenSolver<Hex8Element::Matrix24>(
-                               ke, Eigen::EigenvaluesOnly)
-                               .eigenvalues()
-                               .maxCoeff();
+  const double lambda_ke =
+      Eigen::SelfAdjointEigenSolver<Hex8Element::Matrix24>(ke, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
   const double element_node_mass = model.material().density_kg_m3 * h * h * h / 8.0;
   return 2.0 / std::sqrt(lambda_ke / element_node_mass);
 }
@@ -77,7 +76,8 @@ StabilityEstimate EstimateStability(const StiffnessOperator& stiffness,
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> tridiagonal;
       tridiagonal.computeFromTridiagonal(diagonal, sub, Eigen::ComputeEigenvectors);
       const double theta = tridiagonal.eigenvalues()[m - 1];  // ascending
-      const double residual = breakdown ? 0.0 : b * std::abs(tridiagonal.eigenvectors()(m - 1, m - 1));
+      const double residual =
+          breakdown ? 0.0 : b * std::abs(tridiagonal.eigenvectors()(m - 1, m - 1));
       lambda = theta + residual;
       if (residual <= options.relative_tolerance * theta) {
         estimate.converged = true;
@@ -90,8 +90,7 @@ StabilityEstimate EstimateStability(const StiffnessOperator& stiffness,
     q = w / b;
   }
   estimate.omega_max_rad_s = std::sqrt(std::max(lambda, 0.0));
-  estimate.critical_dt_s =
-      estimate.omega_max_rad_s > 0 ? 2.0 / estimate.omega_max_rad_s : INFINITY;
+  estimate.critical_dt_s = estimate.omega_max_rad_s > 0 ? 2.0 / estimate.omega_max_rad_s : INFINITY;
   return estimate;
 }
 

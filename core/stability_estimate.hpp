@@ -13,11 +13,12 @@ namespace hapticsim {
  * when ω·dt > 2), so 2/ω_max is the limit for every d ≥ 0.
  */
 struct StabilityEstimate {
-  double omega_max_rad_s = 0;    ///< ω_max from the Lanczos iteration, rad/s
-  double critical_dt_s = 0;      ///< 2/ω_max, s
-  double element_bound_dt_s = 0; ///< 2/ω_e from the element-level bound ω_max ≤ ω_e, s (≤ critical)
-  int iterations = 0;            ///< Lanczos iterations (one K·u each)
-  bool converged = false;        ///< the top Ritz pair's residual met the tolerance
+  double omega_max_rad_s = 0;  ///< ω_max from the Lanczos iteration, rad/s
+  double critical_dt_s = 0;    ///< 2/ω_max, s
+  double element_bound_dt_s =
+      0;               ///< 2/ω_e from the element-level bound ω_max ≤ ω_e, s (≤ critical)
+  int iterations = 0;  ///< Lanczos iterations (one K·u each)
+  bool converged = false;  ///< the top Ritz pair's residual met the tolerance
 
   /** True when dt is below the critical step (the run is predicted stable). */
   bool IsStable(double dt_s) const { return dt_s < critical_dt_s; }

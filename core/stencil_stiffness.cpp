@@ -166,8 +166,8 @@ Eigen::VectorXd StencilStiffness::Diagonal() const {
   const std::ptrdiff_t n = grid_.num_nodes();
   for (int node = 0; node < grid_.num_nodes(); ++node) {
     const auto [ix, iy, iz] = grid_.NodeIndices(node);
-    const int cls = AxisClass(ix, grid_.nx()) + 3 * AxisClass(iy, grid_.ny()) +
-                    9 * AxisClass(iz, grid_.nz());
+    const int cls =
+        AxisClass(ix, grid_.nx()) + 3 * AxisClass(iy, grid_.ny()) + 9 * AxisClass(iz, grid_.nz());
     for (int a = 0; a < 3; ++a) {
       diagonal[a * n + node] = 0.0;
       for (const StencilTerm& t : stencils_[cls][a]) {
@@ -182,8 +182,8 @@ double StencilStiffness::FlopsPerApply() const {
   double flops = 0.0;
   for (int node = 0; node < grid_.num_nodes(); ++node) {
     const auto [ix, iy, iz] = grid_.NodeIndices(node);
-    const int cls = AxisClass(ix, grid_.nx()) + 3 * AxisClass(iy, grid_.ny()) +
-                    9 * AxisClass(iz, grid_.nz());
+    const int cls =
+        AxisClass(ix, grid_.nx()) + 3 * AxisClass(iy, grid_.ny()) + 9 * AxisClass(iz, grid_.nz());
     for (int a = 0; a < 3; ++a) flops += 2.0 * static_cast<double>(stencils_[cls][a].size());
   }
   return flops;

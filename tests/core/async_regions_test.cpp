@@ -82,7 +82,7 @@ TEST(AsyncRegions, MultirateErrorDoesNotDependOnTheRate) {
   const auto a = fast.RunTrial(), b = slow.RunTrial();
   const double e_fast = CompareForces(a.samples, DefaultReference().samples).l2_percent;
   const double e_slow = CompareForces(b.samples, DefaultReference().samples).l2_percent;
-  EXPECT_GT(e_fast, 1.0);  // k = 2 costs accuracy…
+  EXPECT_GT(e_fast, 1.0);                               // k = 2 costs accuracy…
   EXPECT_LT(std::abs(e_slow - e_fast), 0.01 * e_fast);  // …the rate almost none
 }
 

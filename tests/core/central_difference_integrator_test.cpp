@@ -25,8 +25,8 @@ Eigen::VectorXd RandomFreeState(const ElasticModel& model, unsigned seed) {
 
 // Central difference conserves E = ½(u⁺ − u)ᵀM(u⁺ − u)/dt² + ½uᵀK u⁺ exactly for an undamped,
 // unforced system (multiply the update by (u⁺ − u⁻)/2 and telescope).
-double ShadowEnergy(const ElasticModel& model, const Eigen::VectorXd& u, const Eigen::VectorXd& u_next,
-                    double dt) {
+double ShadowEnergy(const ElasticModel& model, const Eigen::VectorXd& u,
+                    const Eigen::VectorXd& u_next, double dt) {
   Eigen::VectorXd k_next(u.size());
   model.stiffness().Apply(u_next, k_next);
   const Eigen::VectorXd du = u_next - u;
@@ -165,7 +165,8 @@ TEST(CentralDifference, SlowUndampedPressConvergesToTheStaticSolve) {
   const TrialResult dynamic = RunReferenceTrial(CubeScene(scene));
   ASSERT_EQ(dynamic.outcome, TrialOutcome::kCompleted);
   const std::array<double, 3> depth{0, 0, scene.input.amplitude_m};
-  const double static_reaction = SolveStatic(CubeScene(scene).model(), depth, 1e-12).driven_reaction[2];
+  const double static_reaction =
+      SolveStatic(CubeScene(scene).model(), depth, 1e-12).driven_reaction[2];
   const double dynamic_reaction = -dynamic.samples.back().feedback_force_n[2];
   EXPECT_NEAR(dynamic_reaction, static_reaction, 0.005 * static_reaction);
 }

@@ -1,7 +1,8 @@
 #include "core/hex8_element.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
 
 namespace hapticsim {
 namespace {
@@ -43,7 +44,8 @@ TEST(Hex8Element, HasExactlySixZeroEigenvaluesAndIsOtherwisePositive) {
 TEST(Hex8Element, RigidBodyMotionsProduceNoForce) {
   const double h = 0.02;
   const auto k = Hex8Element::Stiffness(h, Material{});
-  const auto forces = k * RigidModes(h);
+  // Evaluated into a matrix: an Eigen product expression would refer to a destroyed temporary.
+  const Eigen::Matrix<double, 24, 6> forces = k * RigidModes(h);
   EXPECT_LT(forces.cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
 }
 
@@ -64,7 +66,8 @@ TEST(Hex8Element, UniformStrainEnergyMatchesContinuum) {
   Eigen::Matrix<double, 24, 1> u = Eigen::Matrix<double, 24, 1>::Zero();
   for (int local = 0; local < 8; ++local) u[3 * local] = e * h * (local & 1);
   const double energy = 0.5 * u.dot(k * u);
-  const double expected = 0.5 * (material.lame_lambda() + 2 * material.lame_mu()) * e * e * h * h * h;
+  const double expected =
+      0.5 * (material.lame_lambda() + 2 * material.lame_mu()) * e * e * h * h * h;
   EXPECT_NEAR(energy, expected, 1e-12 * expected);
 }
 

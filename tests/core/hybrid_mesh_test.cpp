@@ -62,7 +62,8 @@ TEST(HybridMesh, WithoutCoarseningIsTheFullGrid) {
   for (int r = 0; r < dut.num_independent(); ++r) {
     const auto& p = dut.LatticeOf(r);
     for (int c = 0; c < 3; ++c) {
-      worst = std::max(worst, std::abs(ku_mesh[dut.Dof(r, c)] - ku[grid.Dof(grid.Node(p[0], p[1], p[2]), c)]));
+      worst = std::max(
+          worst, std::abs(ku_mesh[dut.Dof(r, c)] - ku[grid.Dof(grid.Node(p[0], p[1], p[2]), c)]));
     }
   }
   EXPECT_LT(worst, 1e-12 * ku.cwiseAbs().maxCoeff());
@@ -74,7 +75,8 @@ TEST(HybridMesh, MassIsConservedAcrossHangingNodes) {
     EXPECT_GT(dut.num_hanging(), 0);
     const double rho = 1000, edge = 0.25;
     // Each component block carries the whole mass ρL³.
-    EXPECT_NEAR(dut.DofMass(rho).head(dut.num_independent()).sum(), rho * edge * edge * edge, 1e-12);
+    EXPECT_NEAR(dut.DofMass(rho).head(dut.num_independent()).sum(), rho * edge * edge * edge,
+                1e-12);
   }
 }
 
@@ -97,7 +99,8 @@ TEST_P(PatchAcrossResolutionJumps, AffineFieldLeavesNoForceInside) {
     for (int a = 0; a < 3; ++a) on_surface = on_surface || p[a] == 0 || p[a] == 12;
     if (on_surface) continue;
     ++inside;
-    for (int c = 0; c < 3; ++c) worst_inside = std::max(worst_inside, std::abs(ku[dut.Dof(node, c)]));
+    for (int c = 0; c < 3; ++c)
+      worst_inside = std::max(worst_inside, std::abs(ku[dut.Dof(node, c)]));
   }
   EXPECT_GT(inside, 0);
   EXPECT_LT(worst_inside, 1e-12 * scale);

@@ -12,7 +12,8 @@ namespace {
 
 constexpr double kH = 0.02;
 
-Eigen::VectorXd AffineField(const HexGrid& grid, const Eigen::Matrix3d& a, const Eigen::Vector3d& b) {
+Eigen::VectorXd AffineField(const HexGrid& grid, const Eigen::Matrix3d& a,
+                            const Eigen::Vector3d& b) {
   Eigen::VectorXd u(grid.num_dofs());
   for (int node = 0; node < grid.num_nodes(); ++node) {
     const auto p = grid.NodePosition(node);
@@ -68,7 +69,8 @@ TEST_F(PatchTest, StaticSolveReproducesTheAffineFieldInside) {
 
   const StaticSolution solution = SolveStatic(model, driven, 1e-13);
   ASSERT_TRUE(solution.converged);
-  EXPECT_LT((solution.displacement - exact).cwiseAbs().maxCoeff(), 1e-10 * exact.cwiseAbs().maxCoeff());
+  EXPECT_LT((solution.displacement - exact).cwiseAbs().maxCoeff(),
+            1e-10 * exact.cwiseAbs().maxCoeff());
 }
 
 }  // namespace

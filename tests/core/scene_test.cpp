@@ -1,10 +1,10 @@
 #include "core/scene.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cctype>
 #include <cstdio>
 #include <fstream>
-
-#include <gtest/gtest.h>
 
 #include "core/error.hpp"
 #include "core/scene_toml.hpp"
@@ -65,7 +65,8 @@ INSTANTIATE_TEST_SUITE_P(
     Values, RejectsBadValue,
     ::testing::Values(BadValue{"material.poisson_ratio=0.5", "(-1, 0.5)"},
                       BadValue{"material.poisson_ratio=-1", "material.poisson_ratio"},
-                      BadValue{"material.youngs_modulus=0", "material.youngs_modulus must be finite and > 0"},
+                      BadValue{"material.youngs_modulus=0",
+                               "material.youngs_modulus must be finite and > 0"},
                       BadValue{"material.density=-3", "material.density"},
                       BadValue{"mesh.nodes=1", "mesh.nodes must be a whole number from 2"},
                       BadValue{"mesh.nodes=12.5", "mesh.nodes"},
@@ -160,14 +161,16 @@ class RejectsBadAdaptivity : public ::testing::TestWithParam<BadAdaptivity> {};
 
 TEST_P(RejectsBadAdaptivity, WithAMessageNamingTheKey) {
   Scene scene;
-  const std::string message = ErrorMessage([&] { ApplySceneOverrides(&scene, GetParam().assignments); });
+  const std::string message =
+      ErrorMessage([&] { ApplySceneOverrides(&scene, GetParam().assignments); });
   EXPECT_NE(message.find(GetParam().must_mention), std::string::npos) << message;
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Configurations, RejectsBadAdaptivity,
     ::testing::Values(
-        BadAdaptivity{{"adaptivity.primary_size=12"}, "adaptivity.primary_size = 12 covers the whole object"},
+        BadAdaptivity{{"adaptivity.primary_size=12"},
+                      "adaptivity.primary_size = 12 covers the whole object"},
         BadAdaptivity{{"adaptivity.primary_size=2", "adaptivity.secondary_lod=5"},
                       "adaptivity.secondary_lod = 5 does not divide"},
         BadAdaptivity{{"adaptivity.secondary_rate=0"}, "adaptivity.secondary_rate"},

@@ -1,7 +1,8 @@
 #include "core/stability_estimate.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
 
 #include "core/assembled_stiffness.hpp"
 #include "core/cube_scene.hpp"

@@ -35,10 +35,10 @@ TEST_P(StencilMatchesAssembled, OnRandomDisplacements) {
 // chunk plus a tail (16+8+4 exact, and overlapping tails), and unequal axes (catches swapped
 // strides).
 INSTANTIATE_TEST_SUITE_P(Grids, StencilMatchesAssembled,
-                         ::testing::Values(GridCase{2, 2, 2}, GridCase{3, 3, 3},
-                                           GridCase{5, 4, 3}, GridCase{13, 13, 13},
-                                           GridCase{21, 6, 9}, GridCase{2, 11, 4},
-                                           GridCase{30, 3, 3}, GridCase{7, 5, 2}));
+                         ::testing::Values(GridCase{2, 2, 2}, GridCase{3, 3, 3}, GridCase{5, 4, 3},
+                                           GridCase{13, 13, 13}, GridCase{21, 6, 9},
+                                           GridCase{2, 11, 4}, GridCase{30, 3, 3},
+                                           GridCase{7, 5, 2}));
 
 TEST(StencilStiffness, CountsTheFlopsOfTheStoredCouplings) {
   // An interior node couples to 27 neighbours: 81 diagonal-block terms and 72 off-diagonal

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <random>
-
 #include <Eigen/Core>
+#include <random>
 
 namespace hapticsim::testing {
 

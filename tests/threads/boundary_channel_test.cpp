@@ -1,10 +1,10 @@
 #include "core/boundary_channel.hpp"
 
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace hapticsim {
 namespace {

@@ -1,10 +1,10 @@
 // The hapticsim binary as a user runs it: exit statuses, JSON shapes, files written, and the
 // messages bad input gets.
-#include <fstream>
-#include <sstream>
-
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "tests/support/run_command.hpp"
 
@@ -91,8 +91,8 @@ TEST(HapticsimCli, SimulateRefusesAPredictedUnstableStep) {
 }
 
 TEST(HapticsimCli, SimulateReportsDetectedDivergence) {
-  const auto result = Hapticsim({"simulate", "--json", "--allow-unstable", "--set",
-                                 "mesh.nodes=7", "--set", "solver.dt=0.01"});
+  const auto result = Hapticsim({"simulate", "--json", "--allow-unstable", "--set", "mesh.nodes=7",
+                                 "--set", "solver.dt=0.01"});
   EXPECT_EQ(result.exit_status, 3);
   const auto json = nlohmann::json::parse(result.out);
   EXPECT_EQ(json["diverged"], true);
@@ -112,10 +112,9 @@ TEST(HapticsimCli, SceneOutputReadsBackAsAScene) {
 }
 
 TEST(HapticsimCli, AdaptiveSimulateComparesWithTheReference) {
-  const auto json = Json(Hapticsim({"simulate", "--json", "--compare-reference", "--set",
-                                    "adaptivity.primary_size=3", "--set",
-                                    "adaptivity.secondary_lod=2", "--set",
-                                    "adaptivity.secondary_rate=600"}));
+  const auto json = Json(
+      Hapticsim({"simulate", "--json", "--compare-reference", "--set", "adaptivity.primary_size=3",
+                 "--set", "adaptivity.secondary_lod=2", "--set", "adaptivity.secondary_rate=600"}));
   EXPECT_EQ(json["adaptive"], true);
   EXPECT_EQ(json["predicted_stable"], true);
   ASSERT_EQ(json["regions"].size(), 2u);
@@ -132,25 +131,25 @@ TEST(HapticsimCli, AdaptiveSimulateComparesWithTheReference) {
 }
 
 TEST(HapticsimCli, AdaptiveStabilityReportsEachRegionAndTheCoupledVerdict) {
-  const auto stable = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
+  const auto stable =
+      Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
   EXPECT_EQ(stable["stable"], true);
   EXPECT_LT(stable["coupled_spectral_radius"].get<double>(), 1.0);
   ASSERT_EQ(stable["regions"].size(), 2u);
   EXPECT_GT(stable["regions"][1]["critical_dt_s"].get<double>(), 0.0);
 
-  const auto unstable = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2",
-                                        "--set", "adaptivity.secondary_lod=1", "--set",
-                                        "adaptivity.secondary_rate=700", "--set",
-                                        "material.poisson_ratio=0.49"}));
+  const auto unstable =
+      Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2", "--set",
+                      "adaptivity.secondary_lod=1", "--set", "adaptivity.secondary_rate=700",
+                      "--set", "material.poisson_ratio=0.49"}));
   EXPECT_EQ(unstable["stable"], false);
   EXPECT_GT(unstable["coupled_spectral_radius"].get<double>(), 1.0);
 }
 
 TEST(HapticsimCli, AdaptiveSimulateRefusesAPredictedUnstableCoupling) {
-  const auto result = Hapticsim({"simulate", "--set", "adaptivity.primary_size=2", "--set",
-                                 "adaptivity.secondary_lod=1", "--set",
-                                 "adaptivity.secondary_rate=700", "--set",
-                                 "material.poisson_ratio=0.49"});
+  const auto result = Hapticsim(
+      {"simulate", "--set", "adaptivity.primary_size=2", "--set", "adaptivity.secondary_lod=1",
+       "--set", "adaptivity.secondary_rate=700", "--set", "material.poisson_ratio=0.49"});
   EXPECT_EQ(result.exit_status, 3);
   EXPECT_NE(result.out.find("refused: predicted unstable"), std::string::npos) << result.out;
 }
@@ -174,30 +173,36 @@ TEST_P(HapticsimCliRejects, WithStatus2AndAMessageNamingTheProblem) {
 INSTANTIATE_TEST_SUITE_P(
     BadInput, HapticsimCliRejects,
     ::testing::Values(
-        BadInvocation{"PoissonRatio", {"simulate", "--set", "material.poisson_ratio=0.6"},
-                      "(-1, 0.5)"},
-        BadInvocation{"NegativeModulus", {"static", "--json", "--set", "material.youngs_modulus=-5"},
+        BadInvocation{
+            "PoissonRatio", {"simulate", "--set", "material.poisson_ratio=0.6"}, "(-1, 0.5)"},
+        BadInvocation{"NegativeModulus",
+                      {"static", "--json", "--set", "material.youngs_modulus=-5"},
                       "material.youngs_modulus must be finite and > 0"},
         BadInvocation{"OneNode", {"stability", "--set", "mesh.nodes=1"}, "mesh.nodes"},
         BadInvocation{"NanTimeStep", {"simulate", "--set", "solver.dt=nan"}, "solver.dt"},
-        BadInvocation{"UnknownKey", {"simulate", "--set", "material.colour=red"},
-                      "unknown scene key"},
-        BadInvocation{"MissingFile", {"simulate", "--scene", "/nonexistent.toml"},
-                      "/nonexistent.toml"},
+        BadInvocation{
+            "UnknownKey", {"simulate", "--set", "material.colour=red"}, "unknown scene key"},
+        BadInvocation{
+            "MissingFile", {"simulate", "--scene", "/nonexistent.toml"}, "/nonexistent.toml"},
         BadInvocation{"UnknownOption", {"simulate", "--bogus"}, "--bogus"},
         BadInvocation{"UnknownSubcommand", {"frobnicate"}, "unknown subcommand 'frobnicate'"},
-        BadInvocation{"PrimaryTooLarge", {"simulate", "--set", "adaptivity.primary_size=40"},
+        BadInvocation{"PrimaryTooLarge",
+                      {"simulate", "--set", "adaptivity.primary_size=40"},
                       "adaptivity.primary_size"},
-        BadInvocation{"LodNotDividing", {"simulate", "--set", "adaptivity.primary_size=2", "--set",
-                                         "adaptivity.secondary_lod=5"},
+        BadInvocation{"LodNotDividing",
+                      {"simulate", "--set", "adaptivity.primary_size=2", "--set",
+                       "adaptivity.secondary_lod=5"},
                       "adaptivity.secondary_lod"},
-        BadInvocation{"NegativeRate", {"stability", "--set", "adaptivity.secondary_rate=-5"},
+        BadInvocation{"NegativeRate",
+                      {"stability", "--set", "adaptivity.secondary_rate=-5"},
                       "adaptivity.secondary_rate"},
-        BadInvocation{"EmptyShell", {"simulate", "--set", "adaptivity.primary_size=4", "--set",
-                                     "adaptivity.secondary_regions=8"},
+        BadInvocation{"EmptyShell",
+                      {"simulate", "--set", "adaptivity.primary_size=4", "--set",
+                       "adaptivity.secondary_regions=8"},
                       "adaptivity.secondary_regions = 8"},
-        BadInvocation{"OuterRateTooHigh", {"simulate", "--set", "adaptivity.primary_size=2", "--set",
-                                           "adaptivity.outer_rate=2000"},
+        BadInvocation{"OuterRateTooHigh",
+                      {"simulate", "--set", "adaptivity.primary_size=2", "--set",
+                       "adaptivity.outer_rate=2000"},
                       "adaptivity.outer_rate"}),
     [](const ::testing::TestParamInfo<BadInvocation>& info) { return info.param.name; });
 

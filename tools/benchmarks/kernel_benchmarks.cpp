@@ -52,7 +52,8 @@ void BM_AssembledApply(benchmark::State& state) {
 }
 
 // The regions' generic element loop (24×24 per element, hanging-node gathers) on the same full
-// grid (k = 1, so no hanging nodes): what the asynchronous regions pay per node against the stencil.
+// grid (k = 1, so no hanging nodes): what the asynchronous regions pay per node against the
+// stencil.
 void BM_ElementLoopApply(benchmark::State& state) {
   const int nodes = static_cast<int>(state.range(0));
   HybridMesh::Options options;

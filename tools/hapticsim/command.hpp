@@ -1,8 +1,7 @@
 #pragma once
 
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace hapticsim::cli {
 
@@ -10,8 +9,8 @@ namespace hapticsim::cli {
 enum ExitStatus : int {
   kExitOk = 0,
   kExitInternalError = 1,
-  kExitBadInput = 2,   ///< bad command line, scene file or value: the message names the key
-  kExitUnstable = 3,   ///< the run was refused as unstable or diverged
+  kExitBadInput = 2,  ///< bad command line, scene file or value: the message names the key
+  kExitUnstable = 3,  ///< the run was refused as unstable or diverged
 };
 
 /** A registered subcommand: its CLI11 app and what to run when it was chosen. */

@@ -1,5 +1,4 @@
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "core/scene_toml.hpp"
@@ -37,7 +36,8 @@ int Run(const SceneOptions& options) {
 Command AddSceneCommand(CLI::App& parent) {
   auto options = std::make_shared<SceneOptions>();
   CLI::App* app = parent.add_subcommand(
-      "scene", "Print the effective scene (built-in defaults, --scene file, --set overrides) as TOML");
+      "scene",
+      "Print the effective scene (built-in defaults, --scene file, --set overrides) as TOML");
   AddSceneOptions(app, options.get());
   return {app, [options] { return Run(*options); }};
 }

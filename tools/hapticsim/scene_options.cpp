@@ -21,7 +21,8 @@ void AddSceneOptions(CLI::App* app, SceneOptions* options) {
       ->type_name("FILE.toml");
   app->add_option("--set", options->assignments,
                   "Override one scene key, repeatable (applied after --scene). Keys, with their "
-                  "defaults (the paper's scene):" + keys)
+                  "defaults (the paper's scene):" +
+                      keys)
       ->type_name("KEY=VALUE")
       ->take_all();
   app->add_flag("--json", options->json, "Print one JSON object on stdout (units in key names)");

@@ -1,12 +1,11 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 
-#include <nlohmann/json.hpp>
-
-#include "core/error.hpp"
 #include "core/async_regions.hpp"
+#include "core/error.hpp"
 #include "core/force_error.hpp"
 #include "core/realtime_schedule.hpp"
 #include "core/reference_trial.hpp"
@@ -34,8 +33,8 @@ void WriteCsv(const std::string& path, const TrialResult& result) {
   out.precision(10);
   out << "t_s,contact_ux_m,contact_uy_m,contact_uz_m,force_x_N,force_y_N,force_z_N\n";
   for (const ForceSample& s : result.samples) {
-    out << s.t_s << ',' << s.contact_displacement_m[0] << ',' << s.contact_displacement_m[1]
-        << ',' << s.contact_displacement_m[2] << ',' << s.feedback_force_n[0] << ','
+    out << s.t_s << ',' << s.contact_displacement_m[0] << ',' << s.contact_displacement_m[1] << ','
+        << s.contact_displacement_m[2] << ',' << s.feedback_force_n[0] << ','
         << s.feedback_force_n[1] << ',' << s.feedback_force_n[2] << '\n';
   }
   HAPTICSIM_THROW_UNLESS(out.good(), "writing " + path + " failed (disk full?)");
@@ -94,9 +93,8 @@ TrialResult RunAdaptive(const Scene& scene, bool allow_unstable, bool threads,
   const auto& p = regions.partition();
   report->deadlines.resize(static_cast<size_t>(regions.num_regions()));
   for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
-    report->regions.push_back({p.RegionName(r), p.num_nodes(r),
-                               p.num_elements(r), regions.schedule(r).substeps,
-                               regions.schedule(r).rate_hz,
+    report->regions.push_back({p.RegionName(r), p.num_nodes(r), p.num_elements(r),
+                               regions.schedule(r).substeps, regions.schedule(r).rate_hz,
                                regions.schedule(r).alone.critical_dt_s,
                                regions.compute_seconds(r) * 1e6 / simulated_ms});
   }
@@ -110,8 +108,9 @@ int Run(const SimulateOptions& options) {
   TrialOptions trial_options;
   trial_options.run_if_predicted_unstable = options.allow_unstable;
   if (options.threads && !adaptive) {
-    throw Error("--threads runs the asynchronous regions on real threads: set "
-                "adaptivity.primary_size >= 1 too");
+    throw Error(
+        "--threads runs the asynchronous regions on real threads: set "
+        "adaptivity.primary_size >= 1 too");
   }
   const TrialResult result =
       adaptive ? RunAdaptive(scene, options.allow_unstable, options.threads, &report)
@@ -129,10 +128,10 @@ int Run(const SimulateOptions& options) {
                   std::string(TrialOutcomeName(reference->outcome)) + "); lower solver.dt below " +
                   std::to_string(reference->stability.critical_dt_s) + " s");
     }
-    std::vector<ForceSample> matched(reference->samples.begin(),
-                                     reference->samples.begin() +
-                                         static_cast<long>(std::min(reference->samples.size(),
-                                                                    result.samples.size())));
+    std::vector<ForceSample> matched(
+        reference->samples.begin(),
+        reference->samples.begin() +
+            static_cast<long>(std::min(reference->samples.size(), result.samples.size())));
     error = CompareForces(result.samples, matched);
   }
 
@@ -144,8 +143,8 @@ int Run(const SimulateOptions& options) {
 
   double peak_time = 0;
   for (const ForceSample& s : result.samples) {
-    const double magnitude = std::hypot(s.feedback_force_n[0], s.feedback_force_n[1],
-                                        s.feedback_force_n[2]);
+    const double magnitude =
+        std::hypot(s.feedback_force_n[0], s.feedback_force_n[1], s.feedback_force_n[2]);
     if (magnitude == result.peak_force_n) peak_time = s.t_s;
   }
   const double simulated_ms = result.steps * scene.solver.dt_s * 1e3;
@@ -182,7 +181,8 @@ int Run(const SimulateOptions& options) {
                                   {"substeps", r.substeps},
                                   {"critical_dt_s", r.critical_dt_s},
                                   {"cost_us_per_simulated_ms", r.cost_us_per_ms}});
-        if (report.deadlines[i]) out["regions"][i]["deadlines"] = DeadlineJson(*report.deadlines[i]);
+        if (report.deadlines[i])
+          out["regions"][i]["deadlines"] = DeadlineJson(*report.deadlines[i]);
       }
       if (report.threaded_vs_virtual) {
         out["threaded_vs_virtual"] = ErrorJson(*report.threaded_vs_virtual);
@@ -200,8 +200,8 @@ int Run(const SimulateOptions& options) {
               << scene.mesh.nodes << "³-node cube, edge " << Quantity(scene.mesh.edge_m, "m")
               << "; " << WaveformName(scene.input.waveform) << " of "
               << Quantity(scene.input.amplitude_m, "m") << " at "
-              << Quantity(scene.input.frequency_hz, "Hz") << " for "
-              << Duration(scene.duration_s()) << ", dt " << Duration(scene.solver.dt_s) << "\n";
+              << Quantity(scene.input.frequency_hz, "Hz") << " for " << Duration(scene.duration_s())
+              << ", dt " << Duration(scene.solver.dt_s) << "\n";
     if (adaptive) {
       for (const RegionReport& r : report.regions) {
         std::cout << "  " << r.name << " region: " << r.nodes << " nodes, " << r.elements
@@ -225,7 +225,8 @@ int Run(const SimulateOptions& options) {
       std::cout << "  coupled stability: spectral radius "
                 << Quantity(report.coupled.spectral_radius, "") << "per common period of "
                 << Duration(report.coupled.common_period_s) << ": "
-                << (report.coupled.stable ? "stable" : "UNSTABLE (the linked regions grow)") << "\n";
+                << (report.coupled.stable ? "stable" : "UNSTABLE (the linked regions grow)")
+                << "\n";
     } else {
       std::cout << "  stability: critical dt " << Duration(result.stability.critical_dt_s)
                 << " (Lanczos on M⁻¹K), dt is "
@@ -242,8 +243,8 @@ int Run(const SimulateOptions& options) {
         std::cout << "  DIVERGED at t = " << Duration(result.stopped_at_s) << " ("
                   << TrialOutcomeName(result.outcome) << "); forces after that are not shown\n";
       }
-      std::cout << "  peak force on the user: " << Quantity(result.peak_force_n, "N") << " at t = "
-                << Duration(peak_time) << "\n";
+      std::cout << "  peak force on the user: " << Quantity(result.peak_force_n, "N")
+                << " at t = " << Duration(peak_time) << "\n";
       std::cout << "  " << result.steps << " steps in " << Duration(result.wall_time_s)
                 << " of compute (" << Quantity(cost_us_per_ms, "µs") << " per simulated ms)\n";
     }

@@ -1,6 +1,5 @@
 #include <cstdio>
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "core/async_regions.hpp"
@@ -41,14 +40,14 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     std::cout << "Stability of the asynchronous regions: " << scene.mesh.nodes << "³-node cube\n";
     for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
       const RegionSchedule& s = regions.schedule(r);
-      std::cout << "  " << p.RegionName(r) << ": own limit "
-                << Duration(s.alone.critical_dt_s) << " (boundary held), "
-                << Quantity(s.rate_hz, "Hz") << " × " << s.substeps << " substep(s) = step "
-                << Duration(1.0 / (s.rate_hz * s.substeps)) << ": stable alone\n";
+      std::cout << "  " << p.RegionName(r) << ": own limit " << Duration(s.alone.critical_dt_s)
+                << " (boundary held), " << Quantity(s.rate_hz, "Hz") << " × " << s.substeps
+                << " substep(s) = step " << Duration(1.0 / (s.rate_hz * s.substeps))
+                << ": stable alone\n";
     }
     std::cout << "  coupled: spectral radius of the " << Duration(coupled.common_period_s)
-              << " period map " << Quantity(coupled.spectral_radius, "") << "("
-              << coupled.periods << " periods of power iteration): "
+              << " period map " << Quantity(coupled.spectral_radius, "") << "(" << coupled.periods
+              << " periods of power iteration): "
               << (coupled.stable ? "stable" : "UNSTABLE — this configuration is refused") << "\n";
   }
   return kExitOk;
@@ -102,7 +101,9 @@ int RunAllConfigurations(const SceneOptions& options, const Scene& base) {
     }
   }
   if (options.json) {
-    std::cout << nlohmann::json{{"configurations", rows}, {"stable", stable_count}, {"total", total}}
+    std::cout << nlohmann::json{{"configurations", rows},
+                                {"stable", stable_count},
+                                {"total", total}}
                      .dump(2)
               << "\n";
   } else {
@@ -134,13 +135,14 @@ int Run(const SceneOptions& options, bool all_configurations) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << "Stability of central difference: " << scene.mesh.nodes << "³-node cube\n"
-              << "  critical dt (2/ω_max, Lanczos on M⁻¹K): "
-              << Duration(estimate.critical_dt_s) << "  (ω_max "
-              << Quantity(estimate.omega_max_rad_s, "rad/s") << ", " << estimate.iterations
-              << " iterations" << (estimate.converged ? "" : ", NOT converged") << ")\n"
+              << "  critical dt (2/ω_max, Lanczos on M⁻¹K): " << Duration(estimate.critical_dt_s)
+              << "  (ω_max " << Quantity(estimate.omega_max_rad_s, "rad/s") << ", "
+              << estimate.iterations << " iterations"
+              << (estimate.converged ? "" : ", NOT converged") << ")\n"
               << "  element-level bound (never above the limit): "
               << Duration(estimate.element_bound_dt_s) << "\n"
-              << "  dt = " << Duration(dt) << " is " << Quantity(100 * dt / estimate.critical_dt_s, "%")
+              << "  dt = " << Duration(dt) << " is "
+              << Quantity(100 * dt / estimate.critical_dt_s, "%")
               << " of the critical step: " << (stable ? "stable" : "UNSTABLE") << "\n";
   }
   return kExitOk;
@@ -156,9 +158,10 @@ Command AddStabilityCommand(CLI::App& parent) {
       "Critical time step of the scene and whether its solver.dt is below it; with adaptivity "
       "set, each region's limit and the coupled verdict");
   AddSceneOptions(app, options.get());
-  app->add_flag("--all-configurations", *all_configurations,
-                "Coupled verdict for every adaptive configuration of the paper's ranges "
-                "(primary size 1-4, spacing factor 1-3, secondary rate 1000-600 Hz); takes minutes");
+  app->add_flag(
+      "--all-configurations", *all_configurations,
+      "Coupled verdict for every adaptive configuration of the paper's ranges "
+      "(primary size 1-4, spacing factor 1-3, secondary rate 1000-600 Hz); takes minutes");
   return {app, [options, all_configurations] { return Run(*options, *all_configurations); }};
 }
 

@@ -1,5 +1,4 @@
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "core/cube_scene.hpp"
@@ -36,9 +35,9 @@ int Run(const SceneOptions& options) {
               << ", " << Quantity(r[1], "N") << ", " << Quantity(r[2], "N") << "]\n"
               << "  force on the user: " << Quantity(-r[2], "N") << " along z\n"
               << "  contact stiffness: " << Quantity(stiffness, "N/m") << "\n"
-              << "  conjugate gradients: " << solution.iterations << " iterations, relative residual "
-              << solution.relative_residual << (solution.converged ? "" : " (NOT converged)")
-              << "\n";
+              << "  conjugate gradients: " << solution.iterations
+              << " iterations, relative residual " << solution.relative_residual
+              << (solution.converged ? "" : " (NOT converged)") << "\n";
   }
   return solution.converged ? kExitOk : kExitInternalError;
 }
