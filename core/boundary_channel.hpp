@@ -48,9 +48,6 @@ class BoundaryChannel {
    */
   [[nodiscard]] bool TryReadLatestTwo(Snapshot* newer, Snapshot* older) const noexcept;
 
-  /** Number of snapshots published so far. */
-  std::uint64_t published() const { return published_.load(std::memory_order_acquire); }
-
   /** Forgets every snapshot (not thread-safe: only while no thread uses the channel). */
   void Clear();
   /** Multiplies every stored value (not thread-safe; for the spectral-radius estimate). */

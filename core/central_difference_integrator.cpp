@@ -31,7 +31,6 @@ void CentralDifferenceIntegrator::Reset() {
   energy_ = 0.0;
   energy_budget_start_ = -1.0;
   input_work_ = 0.0;
-  steps_ = 0;
 }
 
 void CentralDifferenceIntegrator::SetState(const Eigen::VectorXd& u,
@@ -80,7 +79,6 @@ StepStatus CentralDifferenceIntegrator::Step(std::span<const double> driven_next
   energy_ = 0.5 * kinetic_sum / (dt_ * dt_) + 0.5 * strain_sum;
   std::swap(u_previous_, u_);
   std::swap(u_, u_next_);
-  ++steps_;
 
   if (!std::isfinite(energy_) || !std::isfinite(input_work_)) return StepStatus::kNonFinite;
   if (energy_budget_start_ < 0) energy_budget_start_ = energy_;

@@ -62,13 +62,9 @@ class CentralDifferenceIntegrator {
   }
   /** ½|uₙ − uₙ₋₁|²_M/dt² + ½ uₙᵀ K uₙ at the start of the last step, J. */
   double energy() const { return energy_; }
-  /** Work the driven DOFs have done on the body so far, J (sum of positive increments). */
-  double input_work() const { return input_work_; }
   /** Current displacement uₙ (after the last step), m. */
   const Eigen::VectorXd& displacement() const { return *u_; }
-  const Eigen::VectorXd& previous_displacement() const { return *u_previous_; }
   double dt() const { return dt_; }
-  long steps_taken() const { return steps_; }
   const ElasticModel& model() const { return model_; }
 
  private:
@@ -86,7 +82,6 @@ class CentralDifferenceIntegrator {
   double energy_ = 0.0;
   double energy_budget_start_ = -1.0;  // energy at the first step after Reset/SetState
   double input_work_ = 0.0;
-  long steps_ = 0;
 };
 
 }  // namespace hapticsim

@@ -32,7 +32,6 @@ void RegionIntegrator::Reset() {
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
 }
 
-void RegionIntegrator::set_substep(double substep_s) { h_ = substep_s; }
 
 const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
   if (!ku_valid_) {

@@ -61,7 +61,6 @@ class RegionIntegrator {
   const std::vector<int>& prescribed() const { return prescribed_; }
   const std::vector<int>& loaded() const { return loaded_; }
   double substep() const { return h_; }
-  void set_substep(double substep_s);
 
   /** Overwrites the state (for free-decay runs and the spectral-radius estimate). */
   void SetState(const Eigen::VectorXd& u, const Eigen::VectorXd& u_previous);

@@ -54,7 +54,6 @@ class RegionPartition {
 
   /** The contact node's x, y, z DOFs (in the primary region). */
   const std::array<int, 3>& contact_dofs() const { return contact_dofs_; }
-  const std::vector<int>& fixed_dofs() const { return fixed_dofs_; }
 
   int num_elements(RegionIndex region) const;
   /** Independent nodes touched by the region's elements. */
