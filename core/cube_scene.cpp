@@ -24,11 +24,12 @@ DofConstraints CubeConstraints(const HexGrid& grid, int contact_node,
 CubeScene::CubeScene(const Scene& scene)
     : scene_(scene), contact_node_(0), fixed_nodes_{}, model_([&] {
         const HexGrid grid = CubeGrid(scene);
-        const int last = scene.mesh.nodes - 1;
-        const int middle = last / 2;
-        contact_node_ = grid.Node(middle, middle, 0);
-        fixed_nodes_ = {grid.Node(0, 0, last), grid.Node(last, 0, last), grid.Node(0, last, last),
-                        grid.Node(last, last, last)};
+        const LatticeIndex contact = CubeContactNode(scene.mesh);
+        contact_node_ = grid.Node(contact[0], contact[1], contact[2]);
+        const auto supports = CubeSupportNodes(scene.mesh);
+        for (size_t i = 0; i < supports.size(); ++i) {
+          fixed_nodes_[i] = grid.Node(supports[i][0], supports[i][1], supports[i][2]);
+        }
         return ElasticModel(grid, scene.material,
                             CubeConstraints(grid, contact_node_, fixed_nodes_));
       }()) {}

@@ -11,9 +11,8 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
   ValidateScene(scene);
   HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
                          "asynchronous regions need adaptivity.primary_size >= 1");
-  const int n = scene.mesh.nodes, last = n - 1, middle = last / 2,
-            r = scene.adaptivity.primary_size;
-  const std::array<int, 3> contact{middle, middle, 0};
+  const int n = scene.mesh.nodes, last = n - 1, r = scene.adaptivity.primary_size;
+  const LatticeIndex contact = CubeContactNode(scene.mesh);
 
   HybridMesh::Options options;
   options.nodes_per_axis = n;
@@ -23,7 +22,8 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
     options.primary_lo[a] = std::max(0, contact[a] - r);
     options.primary_hi[a] = std::min(last, contact[a] + r);
   }
-  options.supports = {{0, 0, last}, {last, 0, last}, {0, last, last}, {last, last, last}};
+  const auto supports = CubeSupportNodes(scene.mesh);
+  options.supports.assign(supports.begin(), supports.end());
   options.support_layers = scene.adaptivity.support_layers;
   options.secondary_regions = scene.adaptivity.secondary_regions;
   options.shell_cells = scene.adaptivity.shell_cells;

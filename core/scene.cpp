@@ -292,13 +292,22 @@ void ValidateScene(const Scene& scene) {
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 
+LatticeIndex CubeContactNode(const MeshSettings& mesh) {
+  const int middle = (mesh.nodes - 1) / 2;
+  return {middle, middle, 0};
+}
+
+std::array<LatticeIndex, 4> CubeSupportNodes(const MeshSettings& mesh) {
+  const int last = mesh.nodes - 1;
+  return {LatticeIndex{0, 0, last}, LatticeIndex{last, 0, last}, LatticeIndex{0, last, last},
+          LatticeIndex{last, last, last}};
+}
+
 double PrimaryRateHz(const Scene& scene) { return 1.0 / scene.solver.dt_s; }
 
 bool PrimaryBoxCoversObject(const Scene& scene, int primary_size) {
   const int n = scene.mesh.nodes, k = scene.adaptivity.secondary_lod;
-  const int middle = (n - 1) / 2;
-  const std::array<int, 3> contact{middle, middle, 0};
-  for (int c : contact) {
+  for (int c : CubeContactNode(scene.mesh)) {
     const int lo = std::max(0, c - primary_size), hi = std::min(n - 1, c + primary_size);
     // Every coarse cell [jk, (j+1)k] overlaps (lo, hi) only if the first and last do.
     if (!(lo < k && hi > (n - 1) - k)) return false;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -101,6 +102,18 @@ std::string GetSceneValue(const Scene& scene, std::string_view key);
  * @throws Error with one message naming the key and its allowed range.
  */
 void ValidateScene(const Scene& scene);
+
+/** Lattice indices (ix, iy, iz) of a node of the cube. */
+using LatticeIndex = std::array<int, 3>;
+
+/**
+ * The paper's contact: the middle node of the front face (z = 0); with an even node count, the
+ * one just below the centre in x and y. The one definition every model of the cube uses.
+ */
+LatticeIndex CubeContactNode(const MeshSettings& mesh);
+
+/** The paper's supports: the four corner nodes of the back face (z = edge). */
+std::array<LatticeIndex, 4> CubeSupportNodes(const MeshSettings& mesh);
 
 /** The primary region's rate 1/solver.dt, Hz. */
 double PrimaryRateHz(const Scene& scene);
