@@ -332,14 +332,28 @@ double AsyncRegions::Energy() noexcept {
   return KineticEnergy() + 0.5 * strain;
 }
 
-TrialResult AsyncRegions::RunTrial() {
-  const Scene& scene = partition_.scene();
+TrialResult AsyncRegions::RunTrial() { return RunTrial(partition_.scene().input); }
+
+RegionIndex AsyncRegions::LargestStateRegion() const {
+  RegionIndex largest = kPrimaryRegion;
+  double largest_size = -1;
+  for (int r = 0; r < num_regions(); ++r) {
+    const double size = regions_[r]->integrator->OwnedStateNormSquared();
+    if (!std::isfinite(size)) return r;
+    if (size > largest_size) largest = r, largest_size = size;
+  }
+  return largest;
+}
+
+TrialResult AsyncRegions::RunTrial(const InputSettings& input) {
   TrialResult result;
   result.stability = regions_[kPrimaryRegion]->schedule.alone;
   Reset();
-  const ContactTrajectory trajectory(scene.input);
+  const ContactTrajectory trajectory(input);
   const double dt = 1.0 / regions_[kPrimaryRegion]->schedule.rate_hz;
-  const long steps = scene.num_steps();
+  // As Scene::num_steps(), so a trial of the scene's own input matches the reference's length.
+  const long steps =
+      std::lround(input.periods / input.frequency_hz / partition_.scene().solver.dt_s);
   result.samples.reserve(static_cast<size_t>(steps) + 1);
   const double budget = Energy();  // 0 from rest
   double work = 0;

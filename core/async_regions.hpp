@@ -112,6 +112,11 @@ class AsyncRegions {
 
   /** A trial of the scene's input on the virtual-time schedule. */
   TrialResult RunTrial();
+  /** A trial of another input on the same regions (the sweep reuses one set per configuration). */
+  TrialResult RunTrial(const InputSettings& input);
+
+  /** The region whose state is largest (or non-finite): where a divergence grew. */
+  RegionIndex LargestStateRegion() const;
 
   /** Spectral radius of the one-common-period map by power iteration from a random state. */
   CoupledStability EstimateCoupledStability(int burn_in_periods = 600, int window_periods = 300);

@@ -19,15 +19,6 @@ struct KeyAccess {
   std::function<void(Scene*, std::string_view)> set;
 };
 
-// The shortest text that reads back to exactly `value`.
-std::string FormatReal(double value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  std::string text(buffer, result.ptr);
-  // Keep reals recognisable as reals in TOML ("10000.0", not "10000").
-  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
-  return text;
-}
 
 [[noreturn]] void Reject(std::string_view key, std::string_view value, std::string_view allowed,
                          std::string_view unit) {
@@ -247,6 +238,15 @@ void ValidateAdaptivity(const Scene& scene) {
 }
 
 }  // namespace
+
+std::string FormatReal(double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
+  // Keep reals recognisable as reals in TOML ("10000.0", not "10000").
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  return text;
+}
 
 long Scene::num_steps() const { return std::lround(duration_s() / solver.dt_s); }
 

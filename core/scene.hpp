@@ -73,6 +73,9 @@ struct Scene {
 
 std::string_view WaveformName(Waveform waveform);
 
+/** The shortest text that reads back to exactly `value` ("10000.0", "0.45", "1e-05"). */
+std::string FormatReal(double value);
+
 /**
  * One settable scene key ("section.key"). The table of keys is the single source of truth for
  * scene files, --set overrides, printing and validation.

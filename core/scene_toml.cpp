@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <charconv>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -30,10 +31,19 @@ std::string ValueText(const toml::node& node, const std::string& key, const std:
 
 }  // namespace
 
-Scene LoadSceneFile(const std::string& path) {
+// Reads `text` when given, else the file at `path` (which names the source in messages).
+Scene ParseScene(const std::string& path, const std::optional<std::string>& text);
+
+Scene LoadSceneFile(const std::string& path) { return ParseScene(path, std::nullopt); }
+
+Scene ParseSceneText(const std::string& text, const std::string& origin) {
+  return ParseScene(origin, text);
+}
+
+Scene ParseScene(const std::string& path, const std::optional<std::string>& text) {
   toml::table document;
   try {
-    document = toml::parse_file(path);
+    document = text ? toml::parse(*text, path) : toml::parse_file(path);
   } catch (const toml::parse_error& error) {
     const std::string description(error.description());
     if (error.source().begin.line == 0) {

@@ -16,6 +16,9 @@ namespace hapticsim {
  */
 Scene LoadSceneFile(const std::string& path);
 
+/** As LoadSceneFile, from text (e.g. the scene recorded in an error map); `origin` names it. */
+Scene ParseSceneText(const std::string& text, const std::string& origin);
+
 /**
  * Applies "section.key=value" overrides in order (the --set option).
  * @throws Error naming the key, as SetSceneValue does, or the malformed assignment.

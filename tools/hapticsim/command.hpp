@@ -23,5 +23,8 @@ Command AddSimulateCommand(CLI::App& parent);
 Command AddStaticCommand(CLI::App& parent);
 Command AddStabilityCommand(CLI::App& parent);
 Command AddSceneCommand(CLI::App& parent);
+Command AddSweepCommand(CLI::App& parent);
+Command AddMapCommand(CLI::App& parent);
+Command AddLookupCommand(CLI::App& parent);
 
 }  // namespace hapticsim::cli

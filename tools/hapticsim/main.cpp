@@ -4,6 +4,9 @@
 //   hapticsim static                                             static contact reaction
 //   hapticsim stability                                          critical time step
 //   hapticsim scene                                              the effective scene as TOML
+//   hapticsim sweep [--grid paper|quick|scene|FILE] [--out MAP]  make an error map
+//   hapticsim map info|export|merge                              inspect and join map files
+//   hapticsim lookup MAP --set key=value                         the run-time error lookup
 //
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
 // 1 anything else.
@@ -23,7 +26,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every subcommand");
   const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
-                                      AddStabilityCommand(app), AddSceneCommand(app)};
+                                      AddStabilityCommand(app), AddSceneCommand(app),
+                                      AddSweepCommand(app), AddMapCommand(app),
+                                      AddLookupCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

@@ -1,0 +1,47 @@
+#include "core/sweep_grid_file.hpp"
+
+#include <toml++/toml.h>
+
+#include "core/error.hpp"
+
+namespace hapticsim {
+
+SweepGrid LoadGridFile(const std::string& path, const MapPoint& base) {
+  toml::table file;
+  try {
+    file = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    const auto& where = e.source().begin;
+    throw Error("grid file " + path + ":" + std::to_string(where.line) + ": " +
+                std::string(e.description()));
+  }
+  SweepGrid grid;
+  grid.name = path;
+  for (int a = 0; a < kNumMapAxes; ++a) grid.axes[a] = {base[a]};
+  const toml::table* axes = file["axes"].as_table();
+  HAPTICSIM_THROW_UNLESS(axes, "grid file " + path + " has no [axes] table of value lists");
+  for (const auto& [key, node] : *axes) {
+    const std::string name(key.str());
+    const int axis = FindAxis(name);
+    const std::string where = "grid file " + path + ":" + std::to_string(key.source().begin.line);
+    if (axis < 0) {
+      std::string known;
+      for (int a = 0; a < kNumMapAxes; ++a) known += " " + std::string(AxisInfo(a).name);
+      throw Error(where + ": '" + name + "' is not a map axis; axes are" + known);
+    }
+    const toml::array* list = node.as_array();
+    HAPTICSIM_THROW_UNLESS(list && !list->empty(),
+                           where + ": " + name + " must be a non-empty list of numbers");
+    std::vector<double> values;
+    for (const toml::node& element : *list) {
+      const auto value = element.value<double>();
+      HAPTICSIM_THROW_UNLESS(value.has_value(), where + ": " + name + " holds a non-number");
+      values.push_back(*value);
+    }
+    grid.axes[axis] = values;
+  }
+  ValidateGrid(grid);
+  return grid;
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,105 @@
+#include "core/error_map_file.hpp"
+
+#include "core/error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace hapticsim {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("hapticsim_" + name)).string();
+}
+
+ErrorMap ExampleMap() {
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  for (auto& axis : axes) axis = {1.0};
+  axes[0] = {0.40, 0.49};
+  axes[7] = {1, 2, 3};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  map.provenance.scene_toml = "[mesh]\nnodes = 13\n";
+  map.provenance.model = "test model";
+  map.provenance.code_version = "test";
+  map.provenance.grid = "test";
+  for (size_t i = 0; i < map.samples.size(); ++i) {
+    MapSample& s = map.samples[i];
+    s.status = i == 4 ? SampleStatus::kPredictedUnstable : SampleStatus::kOk;
+    s.status_region = i == 4 ? kCouplingRegion : kNoRegion;
+    s.l2_percent = i == 4 ? NAN : 1.5 * i;
+    s.max_magnitude_percent = 0.25 * i;
+    s.max_direction_deg = 0.125 * i;
+    s.reference_peak_n = 0.8 + i;
+    s.spectral_radius = 0.99;
+    s.cost_us_per_ms = {10.0 + i, 20.0, 0, 0};
+  }
+  return map;
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+void WriteAll(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::string LoadError(const std::string& path, MapLoadParts parts = MapLoadParts::kEverything) {
+  try {
+    LoadErrorMap(path, parts);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ErrorMapFile, RoundTripKeepsEveryField) {
+  const std::string path = TempPath("roundtrip.hsmap");
+  const ErrorMap map = ExampleMap();
+  SaveErrorMap(map, path);
+  const ErrorMap back = LoadErrorMap(path);
+  EXPECT_EQ(back.axes, map.axes);
+  EXPECT_EQ(back.provenance.scene_toml, map.provenance.scene_toml);
+  EXPECT_EQ(back.ResultsChecksum(), map.ResultsChecksum());
+  ASSERT_EQ(back.samples.size(), map.samples.size());
+  EXPECT_TRUE(std::isnan(back.samples[4].l2_percent));
+  EXPECT_EQ(back.samples[4].status_region, kCouplingRegion);
+  EXPECT_EQ(back.samples[3].cost_us_per_ms, map.samples[3].cost_us_per_ms);
+  std::filesystem::remove(path);
+}
+
+TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSayingWhich) {
+  const std::string path = TempPath("damaged.hsmap");
+  SaveErrorMap(ExampleMap(), path);
+  const std::string good = ReadAll(path);
+
+  WriteAll(path, good.substr(0, good.size() - 10));
+  EXPECT_NE(LoadError(path).find("truncated"), std::string::npos) << LoadError(path);
+  WriteAll(path, good.substr(0, 20));
+  EXPECT_NE(LoadError(path).find("truncated"), std::string::npos) << LoadError(path);
+
+  std::string flipped = good;
+  flipped[good.size() - 30] ^= 0x40;  // inside the last section, "details"
+  WriteAll(path, flipped);
+  EXPECT_NE(LoadError(path).find("corrupted: checksum of section 'details'"), std::string::npos)
+      << LoadError(path);
+  // The daemon reads only the lookup tables: damage elsewhere does not stop it.
+  EXPECT_EQ(LoadError(path, MapLoadParts::kLookupOnly), "");
+
+  std::string version = good;
+  version[8] = 7;
+  WriteAll(path, version);
+  EXPECT_NE(LoadError(path).find("wrong format version 7"), std::string::npos) << LoadError(path);
+
+  WriteAll(path, "[mesh]\nnodes = 13\n# a scene file, not a map\n");
+  EXPECT_NE(LoadError(path).find("not an error map"), std::string::npos) << LoadError(path);
+
+  EXPECT_NE(LoadError(TempPath("does-not-exist.hsmap")).find("cannot open"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace hapticsim

@@ -1,0 +1,174 @@
+#include "core/error_sweep.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "core/async_regions.hpp"
+#include "core/error_map_file.hpp"
+
+#include "core/error.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr int kDamping = 2, kAmplitude = 4, kSize = 7, kRate = 8;
+
+// A 9³ cube and a grid small enough to sweep several times per test, still with two values on
+// the axes each shortcut works on: amplitude (linearity), primary size 1 and 2 (the same regions
+// at spacing factor 2) and rate.
+Scene SmallScene() {
+  Scene scene;
+  scene.mesh.nodes = 9;
+  scene.input.frequency_hz = 2.0;
+  return scene;
+}
+
+SweepGrid SmallGrid() {
+  SweepGrid grid;
+  grid.name = "test";
+  const MapPoint base = PointOfScene(SmallScene());
+  for (int a = 0; a < kNumMapAxes; ++a) grid.axes[a] = {base[a]};
+  grid.axes[kDamping] = {10, 30};
+  grid.axes[kAmplitude] = {0.005, 0.01};
+  grid.axes[6] = {2};
+  grid.axes[kSize] = {1, 2};
+  grid.axes[kRate] = {600, 1000};
+  return grid;
+}
+
+ErrorMap Sweep(const SweepGrid& grid, SweepOptions options = {}, SweepStats* stats = nullptr) {
+  SweepStats local;
+  return RunSweep(SmallScene(), grid, options, stats ? stats : &local);
+}
+
+TEST(ErrorSweep, EverySampleIsComputedAndTheResultDoesNotDependOnTheJobCount) {
+  SweepOptions one, two;
+  two.jobs = 2;
+  const ErrorMap a = Sweep(SmallGrid(), one), b = Sweep(SmallGrid(), two);
+  EXPECT_EQ(a.samples.size(), 16u);
+  EXPECT_EQ(a.CountStatus(SampleStatus::kNotComputed), 0u);
+  EXPECT_EQ(a.ResultsChecksum(), b.ResultsChecksum());
+  for (const MapSample& s : a.samples) {
+    if (s.status != SampleStatus::kOk) continue;
+    EXPECT_GT(s.reference_peak_n, 0);
+    EXPECT_GT(s.cost_us_per_ms[0], 0);  // the primary region was timed
+    EXPECT_TRUE(std::isfinite(s.l2_percent));
+  }
+}
+
+TEST(ErrorSweep, EqualRatesAtFullResolutionReproduceTheReference) {
+  SweepGrid grid = SmallGrid();
+  grid.axes[6] = {1};
+  grid.axes[kRate] = {1000};
+  const ErrorMap map = Sweep(grid);
+  for (const MapSample& s : map.samples) {
+    ASSERT_EQ(s.status, SampleStatus::kOk);
+    EXPECT_LT(s.l2_percent, 1e-6);  // monolithic central difference: round-off only
+  }
+}
+
+TEST(ErrorSweep, AmplitudeFromLinearityMatchesRunningEveryAmplitude) {
+  SweepOptions derived, run_all;
+  run_all.use_linearity = false;
+  SweepStats derived_stats, run_all_stats;
+  const ErrorMap a = Sweep(SmallGrid(), derived, &derived_stats);
+  const ErrorMap b = Sweep(SmallGrid(), run_all, &run_all_stats);
+  EXPECT_TRUE(a.provenance.linearity_used);
+  EXPECT_FALSE(b.provenance.linearity_used);
+  EXPECT_GT(derived_stats.saved_by_linearity, 0u);
+  EXPECT_EQ(run_all_stats.saved_by_linearity, 0u);
+  EXPECT_EQ(run_all_stats.adaptive_trials, 2 * derived_stats.adaptive_trials);
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    const MapSample &x = a.samples[i], &y = b.samples[i];
+    ASSERT_EQ(x.status, y.status);
+    if (x.status != SampleStatus::kOk) continue;
+    EXPECT_NEAR(x.l2_percent, y.l2_percent, 1e-9 * y.l2_percent + 1e-12);
+    EXPECT_NEAR(x.max_magnitude_percent, y.max_magnitude_percent,
+                1e-9 * y.max_magnitude_percent + 1e-12);
+    EXPECT_NEAR(x.reference_peak_n, y.reference_peak_n, 1e-12 * y.reference_peak_n);
+  }
+}
+
+TEST(ErrorSweep, SizesGivingTheSameRegionsAreRunOnceWithTheSameAnswer) {
+  SweepStats stats;
+  const ErrorMap both = Sweep(SmallGrid(), {}, &stats);
+  EXPECT_GT(stats.saved_by_same_regions, 0u);  // sizes 1 and 2 round to the same coarse cells
+  SweepGrid only_two = SmallGrid();
+  only_two.axes[kSize] = {2};
+  const ErrorMap alone = Sweep(only_two);
+  for (const MapSample& s : alone.samples) {
+    const auto match = std::find_if(both.samples.begin(), both.samples.end(),
+                                    [&](const MapSample& t) { return t.point == s.point; });
+    ASSERT_NE(match, both.samples.end());
+    EXPECT_EQ(match->status, s.status);
+    if (s.status == SampleStatus::kOk) {
+      EXPECT_EQ(match->l2_percent, s.l2_percent);
+    }
+  }
+}
+
+TEST(ErrorSweep, ShardsMergeIntoTheWholeMap) {
+  const ErrorMap whole = Sweep(SmallGrid());
+  std::vector<ErrorMap> shards;
+  for (int i = 0; i < 3; ++i) {
+    SweepOptions options;
+    options.shard_index = i;
+    options.shard_count = 3;
+    shards.push_back(Sweep(SmallGrid(), options));
+    EXPECT_GT(shards.back().CountStatus(SampleStatus::kNotComputed), 0u);
+  }
+  const ErrorMap merged = MergeErrorMaps(shards);
+  EXPECT_EQ(merged.CountStatus(SampleStatus::kNotComputed), 0u);
+  EXPECT_EQ(merged.ResultsChecksum(), whole.ResultsChecksum());
+  EXPECT_EQ(merged.provenance.shard, "1/1");
+  shards[1].provenance.scene_toml += "# another scene\n";
+  EXPECT_THROW(MergeErrorMaps(shards), Error);
+}
+
+TEST(ErrorSweep, AResumedSweepSkipsJournalledTasksAndEndsWithTheSameMap) {
+  const std::string journal =
+      (std::filesystem::temp_directory_path() / "hapticsim_sweep_test.journal").string();
+  SweepOptions options;
+  options.journal_path = journal;
+  const ErrorMap whole = Sweep(SmallGrid(), options);
+  // Keep the header and two tasks, and tear the third line as a crash mid-write would.
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(journal);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  ASSERT_GE(lines.size(), 4u);
+  {
+    std::ofstream out(journal, std::ios::trunc);
+    out << lines[0] << "\n" << lines[1] << "\n" << lines[2] << "\n"
+        << lines[3].substr(0, lines[3].size() / 2);
+  }
+  options.resume = true;
+  SweepStats stats;
+  const ErrorMap resumed = Sweep(SmallGrid(), options, &stats);
+  EXPECT_GT(stats.samples_resumed, 0u);
+  EXPECT_LT(stats.samples_resumed, stats.samples);
+  EXPECT_EQ(resumed.ResultsChecksum(), whole.ResultsChecksum());
+
+  // A journal of another sweep is refused, not mixed in.
+  SweepGrid other = SmallGrid();
+  other.axes[kRate] = {700, 1000};
+  EXPECT_THROW(Sweep(other, options), Error);
+  std::filesystem::remove(journal);
+}
+
+TEST(ErrorSweep, AStopRequestEndsTheSweepWithoutComputingMore) {
+  std::atomic<bool> stop{true};
+  SweepOptions options;
+  options.stop = &stop;
+  SweepStats stats;
+  const ErrorMap map = Sweep(SmallGrid(), options, &stats);
+  EXPECT_TRUE(stats.interrupted);
+  EXPECT_EQ(map.CountStatus(SampleStatus::kNotComputed), map.samples.size());
+}
+
+}  // namespace
+}  // namespace hapticsim
