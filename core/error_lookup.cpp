@@ -15,26 +15,51 @@ LookupQuery LookupQuery::At(const MapPoint& point) {
   return query;
 }
 
-ErrorLookup::ErrorLookup(const ErrorMap& map, ErrorField field) : field_(field), axes_(map.axes) {
+namespace {
+
+std::vector<double> FieldValues(const ErrorMap& map, ErrorField field) {
   HAPTICSIM_THROW_UNLESS(map.grid,
                          "a scattered (Monte Carlo) map cannot be looked up: make a grid map");
+  std::vector<double> values;
+  values.reserve(map.samples.size());
+  for (const MapSample& sample : map.samples) values.push_back(FieldOf(sample, field));
+  return values;
+}
+
+std::vector<std::uint8_t> Statuses(const ErrorMap& map) {
+  std::vector<std::uint8_t> statuses;
+  statuses.reserve(map.samples.size());
+  for (const MapSample& sample : map.samples) {
+    statuses.push_back(static_cast<std::uint8_t>(sample.status));
+  }
+  return statuses;
+}
+
+}  // namespace
+
+ErrorLookup::ErrorLookup(const ErrorMap& map, ErrorField field)
+    : ErrorLookup(map.axes, FieldValues(map, field), Statuses(map), field) {}
+
+ErrorLookup::ErrorLookup(const std::array<std::vector<double>, kNumMapAxes>& axes,
+                         std::vector<double> values, std::vector<std::uint8_t> statuses,
+                         ErrorField field)
+    : field_(field), axes_(axes), value_(std::move(values)), status_(std::move(statuses)) {
   for (int a = 0; a < kNumMapAxes; ++a) {
     HAPTICSIM_THROW_UNLESS(
         !axes_[a].empty() && axes_[a].size() <= kMaxAxisValues,
         std::string(AxisInfo(a).scene_key) + ": a lookup axis needs 1 to 64 values");
+    for (size_t i = 1; i < axes_[a].size(); ++i) {
+      HAPTICSIM_THROW_UNLESS(axes_[a][i] > axes_[a][i - 1],
+                             std::string(AxisInfo(a).scene_key) + ": axis values must increase");
+    }
   }
   std::size_t stride = 1;
   for (int a = kNumMapAxes - 1; a >= 0; --a) {
     stride_[a] = stride;
     stride *= axes_[a].size();
   }
-  HAPTICSIM_THROW_UNLESS(stride == map.samples.size(), "map samples do not match its axes");
-  value_.reserve(stride);
-  status_.reserve(stride);
-  for (const MapSample& sample : map.samples) {
-    value_.push_back(FieldOf(sample, field));
-    status_.push_back(static_cast<std::uint8_t>(sample.status));
-  }
+  HAPTICSIM_THROW_UNLESS(stride == value_.size() && stride == status_.size(),
+                         "map samples do not match its axes");
 }
 
 double ErrorLookup::Interpolate(const MapPoint& point, LookupResult* result) const noexcept {

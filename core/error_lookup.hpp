@@ -48,6 +48,9 @@ class ErrorLookup {
 
   /** @throws Error for a scattered map or an axis longer than kMaxAxisValues. */
   ErrorLookup(const ErrorMap& map, ErrorField field);
+  /** From a grid's axes, the field per grid point and each point's SampleStatus (row-major). */
+  ErrorLookup(const std::array<std::vector<double>, kNumMapAxes>& axes, std::vector<double> values,
+              std::vector<std::uint8_t> statuses, ErrorField field);
 
   LookupResult Lookup(const LookupQuery& query) const noexcept;
 

@@ -141,67 +141,95 @@ void SaveErrorMap(const ErrorMap& map, const std::string& path) {
   HAPTICSIM_THROW_UNLESS(!ec, "cannot rename " + temporary + " to " + path + ": " + ec.message());
 }
 
-ErrorMap LoadErrorMap(const std::string& path, MapLoadParts parts) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open error map " + path + ": " + std::strerror(errno));
-  in.seekg(0, std::ios::end);
-  const auto file_size = static_cast<std::uint64_t>(in.tellg());
-  auto read_range = [&](std::uint64_t offset, std::uint64_t size) {
-    std::string bytes(size, '\0');
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(bytes.data(), static_cast<std::streamsize>(size));
-    if (!in) Refuse(path, "truncated (cannot read bytes " + std::to_string(offset) + "…)");
+namespace {
+
+// Opens a map file and checks its header and directory; reads and checks sections on demand.
+class MapFileReader {
+ public:
+  explicit MapFileReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+    Open();
+  }
+  const std::string& path() const { return path_; }
+
+  std::string Section(const std::string& name) {
+    const auto it = entries_.find(name);
+    if (it == entries_.end()) Refuse(path_, "section '" + name + "' is missing");
+    const Entry& e = it->second;
+    if (e.offset + e.size > file_size_ || e.offset + e.size < e.offset) {
+      Refuse(path_, "truncated: section '" + name + "' ends at byte " +
+                        std::to_string(e.offset + e.size) + ", the file has " +
+                        std::to_string(file_size_));
+    }
+    std::string bytes = ReadRange(e.offset, e.size);
+    if (Checksum(bytes) != e.checksum) {
+      Refuse(path_, "corrupted: checksum of section '" + name + "'");
+    }
     return bytes;
-  };
-  if (file_size < sizeof kMagic) Refuse(path, "truncated: too short to be an error map");
-  const std::string header = read_range(0, std::min<std::uint64_t>(file_size, kHeaderBytes));
-  if (std::memcmp(header.data(), kMagic, sizeof kMagic) != 0) {
-    Refuse(path, "not an error map file (no HSIMMAP signature)");
   }
-  if (file_size < kHeaderBytes) Refuse(path, "truncated inside the header");
-  const auto version = Read<std::uint32_t>(header, 8);
-  if (version != kErrorMapFormatVersion) {
-    Refuse(path, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
-                     std::to_string(kErrorMapFormatVersion) +
-                     " (remake it with hapticsim sweep)");
-  }
-  const auto count = Read<std::uint32_t>(header, 12);
-  if (count > 64) Refuse(path, "corrupted: " + std::to_string(count) + " sections");
-  if (kHeaderBytes + count * kEntryBytes > file_size) Refuse(path, "truncated inside the directory");
-  const std::string directory = read_range(kHeaderBytes, count * kEntryBytes);
-  if (Checksum(directory) != Read<std::uint64_t>(header, 16)) {
-    Refuse(path, "corrupted: directory checksum mismatch");
-  }
+
+ private:
   struct Entry {
     std::uint64_t offset, size, checksum;
   };
-  std::map<std::string, Entry> entries;
-  for (size_t i = 0; i < count; ++i) {
-    const size_t at = i * kEntryBytes;
-    std::string name(directory.data() + at, kNameBytes);
-    name.resize(std::strlen(name.c_str()));
-    entries[name] = {Read<std::uint64_t>(directory, at + kNameBytes),
-                     Read<std::uint64_t>(directory, at + kNameBytes + 8),
-                     Read<std::uint64_t>(directory, at + kNameBytes + 16)};
-  }
-  auto section = [&](const std::string& name) {
-    const auto it = entries.find(name);
-    if (it == entries.end()) Refuse(path, "section '" + name + "' is missing");
-    const Entry& e = it->second;
-    if (e.offset + e.size > file_size || e.offset + e.size < e.offset) {
-      Refuse(path, "truncated: section '" + name + "' ends at byte " +
-                       std::to_string(e.offset + e.size) + ", the file has " +
-                       std::to_string(file_size));
-    }
-    std::string bytes = read_range(e.offset, e.size);
-    if (Checksum(bytes) != e.checksum) Refuse(path, "corrupted: checksum of section '" + name + "'");
-    return bytes;
-  };
 
-  ErrorMap map;
-  Json meta;
+  std::string ReadRange(std::uint64_t offset, std::uint64_t size) {
+    std::string bytes(size, '\0');
+    in_.seekg(static_cast<std::streamoff>(offset));
+    in_.read(bytes.data(), static_cast<std::streamsize>(size));
+    if (!in_) Refuse(path_, "truncated (cannot read bytes " + std::to_string(offset) + "…)");
+    return bytes;
+  }
+
+  void Open() {
+    const std::string& path = path_;
+    auto& in = in_;
+    if (!in) throw Error("cannot open error map " + path + ": " + std::strerror(errno));
+    in.seekg(0, std::ios::end);
+    file_size_ = static_cast<std::uint64_t>(in.tellg());
+    const std::uint64_t file_size = file_size_;
+    if (file_size < sizeof kMagic) Refuse(path, "truncated: too short to be an error map");
+    const std::string header = ReadRange(0, std::min<std::uint64_t>(file_size, kHeaderBytes));
+    if (std::memcmp(header.data(), kMagic, sizeof kMagic) != 0) {
+      Refuse(path, "not an error map file (no HSIMMAP signature)");
+    }
+    if (file_size < kHeaderBytes) Refuse(path, "truncated inside the header");
+    const auto version = Read<std::uint32_t>(header, 8);
+    if (version != kErrorMapFormatVersion) {
+      Refuse(path, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
+                       std::to_string(kErrorMapFormatVersion) +
+                       " (remake it with hapticsim sweep)");
+    }
+    const auto count = Read<std::uint32_t>(header, 12);
+    if (count > 64) Refuse(path, "corrupted: " + std::to_string(count) + " sections");
+    if (kHeaderBytes + count * kEntryBytes > file_size) Refuse(path, "truncated inside the directory");
+    const std::string directory = ReadRange(kHeaderBytes, count * kEntryBytes);
+    if (Checksum(directory) != Read<std::uint64_t>(header, 16)) {
+      Refuse(path, "corrupted: directory checksum mismatch");
+    }
+    for (size_t i = 0; i < count; ++i) {
+      const size_t at = i * kEntryBytes;
+      std::string name(directory.data() + at, kNameBytes);
+      name.resize(std::strlen(name.c_str()));
+      entries_[name] = {Read<std::uint64_t>(directory, at + kNameBytes),
+                       Read<std::uint64_t>(directory, at + kNameBytes + 8),
+                       Read<std::uint64_t>(directory, at + kNameBytes + 16)};
+    }
+  }
+
+  std::string path_;
+  std::ifstream in_;
+  std::uint64_t file_size_ = 0;
+  std::map<std::string, Entry> entries_;
+};
+
+}  // namespace
+
+// Reads the metadata into `map` (provenance, kind, axes; no samples). Returns the sample count.
+std::uint64_t ReadMeta(MapFileReader& reader, ErrorMap* out) {
+  const std::string& path = reader.path();
+  ErrorMap& map = *out;
   try {
-    meta = Json::parse(section("meta"));
+    const Json meta = Json::parse(reader.Section("meta"));
     map.grid = meta.at("kind").get<std::string>() == "grid";
     auto& p = map.provenance;
     p.scene_toml = meta.at("scene_toml").get<std::string>();
@@ -213,19 +241,31 @@ ErrorMap LoadErrorMap(const std::string& path, MapLoadParts parts) {
     p.linearity_used = meta.at("linearity_used").get<bool>();
     const auto& axes = meta.at("axes");
     if (axes.size() != kNumMapAxes) Refuse(path, "corrupted: wrong number of axes");
+    std::uint64_t grid_size = 1;
     for (int a = 0; a < kNumMapAxes; ++a) {
       if (axes[a].at("name").get<std::string>() != AxisInfo(a).name) {
         Refuse(path, "axis " + std::to_string(a) + " is not " + std::string(AxisInfo(a).name));
       }
-      if (map.grid) map.axes[a] = axes[a].at("values").get<std::vector<double>>();
+      if (map.grid) {
+        map.axes[a] = axes[a].at("values").get<std::vector<double>>();
+        grid_size *= map.axes[a].size();
+      }
     }
+    const auto n = meta.at("samples").get<std::uint64_t>();
+    if (map.grid && n != grid_size) Refuse(path, "corrupted: sample count differs from the axes");
+    return n;
   } catch (const Json::exception& e) {
     Refuse(path, std::string("corrupted metadata: ") + e.what());
   }
-  const auto n = meta.at("samples").get<std::uint64_t>();
+}
+
+ErrorMap LoadErrorMap(const std::string& path, MapLoadParts parts) {
+  MapFileReader reader(path);
+  auto section = [&reader](const std::string& name) { return reader.Section(name); };
+  ErrorMap map;
+  const std::uint64_t n = ReadMeta(reader, &map);
   if (map.grid) {
     ErrorMap grid = ErrorMap::MakeGrid(map.axes);
-    if (grid.samples.size() != n) Refuse(path, "corrupted: sample count differs from the axes");
     map.samples = std::move(grid.samples);
   } else {
     if (parts == MapLoadParts::kLookupOnly) {
@@ -273,6 +313,30 @@ ErrorMap LoadErrorMap(const std::string& path, MapLoadParts parts) {
     }
   }
   return map;
+}
+
+ErrorLookup LoadErrorLookup(const std::string& path, ErrorField field) {
+  MapFileReader reader(path);
+  ErrorMap map;
+  const std::uint64_t n = ReadMeta(reader, &map);
+  if (!map.grid) Refuse(path, "a scattered (Monte Carlo) map has no lookup table; make a grid map");
+  const std::string name = SectionName(field);
+  const std::string table = reader.Section(name);
+  const std::string status = reader.Section("status");
+  if (table.size() != n * 8 || status.size() != n * 2) {
+    Refuse(path, "corrupted: section '" + name + "' or 'status' does not hold " +
+                     std::to_string(n) + " samples");
+  }
+  std::vector<double> values(n);
+  std::memcpy(values.data(), table.data(), table.size());
+  std::vector<std::uint8_t> statuses(n);
+  for (size_t i = 0; i < n; ++i) {
+    statuses[i] = static_cast<std::uint8_t>(status[2 * i]);
+    if (statuses[i] > static_cast<std::uint8_t>(SampleStatus::kNotComputed)) {
+      Refuse(path, "corrupted: unknown status at sample " + std::to_string(i));
+    }
+  }
+  return ErrorLookup(map.axes, std::move(values), std::move(statuses), field);
 }
 
 ErrorMap MergeErrorMaps(const std::vector<ErrorMap>& shards) {

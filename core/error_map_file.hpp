@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error_lookup.hpp"
 #include "core/error_map.hpp"
 
 namespace hapticsim {
@@ -37,6 +38,12 @@ enum class MapLoadParts { kLookupOnly, kEverything };
  *         (checksum), or inconsistent sizes.
  */
 ErrorMap LoadErrorMap(const std::string& path, MapLoadParts parts = MapLoadParts::kEverything);
+
+/**
+ * What the daemon loads: one lookup table and the status of every sample, nothing else.
+ * @throws Error as LoadErrorMap, or for a scattered map.
+ */
+ErrorLookup LoadErrorLookup(const std::string& path, ErrorField field);
 
 /**
  * Joins shards of one sweep: same axes, base scene, model and code; each sample computed in at

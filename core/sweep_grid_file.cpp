@@ -23,10 +23,11 @@ SweepGrid LoadGridFile(const std::string& path, const MapPoint& base) {
   for (const auto& [key, node] : *axes) {
     const std::string name(key.str());
     const int axis = FindAxis(name);
-    const std::string where = "grid file " + path + ":" + std::to_string(key.source().begin.line);
+    std::string where = "grid file ";  // appended: g++ 12 warns falsely on a chain of + here
+    where.append(path).append(":").append(std::to_string(key.source().begin.line));
     if (axis < 0) {
       std::string known;
-      for (int a = 0; a < kNumMapAxes; ++a) known += " " + std::string(AxisInfo(a).name);
+      for (int a = 0; a < kNumMapAxes; ++a) known.append(" ").append(AxisInfo(a).name);
       throw Error(where + ": '" + name + "' is not a map axis; axes are" + known);
     }
     const toml::array* list = node.as_array();

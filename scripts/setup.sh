@@ -8,6 +8,9 @@ packages=(
   libeigen3-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libboost-math-dev
+  libopenmpi-dev openmpi-bin
+  chromium
 )
 
 missing=()

@@ -101,5 +101,39 @@ TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSaying
   std::filesystem::remove(path);
 }
 
+TEST(ErrorMapFile, TheDaemonsLookupTableLoadsAloneAndAgreesWithTheWholeMap) {
+  const std::string path = TempPath("lookup.hsmap");
+  const ErrorMap map = ExampleMap();
+  SaveErrorMap(map, path);
+  const ErrorLookup alone = LoadErrorLookup(path, ErrorField::kMagnitude);
+  const ErrorLookup whole(LoadErrorMap(path), ErrorField::kMagnitude);
+  for (double nu : {0.40, 0.43, 0.49}) {
+    for (double size : {1.0, 2.0, 3.0}) {
+      MapPoint p = map.samples.front().point;
+      p[0] = nu, p[7] = size;
+      const LookupResult a = alone.Lookup(LookupQuery::At(p)), b = whole.Lookup(LookupQuery::At(p));
+      EXPECT_EQ(a.usable(), b.usable());
+      if (a.usable()) {
+        EXPECT_EQ(a.error, b.error);
+      }
+    }
+  }
+  std::string bytes = ReadAll(path);
+  const size_t table = bytes.find("lookup.max_magnitude_percent");
+  ASSERT_NE(table, std::string::npos);
+  const auto offset = *reinterpret_cast<const std::uint64_t*>(bytes.data() + table + 32);
+  bytes[offset + 3] ^= 0x01;  // one bit of the table the daemon reads
+  WriteAll(path, bytes);
+  try {
+    LoadErrorLookup(path, ErrorField::kMagnitude);
+    ADD_FAILURE() << "a corrupted lookup table was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("checksum of section 'lookup.max_magnitude_percent'"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace hapticsim

@@ -63,3 +63,37 @@ TEST(RegionSteps, NeverAllocate) {
 
 }  // namespace
 }  // namespace hapticsim
+
+#include "core/error_lookup.hpp"
+#include "core/sweep_grid.hpp"
+
+namespace hapticsim {
+namespace {
+
+// The error lookup may run in the 1 kHz thread: point queries, box queries and the frequency
+// bound, on a map the size of the paper's grid.
+TEST(ErrorLookup, NeverAllocates) {
+  const SweepGrid paper = PaperGrid();
+  ErrorMap map = ErrorMap::MakeGrid(paper.axes);
+  for (size_t i = 0; i < map.samples.size(); ++i) {
+    map.samples[i].status = SampleStatus::kOk;
+    map.samples[i].max_magnitude_percent = static_cast<double>(i % 97) / 10;
+  }
+  const ErrorLookup lookup(map, ErrorField::kMagnitude);
+  LookupQuery query = LookupQuery::At(map.samples[12345].point);
+  query.hi[0] = 0.48;  // a neighbourhood of heterogeneous material
+  query.lo[3] = 6000, query.hi[3] = 17000;
+  query.frequency_known = false;
+  double sum = 0;
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 1000; ++n) {
+    query.lo[8] = 600 + n % 400;
+    query.hi[8] = query.lo[8];
+    sum += lookup.Lookup(query).error;
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_GT(sum, 0);
+}
+
+}  // namespace
+}  // namespace hapticsim

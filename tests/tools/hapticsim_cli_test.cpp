@@ -28,7 +28,8 @@ std::string Temp(const std::string& name) { return ::testing::TempDir() + name; 
 TEST(HapticsimCli, HelpListsTheSubcommands) {
   const CommandResult result = Hapticsim({"--help"});
   EXPECT_EQ(result.exit_status, 0);
-  for (const char* sub : {"simulate", "static", "stability", "scene"}) {
+  for (const char* sub : {"simulate", "static", "stability", "scene", "sweep", "map", "lookup",
+                          "analyze"}) {
     EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
   }
 }

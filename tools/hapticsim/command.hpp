@@ -26,5 +26,6 @@ Command AddSceneCommand(CLI::App& parent);
 Command AddSweepCommand(CLI::App& parent);
 Command AddMapCommand(CLI::App& parent);
 Command AddLookupCommand(CLI::App& parent);
+Command AddAnalyzeCommand(CLI::App& parent);
 
 }  // namespace hapticsim::cli

@@ -31,10 +31,10 @@ double ParseNumber(const std::string& key, const std::string& text) {
 }
 
 int Run(const LookupCommandOptions& o) {
-  const ErrorMap map = LoadErrorMap(o.map, MapLoadParts::kLookupOnly);
   const ErrorField field = ParseErrorField(o.field);
-  const ErrorLookup lookup(map, field);
+  const ErrorLookup lookup = LoadErrorLookup(o.map, field);
   // Unset parameters: the map's own scene.
+  const ErrorMap map = LoadErrorMap(o.map, MapLoadParts::kLookupOnly);
   const MapPoint base = PointOfScene(ParseSceneText(map.provenance.scene_toml, o.map));
   LookupQuery query = LookupQuery::At(base);
   query.frequency_known = !o.unknown_frequency;

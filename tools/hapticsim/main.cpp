@@ -7,6 +7,7 @@
 //   hapticsim sweep [--grid paper|quick|scene|FILE] [--out MAP]  make an error map
 //   hapticsim map info|export|merge                              inspect and join map files
 //   hapticsim lookup MAP --set key=value                         the run-time error lookup
+//   hapticsim analyze MAP [--report report.html]                 Table I and the HTML report
 //
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
 // 1 anything else.
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
                                       AddStabilityCommand(app), AddSceneCommand(app),
                                       AddSweepCommand(app), AddMapCommand(app),
-                                      AddLookupCommand(app)};
+                                      AddLookupCommand(app), AddAnalyzeCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -76,7 +77,9 @@ int Info(const MapCommandOptions& o) {
     for (int a = 0; a < kNumMapAxes; ++a) {
       std::cout << "    " << std::left << std::setw(28) << AxisInfo(a).scene_key << " {";
       for (size_t i = 0; i < map.axes[a].size(); ++i) {
-        std::cout << (i ? ", " : "") << FormatReal(map.axes[a][i]);
+        const double v = map.axes[a][i];
+        std::cout << (i ? ", " : "")
+                  << (AxisInfo(a).integer ? std::to_string(std::lround(v)) : FormatReal(v));
       }
       std::cout << "}" << (AxisInfo(a).unit.empty() ? "" : " " + std::string(AxisInfo(a).unit))
                 << "\n";

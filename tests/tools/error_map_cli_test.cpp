@@ -1,0 +1,179 @@
+// The error-map commands as a user runs them: sweep (with Ctrl-C and --resume), map info,
+// export and merge, lookup, analyze, and the HTML report rendered in a real browser.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/run_command.hpp"
+
+namespace hapticsim {
+namespace {
+
+using testing::CommandResult;
+
+CommandResult Hapticsim(std::vector<std::string> args) {
+  args.insert(args.begin(), HAPTICSIM_CLI_PATH);
+  return testing::RunCommand(args);
+}
+
+nlohmann::json Json(const CommandResult& result) {
+  EXPECT_EQ(result.exit_status, 0) << result.err;
+  return nlohmann::json::parse(result.out);
+}
+
+std::string Temp(const std::string& name) { return ::testing::TempDir() + "hsmap_cli_" + name; }
+
+// A 9³ cube, half-second trials and a grid file that varies five axes: seconds per sweep.
+const std::vector<std::string> kScene = {"--set", "mesh.nodes=9", "--set", "input.frequency=2"};
+
+std::string GridFile() {
+  const std::string path = Temp("grid.toml");
+  std::ofstream(path) << "# a test grid\n[axes]\n"
+                         "poisson_ratio = [0.40, 0.49]\n"
+                         "youngs_modulus = [5000.0, 20000.0]\n"
+                         "\"input.amplitude\" = [0.005, 0.01]\n"
+                         "primary_size = [1, 3]\n"
+                         "secondary_rate = [600.0, 1000.0]\n";
+  return path;
+}
+
+std::vector<std::string> SweepArgs(const std::string& out, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"sweep", "--grid", GridFile(), "--out", out, "--json"};
+  args.insert(args.end(), kScene.begin(), kScene.end());
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
+const nlohmann::json& FullSweep() {
+  static const nlohmann::json summary = Json(Hapticsim(SweepArgs(Temp("full.hsmap"))));
+  return summary;
+}
+
+TEST(ErrorMapCli, SweepWritesAMapThatInfoDescribes) {
+  const nlohmann::json& sweep = FullSweep();
+  EXPECT_EQ(sweep["samples"], 32);
+  EXPECT_EQ(sweep["not_computed"], 0);
+  EXPECT_EQ(sweep["ok"].get<int>() + sweep["predicted_unstable"].get<int>() +
+                sweep["diverged"].get<int>(),
+            32);
+  EXPECT_GT(sweep["saved"]["linearity_trials"].get<int>(), 0);
+  const auto info = Json(Hapticsim({"map", "info", Temp("full.hsmap"), "--json"}));
+  EXPECT_EQ(info["samples"], 32);
+  EXPECT_EQ(info["kind"], "grid");
+  EXPECT_EQ(info["axes"]["poisson_ratio"]["values"], nlohmann::json({0.40, 0.49}));
+  EXPECT_EQ(info["axes"]["youngs_modulus"]["unit"], "Pa");
+  EXPECT_EQ(info["results_checksum"], sweep["results_checksum"]);
+  EXPECT_NE(info["scene_toml"].get<std::string>().find("nodes = 9"), std::string::npos);
+}
+
+TEST(ErrorMapCli, ExportWritesOneCsvRowPerSampleWithUnitsInTheHeader) {
+  FullSweep();
+  const std::string csv = Temp("full.csv");
+  ASSERT_EQ(Hapticsim({"map", "export", Temp("full.hsmap"), "--csv", csv}).exit_status, 0);
+  std::ifstream in(csv);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("poisson_ratio,density_kg/m^3,damping_1/s,youngs_modulus_Pa,", 0), 0u)
+      << header;
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 32);
+}
+
+TEST(ErrorMapCli, LookupInterpolatesClampsWithAFlagAndRefusesUnknownAxes) {
+  FullSweep();
+  const std::string map = Temp("full.hsmap");
+  const auto inside = Json(Hapticsim({"lookup", map, "--set", "youngs_modulus=12000", "--set",
+                                      "primary_size=3", "--set", "secondary_rate=1000", "--json"}));
+  EXPECT_FALSE(inside["clamped"].get<bool>());
+  EXPECT_GE(inside["error"].get<double>(), 0.0);
+  const auto outside = Json(Hapticsim({"lookup", map, "--set", "youngs_modulus=90000", "--set",
+                                       "primary_size=3", "--set", "secondary_rate=1000", "--json"}));
+  EXPECT_TRUE(outside["clamped"].get<bool>());
+  EXPECT_EQ(outside["clamped_axis"], "youngs_modulus");
+  const CommandResult bad = Hapticsim({"lookup", map, "--set", "stiffness=3"});
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_NE(bad.err.find("not a map axis"), std::string::npos) << bad.err;
+}
+
+TEST(ErrorMapCli, ADamagedMapIsRefusedWithAMessageThatSaysHow) {
+  FullSweep();
+  const std::string damaged = Temp("damaged.hsmap");
+  std::filesystem::copy_file(Temp("full.hsmap"), damaged,
+                             std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(damaged, std::filesystem::file_size(damaged) - 100);
+  const CommandResult result = Hapticsim({"map", "info", damaged});
+  EXPECT_EQ(result.exit_status, 2);
+  EXPECT_NE(result.err.find("truncated"), std::string::npos) << result.err;
+}
+
+TEST(ErrorMapCli, ShardsMergeToTheSameResultsAsOneSweep) {
+  const std::string a = Temp("shard1.hsmap"), b = Temp("shard2.hsmap"), merged = Temp("m.hsmap");
+  ASSERT_EQ(Hapticsim(SweepArgs(a, {"--shard", "1/2"})).exit_status, 0);
+  ASSERT_EQ(Hapticsim(SweepArgs(b, {"--shard", "2/2", "--jobs", "1"})).exit_status, 0);
+  const CommandResult result = Hapticsim({"map", "merge", merged, a, b});
+  ASSERT_EQ(result.exit_status, 0) << result.err;
+  const auto info = Json(Hapticsim({"map", "info", merged, "--json"}));
+  EXPECT_EQ(info["not_computed"], 0);
+  EXPECT_EQ(info["results_checksum"], FullSweep()["results_checksum"]);
+}
+
+TEST(ErrorMapCli, CtrlCKeepsTheDoneWorkAndResumeFinishesTheSameMap) {
+  // The test grid with a slower input added: about 5 s on one job, interrupted after 1.5 s.
+  const std::vector<std::string> slower = {"--set", "input.periods=3"};
+  const std::string out = Temp("interrupted.hsmap"), whole = Temp("uninterrupted.hsmap");
+  std::filesystem::remove(out);
+  // SIGINT as Ctrl-C sends it; --preserve-status returns the sweep's own exit status.
+  std::vector<std::string> args = {"/usr/bin/timeout", "--preserve-status", "-s", "INT", "1.5",
+                                   HAPTICSIM_CLI_PATH};
+  for (const std::string& a : SweepArgs(out, {"--jobs", "1", slower[0], slower[1]})) {
+    args.push_back(a);
+  }
+  const CommandResult interrupted = testing::RunCommand(args);
+  ASSERT_EQ(interrupted.exit_status, 130) << interrupted.err;
+  EXPECT_NE(interrupted.err.find("--resume"), std::string::npos) << interrupted.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_TRUE(std::filesystem::exists(out + ".journal"));
+  const auto resumed = Json(Hapticsim(SweepArgs(out, {"--resume", slower[0], slower[1]})));
+  EXPECT_GT(resumed["samples_resumed"].get<int>(), 0);
+  EXPECT_LT(resumed["samples_resumed"].get<int>(), 32);
+  EXPECT_FALSE(std::filesystem::exists(out + ".journal"));
+  const auto reference = Json(Hapticsim(SweepArgs(whole, {slower[0], slower[1]})));
+  EXPECT_EQ(resumed["results_checksum"], reference["results_checksum"]);
+}
+
+TEST(ErrorMapCli, AnalyzePrintsTableOneAndTheReportRendersInABrowser) {
+  FullSweep();
+  const std::string report = Temp("report.html");
+  const auto analysis =
+      Json(Hapticsim({"analyze", Temp("full.hsmap"), "--json", "--report", report}));
+  const auto& c = analysis["correlations"];
+  for (const char* name : {"poisson_ratio", "youngs_modulus", "amplitude", "primary_size",
+                           "secondary_rate", "reference_force"}) {
+    ASSERT_TRUE(c.contains(name)) << name;
+    EXPECT_TRUE(c[name].contains("spearman_p")) << name;
+  }
+  EXPECT_TRUE(c["density"]["pearson"].is_null());  // constant in this grid
+  const double r = c["poisson_ratio"]["pearson"].get<double>();
+  EXPECT_TRUE(r >= -1 && r <= 1);
+
+  // Headless Chromium runs the page's script: it reports how many samples it drew.
+  const std::string profile = Temp("chromium-profile");
+  std::filesystem::remove_all(profile);
+  const CommandResult page = testing::RunCommand(
+      {"/usr/bin/chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+       "--no-first-run", "--disable-background-networking", "--disable-component-update",
+       "--disable-sync", "--user-data-dir=" + profile, "--dump-dom", "file://" + report});
+  ASSERT_EQ(page.exit_status, 0) << page.err;
+  const int ok = analysis["samples"].get<int>();
+  EXPECT_NE(page.out.find("rendered " + std::to_string(ok) + " samples on 10 axes"),
+            std::string::npos)
+      << "the report's script did not finish drawing";
+  EXPECT_NE(page.out.find("<td>poisson_ratio</td>"), std::string::npos);
+  std::filesystem::remove_all(profile);
+}
+
+}  // namespace
+}  // namespace hapticsim
