@@ -45,4 +45,16 @@ SweepGrid LoadGridFile(const std::string& path, const MapPoint& base) {
   return grid;
 }
 
+SweepGrid ChooseSweepGrid(const std::string& name, int monte_carlo, std::uint64_t seed,
+                          const Scene& scene) {
+  if (monte_carlo > 0) return MonteCarloGrid(monte_carlo, seed);
+  if (name == "paper") return PaperGrid();
+  if (name == "quick") return QuickGrid();
+  if (name == "scene") return SceneGrid(PointOfScene(scene));
+  if (name.size() > 5 && name.substr(name.size() - 5) == ".toml") {
+    return LoadGridFile(name, PointOfScene(scene));
+  }
+  throw Error("--grid " + name + ": choose paper, quick, scene or a FILE.toml");
+}
+
 }  // namespace hapticsim

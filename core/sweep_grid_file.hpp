@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "core/scene.hpp"
 #include "core/sweep_grid.hpp"
 
 namespace hapticsim {
@@ -19,5 +20,13 @@ namespace hapticsim {
  *         list not strictly increasing.
  */
 SweepGrid LoadGridFile(const std::string& path, const MapPoint& base);
+
+/**
+ * The grid a user names on the command line: "paper", "quick", "scene" (the scene's material),
+ * a FILE.toml, or `monte_carlo` > 0 points drawn with `seed`.
+ * @throws Error listing the choices.
+ */
+SweepGrid ChooseSweepGrid(const std::string& name, int monte_carlo, std::uint64_t seed,
+                          const Scene& scene);
 
 }  // namespace hapticsim

@@ -41,17 +41,6 @@ std::pair<int, int> ParseShard(const std::string& text) {
   return {index - 1, count};
 }
 
-SweepGrid ChooseGrid(const SweepCommandOptions& o, const Scene& scene) {
-  if (o.monte_carlo > 0) return MonteCarloGrid(o.monte_carlo, o.seed);
-  if (o.grid == "paper") return PaperGrid();
-  if (o.grid == "quick") return QuickGrid();
-  if (o.grid == "scene") return SceneGrid(PointOfScene(scene));
-  if (o.grid.size() > 5 && o.grid.substr(o.grid.size() - 5) == ".toml") {
-    return LoadGridFile(o.grid, PointOfScene(scene));
-  }
-  throw hapticsim::Error("--grid " + o.grid + ": choose paper, quick, scene or a FILE.toml");
-}
-
 nlohmann::json StatsJson(const SweepStats& s, const ErrorMap& map) {
   return {{"samples", s.samples},
           {"samples_resumed", s.samples_resumed},
@@ -78,7 +67,7 @@ nlohmann::json StatsJson(const SweepStats& s, const ErrorMap& map) {
 
 int Run(const SweepCommandOptions& o) {
   const Scene scene = o.scene.Resolve();
-  const SweepGrid grid = ChooseGrid(o, scene);
+  const SweepGrid grid = ChooseSweepGrid(o.grid, o.monte_carlo, o.seed, scene);
   const auto [shard_index, shard_count] = ParseShard(o.shard);
   SweepOptions options;
   options.jobs = o.jobs;
