@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/error_sweep.hpp"
 #include "tools/hapticsim/command.hpp"
 
 int main(int argc, char** argv) {
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
       "hapticsim: force feedback from a deforming soft-tissue model (linear hexahedral FEM),\n"
       "with the error of that force. Units are SI throughout. Run a subcommand with --help.",
       "hapticsim"};
+  app.set_version_flag("--version", hapticsim::CodeVersion());
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every subcommand");
   const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
@@ -49,6 +51,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
