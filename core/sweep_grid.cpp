@@ -71,7 +71,10 @@ SweepGrid MonteCarloGrid(int count, std::uint64_t seed) {
   for (MapPoint& point : grid.points) {
     for (int a = 0; a < kNumMapAxes; ++a) {
       const std::vector<double>& v = paper.axes[a];
-      if (AxisInfo(a).integer) {
+      // Rates from the paper's values too: the coupled schedule repeats after the common period
+      // of the rates (10 ms for these, up to 1 s for arbitrary whole-Hz rates), and the stability
+      // estimate runs hundreds of common periods.
+      if (AxisInfo(a).integer || a == static_cast<int>(MapAxis::kSecondaryRate)) {
         point[a] = v[static_cast<size_t>(uniform() * static_cast<double>(v.size()))];
       } else {
         point[a] = v.front() + uniform() * (v.back() - v.front());

@@ -37,8 +37,8 @@ SweepGrid QuickGrid();
 SweepGrid SceneGrid(const MapPoint& scene_point);
 
 /**
- * `count` points drawn uniformly from the paper's ranges (continuous material, input and
- * secondary rate; the integer axes from their values), reproducible from `seed`.
+ * `count` points drawn uniformly from the paper's ranges: material and input continuous; spacing
+ * factor, primary size and secondary rate from the paper's values. Reproducible from `seed`.
  */
 SweepGrid MonteCarloGrid(int count, std::uint64_t seed);
 

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/async_regions.hpp"
+#include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
 
 #include "core/error.hpp"
@@ -168,6 +169,36 @@ TEST(ErrorSweep, AStopRequestEndsTheSweepWithoutComputingMore) {
   const ErrorMap map = Sweep(SmallGrid(), options, &stats);
   EXPECT_TRUE(stats.interrupted);
   EXPECT_EQ(map.CountStatus(SampleStatus::kNotComputed), map.samples.size());
+}
+
+TEST(ErrorSweep, MonteCarloPointsAreReproducibleAndInsideThePapersRanges) {
+  const SweepGrid a = MonteCarloGrid(200, 42), b = MonteCarloGrid(200, 42);
+  const SweepGrid c = MonteCarloGrid(200, 43);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_NE(a.points, c.points);
+  const SweepGrid paper = PaperGrid();
+  for (const MapPoint& p : a.points) {
+    for (int axis = 0; axis < kNumMapAxes; ++axis) {
+      const auto& values = paper.axes[axis];
+      EXPECT_GE(p[axis], values.front());
+      EXPECT_LE(p[axis], values.back());
+      if (AxisInfo(axis).integer) {
+        EXPECT_NE(std::find(values.begin(), values.end(), p[axis]), values.end());
+      }
+    }
+  }
+}
+
+TEST(ErrorSweep, AMonteCarloSweepMakesAScatteredMapThatCannotBeLookedUp) {
+  SweepGrid grid = MonteCarloGrid(3, 7);
+  for (MapPoint& p : grid.points) p[6] = 2, p[7] = 1;  // spacing factor 2: valid on the 9³ cube
+  SweepOptions options;
+  options.jobs = 2;
+  const ErrorMap map = Sweep(grid, options);
+  EXPECT_FALSE(map.grid);
+  EXPECT_EQ(map.CountStatus(SampleStatus::kNotComputed), 0u);
+  for (size_t i = 0; i < grid.points.size(); ++i) EXPECT_EQ(map.samples[i].point, grid.points[i]);
+  EXPECT_THROW(ErrorLookup(map, ErrorField::kL2), Error);
 }
 
 }  // namespace
