@@ -9,6 +9,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev
+  liblcm-dev liblcm-bin liblcm-java libspdlog-dev
   libopenmpi-dev openmpi-bin
   chromium
 )

@@ -1,0 +1,202 @@
+#include "daemon/daemon_config.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/scene_toml.hpp"
+
+namespace hapticsim {
+namespace {
+
+using Setter = std::function<void(DaemonConfig*, const toml::node&, const std::string& where)>;
+
+template <typename T>
+T Get(const toml::node& node, const std::string& key, const std::string& where, const char* type) {
+  const std::optional<T> value = node.value<T>();
+  if (!value) throw Error(where + ": " + key + " must be " + type);
+  return *value;
+}
+
+const std::map<std::string, Setter>& Setters() {
+  static const std::map<std::string, Setter> setters = [] {
+    std::map<std::string, Setter> s;
+    auto text = [&s](const std::string& key, std::string DaemonConfig::*field) {
+      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+        c->*field = Get<std::string>(n, key, where, "a string");
+      };
+    };
+    auto real = [&s](const std::string& key, double DaemonConfig::*field) {
+      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+        c->*field = Get<double>(n, key, where, "a number");
+      };
+    };
+    auto flag = [&s](const std::string& key, bool DaemonConfig::*field) {
+      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+        c->*field = Get<bool>(n, key, where, "true or false");
+      };
+    };
+    text("scene.file", &DaemonConfig::scene_file);
+    flag("lcm.enabled", &DaemonConfig::lcm_enabled);
+    text("lcm.url", &DaemonConfig::lcm_url);
+    text("lcm.device_channel", &DaemonConfig::device_channel);
+    text("lcm.force_channel", &DaemonConfig::force_channel);
+    text("lcm.status_channel", &DaemonConfig::status_channel);
+    text("lcm.command_channel", &DaemonConfig::command_channel);
+    text("supervisor.error_map", &DaemonConfig::error_map);
+    real("supervisor.error_target_percent", &DaemonConfig::error_target_percent);
+    real("supervisor.status_rate_hz", &DaemonConfig::status_rate_hz);
+    real("input.stale_after_s", &DaemonConfig::stale_after_s);
+    flag("input.zero_force_when_stale", &DaemonConfig::zero_force_when_stale);
+    real("input.max_speed_m_per_s", &DaemonConfig::max_speed_m_per_s);
+    real("input.workspace_margin_m", &DaemonConfig::workspace_margin_m);
+    real("input.max_force_n", &DaemonConfig::max_force_n);
+    s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
+      c->fifo_priority = static_cast<int>(Get<std::int64_t>(n, "realtime.fifo_priority", w,
+                                                             "a whole number"));
+    };
+    s["realtime.cpus"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
+      const toml::array* list = n.as_array();
+      if (!list) throw Error(where + ": realtime.cpus must be a list of CPU numbers, e.g. [1]");
+      c->cpus.clear();
+      for (const toml::node& cpu : *list) {
+        c->cpus.push_back(
+            static_cast<int>(Get<std::int64_t>(cpu, "realtime.cpus", where, "whole numbers")));
+      }
+    };
+    flag("realtime.lock_memory", &DaemonConfig::lock_memory);
+    text("log.level", &DaemonConfig::log_level);
+    real("log.max_lines_per_s", &DaemonConfig::max_log_lines_per_s);
+    return s;
+  }();
+  return setters;
+}
+
+// The adaptive configuration the daemon starts from (before the supervisor chooses one) is
+// given by the scene file's [adaptivity]; without one, a small stable default.
+void DefaultAdaptivity(Scene* scene) {
+  if (scene->adaptivity.primary_size > 0) return;
+  scene->adaptivity.primary_size = 3;
+  scene->adaptivity.secondary_lod = 2;
+  scene->adaptivity.secondary_rate_hz = PrimaryRateHz(*scene);
+}
+
+}  // namespace
+
+void ValidateDaemonConfig(const DaemonConfig& c) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw Error(message);
+  };
+  require(std::isfinite(c.error_target_percent) && c.error_target_percent > 0 &&
+              c.error_target_percent <= 100,
+          "supervisor.error_target_percent must be in (0, 100] %");
+  require(std::isfinite(c.status_rate_hz) && c.status_rate_hz >= 0.1 && c.status_rate_hz <= 100,
+          "supervisor.status_rate_hz must be from 0.1 to 100 Hz");
+  require(std::isfinite(c.stale_after_s) && c.stale_after_s >= 0.002 && c.stale_after_s <= 10,
+          "input.stale_after_s must be from 0.002 to 10 s");
+  require(std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0,
+          "input.max_speed_m_per_s must be > 0 m/s");
+  require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0,
+          "input.workspace_margin_m must be >= 0 m");
+  require(std::isfinite(c.max_force_n) && c.max_force_n > 0, "input.max_force_n must be > 0 N");
+  require(c.fifo_priority >= 0 && c.fifo_priority <= 99,
+          "realtime.fifo_priority must be from 0 (off) to 99");
+  for (int cpu : c.cpus) require(cpu >= 0 && cpu < 4096, "realtime.cpus: CPU numbers are >= 0");
+  require(std::isfinite(c.max_log_lines_per_s) && c.max_log_lines_per_s > 0,
+          "log.max_lines_per_s must be > 0");
+  const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
+  require(std::find(levels.begin(), levels.end(), c.log_level) != levels.end(),
+          "log.level must be one of trace, debug, info, warn, error");
+  for (const auto& [key, channel] :
+       {std::pair{"lcm.device_channel", &c.device_channel}, {"lcm.force_channel", &c.force_channel},
+        {"lcm.status_channel", &c.status_channel}, {"lcm.command_channel", &c.command_channel}}) {
+    require(!channel->empty() && channel->size() <= 63,
+            std::string(key) + " must be a channel name of 1 to 63 characters");
+  }
+  require(c.lcm_url.find("://") != std::string::npos,
+          "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq://");
+  require(c.scene.adaptivity.enabled(),
+          "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
+  ValidateScene(c.scene);
+}
+
+DaemonConfig DefaultDaemonConfig() {
+  DaemonConfig config;
+  DefaultAdaptivity(&config.scene);
+  return config;
+}
+
+DaemonConfig LoadDaemonConfig(const std::string& path) {
+  toml::table document;
+  try {
+    document = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    if (e.source().begin.line == 0) {
+      throw Error("cannot read config file " + path + ": " + std::string(e.description()));
+    }
+    throw Error("config file " + path + ":" + std::to_string(e.source().begin.line) + ": " +
+                std::string(e.description()));
+  }
+  DaemonConfig config;
+  for (const auto& [section, node] : document) {
+    const toml::table* table = node.as_table();
+    std::string where = "config file ";
+    where.append(path).append(":").append(std::to_string(node.source().begin.line));
+    if (!table) throw Error(where + ": '" + std::string(section.str()) + "' must be a [section]");
+    for (const auto& [key, value] : *table) {
+      const std::string name = std::string(section.str()) + "." + std::string(key.str());
+      std::string at = "config file ";
+      at.append(path).append(":").append(std::to_string(value.source().begin.line));
+      const auto setter = Setters().find(name);
+      if (setter == Setters().end()) {
+        std::string known;
+        for (const auto& entry : Setters()) known.append(" ").append(entry.first);
+        throw Error(at + ": unknown key " + name + "; keys are" + known);
+      }
+      setter->second(&config, value, at);
+    }
+  }
+  config.scene = config.scene_file.empty() ? Scene{} : LoadSceneFile(config.scene_file);
+  DefaultAdaptivity(&config.scene);
+  try {
+    ValidateDaemonConfig(config);
+  } catch (const Error& e) {
+    throw Error("config file " + path + ": " + e.what());
+  }
+  return config;
+}
+
+std::string FormatDaemonConfig(const DaemonConfig& c) {
+  std::ostringstream out;
+  auto quote = [](const std::string& s) { return "\"" + s + "\""; };
+  auto real = [](double v) { return FormatReal(v); };
+  out << "# hapticsimd configuration (every key optional; these are the values in effect)\n"
+      << "[scene]\nfile = " << quote(c.scene_file) << "\n\n"
+      << "[lcm]\nenabled = " << (c.lcm_enabled ? "true" : "false") << "\n"
+      << "url = " << quote(c.lcm_url) << "  # ttl=0: multicast stays on this host\n"
+      << "device_channel = " << quote(c.device_channel) << "\n"
+      << "force_channel = " << quote(c.force_channel) << "\n"
+      << "status_channel = " << quote(c.status_channel) << "\n"
+      << "command_channel = " << quote(c.command_channel) << "\n\n"
+      << "[supervisor]\nerror_map = " << quote(c.error_map) << "\n"
+      << "error_target_percent = " << real(c.error_target_percent) << "\n"
+      << "status_rate_hz = " << real(c.status_rate_hz) << "\n\n"
+      << "[input]\nstale_after_s = " << real(c.stale_after_s) << "\n"
+      << "zero_force_when_stale = " << (c.zero_force_when_stale ? "true" : "false") << "\n"
+      << "max_speed_m_per_s = " << real(c.max_speed_m_per_s) << "\n"
+      << "workspace_margin_m = " << real(c.workspace_margin_m) << "\n"
+      << "max_force_n = " << real(c.max_force_n) << "\n\n"
+      << "[realtime]\nfifo_priority = " << c.fifo_priority << "\ncpus = [";
+  for (size_t i = 0; i < c.cpus.size(); ++i) out << (i ? ", " : "") << c.cpus[i];
+  out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n\n"
+      << "[log]\nlevel = " << quote(c.log_level) << "\n"
+      << "max_lines_per_s = " << real(c.max_log_lines_per_s) << "\n";
+  return out.str();
+}
+
+}  // namespace hapticsim

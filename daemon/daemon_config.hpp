@@ -1,0 +1,60 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/**
+ * hapticsimd's configuration (/etc/hapticsim/hapticsimd.toml by default). Every key is optional;
+ * `hapticsimd --print-config` prints them all with their defaults.
+ */
+struct DaemonConfig {
+  // [scene]
+  std::string scene_file;  ///< scene TOML (empty: the built-in paper scene)
+  Scene scene;             ///< the scene file's scene, adaptivity as configured below
+  // [lcm]
+  bool lcm_enabled = true;
+  /// Host-local by default: ttl=0 keeps multicast on this machine.
+  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  std::string device_channel = "HAPTIC_DEVICE";
+  std::string force_channel = "HAPTIC_FORCE";
+  std::string status_channel = "HAPTIC_STATUS";
+  std::string command_channel = "HAPTIC_COMMAND";
+  // [supervisor]
+  std::string error_map;              ///< map file (empty: none; the error is reported as -1)
+  double error_target_percent = 7.0;  ///< the force-magnitude JND
+  double status_rate_hz = 5;
+  // [input]
+  double stale_after_s = 0.05;          ///< input older than this is stale
+  bool zero_force_when_stale = true;    ///< stale: render zero force (else hold the last)
+  double max_speed_m_per_s = 5.0;       ///< faster jumps are rejected (no hand moves so)
+  double workspace_margin_m = 0.1;      ///< accepted positions: the object's box grown by this
+  double max_force_n = 50.0;            ///< a larger force is a fault: zero force, reset
+  // [realtime]
+  int fifo_priority = 0;        ///< SCHED_FIFO priority of the region threads (0: normal)
+  std::vector<int> cpus;        ///< CPUs the region threads are pinned to (empty: any)
+  bool lock_memory = false;     ///< mlockall(MCL_CURRENT | MCL_FUTURE)
+  // [log]
+  std::string log_level = "info";  ///< trace, debug, info, warn, error
+  double max_log_lines_per_s = 10;  ///< rate limit of repeated warnings
+};
+
+/**
+ * Reads a config file over the defaults and validates every key.
+ * @throws Error naming the file, line and key when something is wrong.
+ */
+DaemonConfig LoadDaemonConfig(const std::string& path);
+
+/** The defaults, as with an empty config file. */
+DaemonConfig DefaultDaemonConfig();
+
+/** Validates a config (ranges, the scene's adaptivity). @throws Error naming the key. */
+void ValidateDaemonConfig(const DaemonConfig& config);
+
+/** The config as TOML that LoadDaemonConfig reads back. */
+std::string FormatDaemonConfig(const DaemonConfig& config);
+
+}  // namespace hapticsim

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/** Why a device input was refused. */
+enum class InputRejection : int {
+  kAccepted = 0,
+  kNonFinite,         ///< a coordinate is NaN or infinite
+  kOutsideWorkspace,  ///< beyond the object's box grown by the workspace margin
+  kJump,              ///< faster than max_speed since the last accepted input (no hand moves so)
+  kOldSequence,       ///< seq not newer than the last accepted one (duplicate or reordered)
+};
+inline constexpr int kNumInputRejections = 5;
+std::string_view InputRejectionName(InputRejection rejection);
+
+/**
+ * Checks device inputs before they reach the simulation (the I/O thread calls it for every
+ * message). Sequence gaps are counted, not refused: a lost message is no reason to drop the
+ * next one.
+ */
+class InputGuard {
+ public:
+  InputGuard(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s)
+      : edge_m_(mesh.edge_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}
+
+  InputRejection Check(std::int64_t seq, const std::array<double, 3>& position_m,
+                       std::int64_t received_ns) noexcept;
+
+  std::int64_t sequence_gaps() const { return gaps_; }
+  /** Forget the last accepted input (after a reset or a long pause). */
+  void Reset() { have_last_ = false; }
+
+ private:
+  double edge_m_, margin_m_, max_speed_;
+  bool have_last_ = false;
+  std::int64_t last_seq_ = 0, last_ns_ = 0, gaps_ = 0;
+  std::array<double, 3> last_position_{};
+};
+
+}  // namespace hapticsim

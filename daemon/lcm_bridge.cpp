@@ -1,0 +1,107 @@
+#include "daemon/lcm_bridge.hpp"
+
+#include <poll.h>
+
+#include "core/error.hpp"
+#include "hapticsim/device_input_t.hpp"
+#include "hapticsim/force_feedback_t.hpp"
+
+namespace hapticsim {
+
+LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop)
+    : config_(config),
+      loop_(loop),
+      lcm_(config.lcm_url),
+      guard_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s) {
+  if (!lcm_.good()) {
+    throw Error("LCM could not start on " + config.lcm_url +
+                " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
+                "224.0.0.0/4 dev lo`; set lcm.url in the config)");
+  }
+  lcm_.subscribe(config.device_channel, &LcmBridge::OnDevice, this)->setQueueCapacity(1000);
+  lcm_.subscribe(config.command_channel, &LcmBridge::OnCommand, this)->setQueueCapacity(100);
+}
+
+void LcmBridge::OnDevice(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  device_input_t input{};
+  if (input.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) < 0) {
+    counters_.decode_errors.fetch_add(1);
+    return;
+  }
+  counters_.inputs_received.fetch_add(1);
+  const std::int64_t now = HapticLoop::NowNs();
+  const std::array<double, 3> position{input.position[0], input.position[1], input.position[2]};
+  const InputRejection verdict = guard_.Check(input.seq, position, now);
+  if (verdict != InputRejection::kAccepted) {
+    counters_.inputs_rejected.fetch_add(1);
+    counters_.rejected_by_kind[static_cast<int>(verdict)].fetch_add(1);
+    last_rejection_.store(static_cast<int>(verdict));
+    last_accepted_.latest_rejected = true;  // the primary flags it; the simulation keeps the last
+    loop_.input().Write(last_accepted_);
+    return;
+  }
+  last_accepted_ = {input.seq, now, position, false};
+  loop_.input().Write(last_accepted_);
+}
+
+void LcmBridge::OnCommand(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  command_t command{};
+  if (command.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) < 0) {
+    counters_.decode_errors.fetch_add(1);
+    return;
+  }
+  counters_.commands_received.fetch_add(1);
+  std::lock_guard lock(mutex_);
+  if (commands_.size() < 100) commands_.push_back(command);
+}
+
+void LcmBridge::PublishForces() {
+  ForceRecord record;
+  while (loop_.forces().Pop(&record)) {
+    force_feedback_t out{};
+    out.utime = record.utime_us;
+    out.seq = record.seq;
+    for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
+    out.error_percent = record.error_percent;
+    out.flags = record.flags;
+    if (record.seq >= 0) {  // nothing to answer before the first input
+      lcm_.publish(config_.force_channel, &out);
+      counters_.forces_published.fetch_add(1);
+    }
+  }
+}
+
+void LcmBridge::PostStatus(const status_t& status) {
+  std::lock_guard lock(mutex_);
+  status_ = status;
+}
+
+std::optional<command_t> LcmBridge::PopCommand() {
+  std::lock_guard lock(mutex_);
+  if (commands_.empty()) return std::nullopt;
+  command_t command = commands_.front();
+  commands_.pop_front();
+  return command;
+}
+
+InputRejection LcmBridge::TakeLastRejection() {
+  return static_cast<InputRejection>(last_rejection_.exchange(0));
+}
+
+void LcmBridge::Run(const std::atomic<bool>& stop) {
+  pollfd fd{lcm_.getFileno(), POLLIN, 0};
+  const timespec quarter_ms{0, 250'000};
+  while (!stop.load()) {
+    if (ppoll(&fd, 1, &quarter_ms, nullptr) > 0 && (fd.revents & POLLIN)) lcm_.handle();
+    PublishForces();
+    std::optional<status_t> status;
+    {
+      std::lock_guard lock(mutex_);
+      status.swap(status_);
+    }
+    if (status) lcm_.publish(config_.status_channel, &*status);
+  }
+  PublishForces();
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,373 @@
+// hapticsimd: the haptic force daemon. Device input in (LCM), force plus its looked-up error out
+// at the primary rate (1 kHz), on real-time threads; a supervisor that chooses a stable
+// configuration meeting the error target; systemd notify and watchdog.
+//
+//   hapticsimd [--config /etc/hapticsim/hapticsimd.toml] [--check-config] [--print-config]
+//
+// Signals: SIGTERM/SIGINT stop cleanly; SIGHUP reloads the error map (a bad one is refused and
+// the old one kept). Exit status: 0 clean stop, 2 bad configuration, 1 anything else.
+#include <signal.h>
+#include <spdlog/async.h>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/error_lookup.hpp"
+#include "core/error_map_file.hpp"
+#include "core/error_sweep.hpp"
+#include "daemon/daemon_config.hpp"
+#include "daemon/haptic_loop.hpp"
+#include "daemon/lcm_bridge.hpp"
+#include "daemon/supervisor.hpp"
+#include "daemon/systemd_notify.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr const char* kDefaultConfig = "/etc/hapticsim/hapticsimd.toml";
+
+struct Arguments {
+  std::string config = kDefaultConfig;
+  bool check_config = false;
+  bool print_config = false;
+  std::string lcm_url;
+  std::string error_map;
+  double duration_s = 0;
+};
+
+std::shared_ptr<spdlog::logger> MakeLogger(const std::string& level) {
+  spdlog::init_thread_pool(8192, 1);
+  auto sink = std::make_shared<spdlog::sinks::stderr_sink_mt>();
+  auto logger = std::make_shared<spdlog::async_logger>(
+      "hapticsimd", sink, spdlog::thread_pool(), spdlog::async_overflow_policy::overrun_oldest);
+  // systemd's journal adds its own time stamp; the level prefix lets journalctl -p filter.
+  logger->set_pattern("%^%l%$ %v");
+  logger->set_level(spdlog::level::from_str(level));
+  spdlog::set_default_logger(logger);
+  return logger;
+}
+
+// Collapses deadline misses into one line per burst: a burst ends after 200 ms without a miss.
+class MissLogger {
+ public:
+  MissLogger(std::string thread, double max_lines_per_s)
+      : thread_(std::move(thread)), min_gap_s_(1.0 / max_lines_per_s) {}
+
+  void Add(const DeadlineEvent& event) {
+    if (count_ == 0) first_ns_ = event.release_ns;
+    ++count_;
+    last_ns_ = event.release_ns;
+    worst_lateness_ns_ = std::max(worst_lateness_ns_, event.lateness_ns);
+    worst_execution_ns_ = std::max(worst_execution_ns_, event.execution_ns);
+  }
+
+  void Flush(std::int64_t now_ns, bool force = false) {
+    if (count_ == 0) return;
+    const bool quiet = now_ns - last_ns_ > 200'000'000;
+    const bool allowed = (now_ns - last_line_ns_) * 1e-9 >= min_gap_s_;
+    if (!(force || (quiet && allowed))) return;
+    spdlog::warn("deadline misses: {} thread, {} periods late over {:.1f} ms (worst wake-up "
+                 "lateness {:.0f} µs, worst compute {:.0f} µs)",
+                 thread_, count_, (last_ns_ - first_ns_) * 1e-6, worst_lateness_ns_ * 1e-3,
+                 worst_execution_ns_ * 1e-3);
+    count_ = 0;
+    worst_lateness_ns_ = worst_execution_ns_ = 0;
+    last_line_ns_ = now_ns;
+  }
+
+ private:
+  std::string thread_;
+  double min_gap_s_;
+  std::int64_t count_ = 0, first_ns_ = 0, last_ns_ = 0, last_line_ns_ = 0;
+  std::int64_t worst_lateness_ns_ = 0, worst_execution_ns_ = 0;
+};
+
+struct MapState {
+  std::string path;
+  std::unique_ptr<ErrorMap> map;
+};
+
+MapState LoadMap(const std::string& path) {
+  MapState state{path, nullptr};
+  if (path.empty()) return state;
+  try {
+    state.map = std::make_unique<ErrorMap>(LoadErrorMap(path));
+    spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
+                 state.map->provenance.grid, state.map->provenance.code_version);
+  } catch (const Error& e) {
+    spdlog::error("{}; running without an error map (forces carry error -1 and the no-map flag)",
+                  e.what());
+  }
+  return state;
+}
+
+std::int32_t DecisionFlags(const SupervisorDecision& d) {
+  std::int32_t flags = 0;
+  if (!d.have_map) flags |= force_flags::kNoErrorMap;
+  if (d.have_map && !d.target_met) flags |= force_flags::kErrorTargetExceeded;
+  if (d.clamped) flags |= force_flags::kLookupClamped;
+  return flags;
+}
+
+status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
+                    const SupervisorDecision& decision, double target, bool pinned,
+                    const std::string& map_path, const LcmCounters* counters) {
+  status_t s{};
+  s.utime = HapticLoop::NowNs() / 1000;
+  s.primary_size = decision.configuration.primary_size;
+  s.secondary_lod = decision.configuration.secondary_lod;
+  s.secondary_rate_hz = decision.configuration.secondary_rate_hz;
+  s.spectral_radius = decision.spectral_radius;
+  s.error_target_percent = target;
+  s.error_percent = decision.error_percent;
+  s.target_met = decision.target_met;
+  s.pinned = pinned;
+  s.error_map = decision.have_map ? map_path : "";
+  if (counters) {
+    s.inputs_received = counters->inputs_received.load();
+    s.inputs_rejected = counters->inputs_rejected.load();
+    s.decode_errors = counters->decode_errors.load();
+    s.forces_published = counters->forces_published.load();
+  }
+  s.stale_periods = loop.stale_periods();
+  const AsyncRegions& regions = loop.regions();
+  s.num_regions = regions.num_regions();
+  for (int r = 0; r < regions.num_regions(); ++r) {
+    const DeadlineSnapshot& d = snapshots[r];
+    region_status_t region{};
+    region.name = regions.partition().RegionName(r);
+    region.nodes = regions.partition().num_nodes(r);
+    region.rate_hz = regions.schedule(r).rate_hz;
+    region.substeps = regions.schedule(r).substeps;
+    region.critical_dt_s = regions.schedule(r).alone.critical_dt_s;
+    region.cycles = d.cycles;
+    region.deadline_misses = d.misses;
+    region.worst_lateness_us = d.worst_lateness_s * 1e6;
+    region.recent_lateness_us = d.recent_worst_lateness_s * 1e6;
+    region.execution_p50_us = d.recent_execution_p50_s * 1e6;
+    region.execution_p99_us = d.recent_execution_p99_s * 1e6;
+    region.execution_max_us = d.recent_execution_max_s * 1e6;
+    s.regions.push_back(region);
+  }
+  return s;
+}
+
+int Serve(const Arguments& args) {
+  DaemonConfig config;
+  const bool default_missing = args.config == kDefaultConfig && !std::filesystem::exists(args.config);
+  config = default_missing ? DefaultDaemonConfig() : LoadDaemonConfig(args.config);
+  if (!args.lcm_url.empty()) config.lcm_url = args.lcm_url;
+  if (!args.error_map.empty()) config.error_map = args.error_map;
+  ValidateDaemonConfig(config);
+  if (args.print_config || args.check_config) {
+    if (args.print_config) std::cout << FormatDaemonConfig(config);
+    if (args.check_config) {
+      std::cout << "hapticsimd: configuration "
+                << (default_missing ? "(built-in defaults; " + args.config + " does not exist)"
+                                    : args.config)
+                << " is valid\n";
+    }
+    return 0;
+  }
+
+  auto logger = MakeLogger(config.log_level);
+  spdlog::info("hapticsimd {} starting; config {}", CodeVersion(),
+               default_missing ? "built-in defaults (no " + args.config + ")" : args.config);
+  if (config.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    spdlog::warn("mlockall refused ({}; needs CAP_IPC_LOCK or LimitMEMLOCK=infinity): memory "
+                 "may be paged, running on",
+                 std::strerror(errno));
+  }
+  // Signals go to the supervisor loop below only: every thread started from here blocks them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  MapState map = LoadMap(config.error_map);
+  double target = config.error_target_percent;
+  std::optional<RegionConfiguration> pinned;
+  SupervisorDecision decision = ChooseConfiguration(config.scene, map.map.get(), target, pinned);
+  spdlog::info("configuration: {}", decision.reason);
+
+  HapticLoop::Options options;
+  options.stale_after_s = config.stale_after_s;
+  options.zero_force_when_stale = config.zero_force_when_stale;
+  options.max_force_n = config.max_force_n;
+  options.fifo_priority = config.fifo_priority;
+  options.cpus = config.cpus;
+  HapticLoop loop(SceneWith(config.scene, decision.configuration), options);
+  loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+
+  std::unique_ptr<LcmBridge> bridge;
+  if (config.lcm_enabled) {
+    bridge = std::make_unique<LcmBridge>(config, loop);
+    spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
+                 config.device_channel, config.force_channel, config.status_channel,
+                 config.command_channel);
+  }
+  const std::string refused = loop.Start();
+  if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
+  std::atomic<bool> stop_io{false};
+  std::thread io;
+  if (bridge) io = std::thread([&] { bridge->Run(stop_io); });
+
+  const SystemdNotifier systemd;
+  // Ready once the primary loop has run a period.
+  while (loop.monitor(kPrimaryRegion).last_done_ns() == 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  systemd.Notify("READY=1\nSTATUS=serving");
+  spdlog::info("serving: {} regions running", loop.regions().num_regions());
+
+  std::vector<MissLogger> miss_loggers;
+  for (int r = 0; r < loop.regions().num_regions(); ++r) {
+    miss_loggers.emplace_back(loop.regions().partition().RegionName(r), config.max_log_lines_per_s);
+  }
+  const std::int64_t start_ns = HapticLoop::NowNs();
+  std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
+  std::int64_t faults_seen = 0;
+  const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
+  const timespec tick{0, 20'000'000};
+  for (;;) {
+    siginfo_t info{};
+    const int signal = sigtimedwait(&signals, &info, &tick);
+    if (signal == SIGTERM || signal == SIGINT) {
+      spdlog::info("{}: stopping", signal == SIGTERM ? "SIGTERM" : "SIGINT");
+      break;
+    }
+    if (signal == SIGHUP) {
+      spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
+      MapState reloaded = LoadMap(config.error_map);
+      if (reloaded.map || config.error_map.empty()) {
+        map = std::move(reloaded);
+        decision = ChooseConfiguration(config.scene, map.map.get(), target, decision.configuration);
+        loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+      }
+    }
+    const std::int64_t now = HapticLoop::NowNs();
+    if (args.duration_s > 0 && (now - start_ns) * 1e-9 >= args.duration_s) {
+      spdlog::info("--duration {} s reached: stopping", args.duration_s);
+      break;
+    }
+    for (int r = 0; r < loop.regions().num_regions(); ++r) {
+      DeadlineEvent event;
+      while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event);
+      miss_loggers[r].Flush(now);
+    }
+    if (bridge) {
+      const InputRejection rejection = bridge->TakeLastRejection();
+      if (rejection != InputRejection::kAccepted) {
+        spdlog::warn("device input rejected: {} ({} rejected so far; the last accepted input "
+                     "stays in use)",
+                     InputRejectionName(rejection), bridge->counters().inputs_rejected.load());
+      }
+      while (std::optional<command_t> command = bridge->PopCommand()) {
+        switch (command->command) {
+          case command_t::SET_ERROR_TARGET:
+            if (!(std::isfinite(command->error_target_percent) &&
+                  command->error_target_percent > 0 && command->error_target_percent <= 100)) {
+              spdlog::warn("command SET_ERROR_TARGET {} refused: the target must be in (0, 100] %",
+                           command->error_target_percent);
+              break;
+            }
+            target = command->error_target_percent;
+            decision.target_met = decision.have_map && decision.error_percent <= target;
+            loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+            spdlog::info("error target set to {} %: the active configuration's {} % {}", target,
+                         decision.error_percent,
+                         decision.target_met ? "meets it" : "EXCEEDS it");
+            break;
+          case command_t::RESET:
+            spdlog::info("command RESET: the simulation restarts from rest");
+            loop.Stop();
+            loop.Start();
+            break;
+          default:
+            spdlog::warn("command {} refused: unknown or not supported by this version",
+                         command->command);
+        }
+      }
+    }
+    if (loop.force_faults() > faults_seen) {
+      faults_seen = loop.force_faults();
+      spdlog::error("force fault (non-finite or above input.max_force_n = {} N): zero force sent; "
+                    "resetting the simulation to rest",
+                    config.max_force_n);
+      loop.Stop();
+      loop.Start();
+    }
+    if (now >= next_status_ns) {
+      next_status_ns = now + static_cast<std::int64_t>(1e9 / config.status_rate_hz);
+      std::vector<DeadlineSnapshot> snapshots;
+      for (int r = 0; r < loop.regions().num_regions(); ++r) {
+        snapshots.push_back(loop.monitor(r).TakeSnapshot());
+      }
+      if (bridge) {
+        bridge->PostStatus(MakeStatus(loop, snapshots, decision, target, pinned.has_value(),
+                                      map.path, &bridge->counters()));
+      }
+    }
+    if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {
+      // Only while the primary loop is alive: a hung loop stops the pings and systemd restarts us.
+      const double since_primary = (now - loop.monitor(kPrimaryRegion).last_done_ns()) * 1e-9;
+      if (since_primary < std::max(0.1, 50 * primary_period_s)) {
+        systemd.Notify("WATCHDOG=1");
+        next_watchdog_ns = now + static_cast<std::int64_t>(systemd.watchdog_interval_s() * 0.5e9);
+      }
+    }
+  }
+  systemd.Notify("STOPPING=1");
+  stop_io = true;
+  if (io.joinable()) io.join();
+  loop.Stop();
+  for (auto& m : miss_loggers) m.Flush(HapticLoop::NowNs(), true);
+  spdlog::info("stopped cleanly");
+  logger->flush();
+  spdlog::shutdown();
+  return 0;
+}
+
+}  // namespace
+}  // namespace hapticsim
+
+int main(int argc, char** argv) {
+  hapticsim::Arguments args;
+  CLI::App app{"hapticsimd: the haptic force daemon — device input in, force and its looked-up "
+               "error out at 1 kHz (LCM, host-local by default: ttl=0)",
+               "hapticsimd"};
+  app.add_option("--config,-c", args.config, "Configuration file (TOML)")->capture_default_str();
+  app.add_flag("--check-config", args.check_config, "Validate the configuration and exit");
+  app.add_flag("--print-config", args.print_config, "Print the configuration in effect and exit");
+  app.add_option("--lcm-url", args.lcm_url, "Override lcm.url");
+  app.add_option("--error-map", args.error_map, "Override supervisor.error_map");
+  app.add_option("--duration", args.duration_s, "Stop after this many seconds (tests, soak)");
+  app.set_version_flag("--version", hapticsim::CodeVersion());
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    return hapticsim::Serve(args);
+  } catch (const hapticsim::Error& e) {
+    std::cerr << "hapticsimd: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "hapticsimd: internal error: " << e.what() << "\n";
+    return 1;
+  }
+}

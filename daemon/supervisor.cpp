@@ -1,0 +1,140 @@
+#include "daemon/supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "core/async_regions.hpp"
+#include "core/error.hpp"
+#include "core/error_lookup.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr int kLod = static_cast<int>(MapAxis::kSecondaryLod);
+constexpr int kSize = static_cast<int>(MapAxis::kPrimarySize);
+constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
+
+std::string Describe(const RegionConfiguration& c) {
+  std::ostringstream text;
+  text << "primary_size " << c.primary_size << ", secondary_lod " << c.secondary_lod
+       << ", secondary_rate " << c.secondary_rate_hz << " Hz";
+  return text.str();
+}
+
+// Coupled stability of a configuration on this scene; nullopt when the configuration is invalid.
+std::optional<double> CoupledRadius(const Scene& scene, const RegionConfiguration& c) {
+  try {
+    AsyncRegions regions(SceneWith(scene, c));
+    const CoupledStability stability = regions.EstimateCoupledStability();
+    return stability.stable ? std::optional<double>(stability.spectral_radius) : std::nullopt;
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+Scene SceneWith(const Scene& scene, const RegionConfiguration& c) {
+  Scene out = scene;
+  out.adaptivity.primary_size = c.primary_size;
+  out.adaptivity.secondary_lod = c.secondary_lod;
+  out.adaptivity.secondary_rate_hz = c.secondary_rate_hz;
+  return out;
+}
+
+SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
+                                       double target_percent,
+                                       const std::optional<RegionConfiguration>& pinned) {
+  struct Candidate {
+    RegionConfiguration configuration;
+    double error = -1, cost = 0;
+    bool clamped = false;
+  };
+  std::vector<Candidate> candidates;
+  if (map && map->grid) {
+    const ErrorLookup lookup(*map, ErrorField::kMagnitude);
+    // Mean measured cost of each configuration over the map's ok samples.
+    std::map<std::array<double, 3>, std::pair<double, int>> cost;
+    for (const MapSample& s : map->samples) {
+      if (s.status != SampleStatus::kOk) continue;
+      auto& entry = cost[{s.point[kLod], s.point[kSize], s.point[kRate]}];
+      entry.first += s.total_cost_us_per_ms();
+      entry.second += 1;
+    }
+    const MapPoint at = PointOfScene(scene);
+    for (double lod : map->axes[kLod]) {
+      for (double size : map->axes[kSize]) {
+        for (double rate : map->axes[kRate]) {
+          const RegionConfiguration c{static_cast<int>(lod), static_cast<int>(size), rate};
+          if (pinned && !(c == *pinned)) continue;
+          LookupQuery query = LookupQuery::At(at);
+          query.lo[kLod] = query.hi[kLod] = lod;
+          query.lo[kSize] = query.hi[kSize] = size;
+          query.lo[kRate] = query.hi[kRate] = rate;
+          const int amplitude = static_cast<int>(MapAxis::kAmplitude);
+          query.lo[amplitude] = map->axes[amplitude].front();
+          query.hi[amplitude] = map->axes[amplitude].back();
+          query.frequency_known = false;
+          const LookupResult result = lookup.Lookup(query);
+          if (!result.usable()) continue;  // predicted unstable or diverged in the map
+          const auto entry = cost.find({lod, size, rate});
+          const double mean_cost =
+              entry == cost.end() ? 1e9 : entry->second.first / entry->second.second;
+          candidates.push_back({c, result.error, mean_cost, result.clamped});
+        }
+      }
+    }
+  }
+  if (candidates.empty()) {  // no map, or nothing usable in it: the scene's own configuration
+    const RegionConfiguration own = pinned.value_or(RegionConfiguration{
+        scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
+        scene.adaptivity.secondary_rate_hz});
+    candidates.push_back({own, -1, 0, false});
+    if (!pinned) {
+      RegionConfiguration equal = own;
+      equal.secondary_rate_hz = PrimaryRateHz(scene);
+      if (!(equal == own)) candidates.push_back({equal, -1, 0, false});
+    }
+  }
+  const bool have_map = candidates.front().error >= 0;
+  // Cheapest first among those meeting the target; then the most accurate of the rest.
+  std::stable_sort(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
+    const bool a_meets = a.error >= 0 && a.error <= target_percent;
+    const bool b_meets = b.error >= 0 && b.error <= target_percent;
+    if (a_meets != b_meets) return a_meets;
+    if (a_meets) return a.cost < b.cost;
+    return a.error < b.error;
+  });
+  SupervisorDecision decision;
+  decision.have_map = have_map;
+  for (const Candidate& candidate : candidates) {
+    ++decision.stability_checks;
+    const std::optional<double> radius = CoupledRadius(scene, candidate.configuration);
+    if (!radius) continue;
+    decision.configuration = candidate.configuration;
+    decision.error_percent = candidate.error;
+    decision.cost_us_per_ms = candidate.cost;
+    decision.clamped = candidate.clamped;
+    decision.spectral_radius = *radius;
+    decision.target_met = have_map && candidate.error <= target_percent;
+    std::ostringstream reason;
+    reason << Describe(candidate.configuration) << ": coupled spectral radius " << *radius;
+    if (have_map) {
+      reason << ", looked-up error " << candidate.error << " % against the target "
+             << target_percent << " %" << (decision.target_met ? "" : " (TARGET EXCEEDED)")
+             << (candidate.clamped ? " (the scene is outside the map: clamped)" : "");
+    } else {
+      reason << ", no error map: the error is unknown";
+    }
+    decision.reason = reason.str();
+    return decision;
+  }
+  throw Error(pinned ? "the pinned configuration " + Describe(*pinned) +
+                           " is not stable on this scene"
+                     : "no stable configuration for this scene (checked " +
+                           std::to_string(decision.stability_checks) + ")");
+}
+
+}  // namespace hapticsim

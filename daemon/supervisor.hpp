@@ -1,0 +1,48 @@
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "core/error_map.hpp"
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/** An adaptive configuration the supervisor can choose. */
+struct RegionConfiguration {
+  int primary_size = 3;
+  int secondary_lod = 2;
+  double secondary_rate_hz = 1000;
+  bool operator==(const RegionConfiguration&) const = default;
+};
+
+struct SupervisorDecision {
+  RegionConfiguration configuration;
+  bool have_map = false;
+  double error_percent = -1;      ///< looked-up worst magnitude error, % (-1 without a map)
+  bool target_met = false;
+  bool clamped = false;           ///< the scene is outside the map on some axis
+  double spectral_radius = 0;     ///< coupled, verified before choosing
+  double cost_us_per_ms = 0;      ///< mean measured cost in the map (0 without a map)
+  int stability_checks = 0;       ///< candidates whose stability was estimated
+  std::string reason;             ///< one line for the log
+};
+
+/**
+ * Stability first: picks the cheapest configuration (by the map's measured cost) whose
+ * looked-up error meets `target_percent` and whose coupled regions are stable (estimated here,
+ * not only trusted from the map); when none meets the target, the stable one with the least
+ * error, target_met = false. The error is looked up for the scene's material with the input
+ * frequency and amplitude unknown (their worst case over the map). Without a map: the scene's own
+ * configuration if stable, else equal rates (always stable when the primary rate is).
+ * `pinned`: only that configuration (refused — an Error — if it is unstable).
+ * @throws Error when no stable configuration exists at all.
+ */
+SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
+                                       double target_percent,
+                                       const std::optional<RegionConfiguration>& pinned);
+
+/** The scene with `configuration` as its adaptivity. */
+Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration);
+
+}  // namespace hapticsim

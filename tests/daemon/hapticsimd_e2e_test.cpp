@@ -1,0 +1,230 @@
+// hapticsimd end to end on a real LCM bus: run only inside a private network namespace
+// (tests/support/in_private_netns.sh creates one: loopback up, a multicast route on it), so the
+// daemon's default udpm:// URL is used as in production and no packet leaves the namespace.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <functional>
+#include <thread>
+
+#include "hapticsim/command_t.hpp"
+#include "hapticsim/device_input_t.hpp"
+#include "hapticsim/force_feedback_t.hpp"
+#include "hapticsim/status_t.hpp"
+#include "tests/support/run_command.hpp"
+
+namespace hapticsim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kEdge = 0.25;  // the default cube
+
+std::string Temp(const std::string& name) { return ::testing::TempDir() + "hapticsimd_e2e_" + name; }
+
+// A one-configuration map for the default scene, made by the real sweep (about a second).
+const std::string& SmallMap() {
+  static const std::string path = [] {
+    const std::string grid = Temp("grid.toml"), map = Temp("map.hsmap");
+    std::ofstream(grid) << "[axes]\nsecondary_lod = [2]\nprimary_size = [3]\n"
+                           "secondary_rate = [1000.0]\nfrequency = [1.0]\n";
+    const auto result = testing::RunCommand(
+        {HAPTICSIM_CLI_PATH, "sweep", "--grid", grid, "--out", map, "--json"});
+    EXPECT_EQ(result.exit_status, 0) << result.err;
+    return map;
+  }();
+  return path;
+}
+
+// The client side: what a device driver and a monitoring tool see.
+class Client {
+ public:
+  Client() : lcm_("udpm://239.255.76.67:7667?ttl=0") {
+    EXPECT_TRUE(lcm_.good()) << "no LCM: is this running inside tests/support/in_private_netns.sh?";
+    lcm_.subscribe("HAPTIC_FORCE", &Client::OnForce, this);
+    lcm_.subscribe("HAPTIC_STATUS", &Client::OnStatus, this);
+    thread_ = std::thread([this] {
+      while (!stop_) lcm_.handleTimeout(10);
+    });
+  }
+  ~Client() {
+    stop_ = true;
+    thread_.join();
+  }
+
+  void Send(std::int64_t seq, double x, double y, double z) {
+    device_input_t input{};
+    input.utime = seq;
+    input.seq = seq;
+    input.position[0] = x, input.position[1] = y, input.position[2] = z;
+    lcm_.publish("HAPTIC_DEVICE", &input);
+  }
+  void SendRaw(const std::string& bytes) {
+    lcm_.publish("HAPTIC_DEVICE", bytes.data(), static_cast<unsigned>(bytes.size()));
+  }
+  void Command(const command_t& command) { lcm_.publish("HAPTIC_COMMAND", &command); }
+
+  std::vector<force_feedback_t> Forces() {
+    std::lock_guard lock(mutex_);
+    return forces_;
+  }
+  std::optional<status_t> LastStatus() {
+    std::lock_guard lock(mutex_);
+    return status_;
+  }
+  // Waits until `predicate(last status)` holds.
+  bool WaitForStatus(const std::function<bool(const status_t&)>& predicate, double timeout_s) {
+    const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+    while (Clock::now() < end) {
+      if (auto s = LastStatus(); s && predicate(*s)) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+ private:
+  void OnForce(const lcm::ReceiveBuffer*, const std::string&, const force_feedback_t* f) {
+    std::lock_guard lock(mutex_);
+    forces_.push_back(*f);
+  }
+  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t* s) {
+    std::lock_guard lock(mutex_);
+    status_ = *s;
+  }
+
+  lcm::LCM lcm_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  std::mutex mutex_;
+  std::vector<force_feedback_t> forces_;
+  std::optional<status_t> status_;
+};
+
+class HapticsimdEndToEnd : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string config = Temp("hapticsimd.toml");
+    std::ofstream(config) << "# the defaults, and a map\n[supervisor]\nerror_map = \"" << SmallMap()
+                          << "\"\nerror_target_percent = 7.0\n[lcm]\n"
+                             "url = \"udpm://239.255.76.67:7667?ttl=0\"\n";
+    daemon_ = std::make_unique<testing::BackgroundProcess>(
+        std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("daemon.log"));
+  }
+  std::unique_ptr<testing::BackgroundProcess> daemon_;
+};
+
+// Press into the object at the contact point at 1 kHz: 0.3 s above the surface, then 1 cm in.
+TEST_F(HapticsimdEndToEnd, AnswersDeviceInputWithForceErrorAndItsSeq) {
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 30))
+      << "no status from the daemon; its log:\n" << daemon_->Log();
+  std::set<std::int64_t> sent;
+  auto next = Clock::now();
+  for (std::int64_t seq = 1; seq <= 1300; ++seq) {
+    const double z = seq <= 300 ? -0.005 : 0.01 * std::min(1.0, (seq - 300) / 500.0);
+    client.Send(seq, kEdge / 2, kEdge / 2, z);
+    sent.insert(seq);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const std::vector<force_feedback_t> forces = client.Forces();
+  ASSERT_GT(forces.size(), 1000u) << daemon_->Log();
+  int in_contact = 0, pushing_back = 0;
+  for (const force_feedback_t& f : forces) {
+    EXPECT_TRUE(sent.count(f.seq)) << "a force answers seq " << f.seq << ", never sent";
+    EXPECT_TRUE(std::isfinite(f.force[0] + f.force[1] + f.force[2]));
+    EXPECT_GT(f.error_percent, 0.0);  // the looked-up error of the active configuration
+    EXPECT_FALSE(f.flags & force_feedback_t::FLAG_NO_ERROR_MAP);
+    if (f.seq <= 300) {
+      EXPECT_FALSE(f.flags & force_feedback_t::FLAG_IN_CONTACT) << f.seq;
+      EXPECT_EQ(f.force[2], 0.0) << "force out of contact at seq " << f.seq;
+    }
+    if (f.flags & force_feedback_t::FLAG_IN_CONTACT) ++in_contact;
+    if (f.seq > 1100 && f.force[2] < -0.5) ++pushing_back;  // 1 cm press: about 1.3 N back
+  }
+  EXPECT_GT(in_contact, 700);
+  EXPECT_GT(pushing_back, 100);
+  // Seqs come back in order.
+  for (size_t i = 1; i < forces.size(); ++i) EXPECT_GE(forces[i].seq, forces[i - 1].seq);
+
+  const std::optional<status_t> status = client.LastStatus();
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->num_regions, 2);
+  EXPECT_EQ(status->regions[0].name, "primary");
+  EXPECT_DOUBLE_EQ(status->regions[0].rate_hz, 1000.0);
+  EXPECT_GT(status->regions[0].cycles, 1000);
+  EXPECT_GT(status->regions[0].execution_p50_us, 0.0);
+  EXPECT_DOUBLE_EQ(status->error_target_percent, 7.0);
+  EXPECT_TRUE(status->target_met);
+  EXPECT_GE(status->inputs_received, 1300);
+  EXPECT_LT(status->spectral_radius, 1.0);
+
+  daemon_->Signal(SIGTERM);
+  EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
+  EXPECT_NE(daemon_->Log().find("stopped cleanly"), std::string::npos) << daemon_->Log();
+}
+
+TEST_F(HapticsimdEndToEnd, BadInputIsRejectedCountedAndTheDaemonKeepsServing) {
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 30)) << daemon_->Log();
+  for (std::int64_t seq = 1; seq <= 50; ++seq) {
+    client.Send(seq, kEdge / 2, kEdge / 2, 0.002);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  client.Send(51, NAN, kEdge / 2, 0.002);             // non-finite
+  client.Send(52, kEdge / 2, kEdge / 2, 5.0);         // far outside the workspace
+  client.Send(53, kEdge / 2 + 0.2, kEdge / 2, 0.002); // a jump no hand can make in 1 ms
+  client.Send(40, kEdge / 2, kEdge / 2, 0.002);       // an old seq
+  client.SendRaw("this is not an LCM message");
+  ASSERT_TRUE(client.WaitForStatus(
+      [](const status_t& s) { return s.inputs_rejected >= 4 && s.decode_errors >= 1; }, 5))
+      << daemon_->Log();
+  for (std::int64_t seq = 54; seq <= 300; ++seq) {
+    client.Send(seq, kEdge / 2, kEdge / 2, 0.002);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto forces = client.Forces();
+  ASSERT_FALSE(forces.empty());
+  EXPECT_EQ(forces.back().seq, 300) << "the daemon stopped answering after bad input";
+  for (const auto& f : forces) EXPECT_TRUE(std::isfinite(f.force[2]));
+  EXPECT_NE(daemon_->Log().find("device input rejected"), std::string::npos);
+}
+
+TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheFlagsFollow) {
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.target_met; }, 30))
+      << daemon_->Log();
+  command_t command{};
+  command.command = command_t::SET_ERROR_TARGET;
+  command.error_target_percent = 0.001;  // unreachable
+  client.Command(command);
+  ASSERT_TRUE(client.WaitForStatus(
+      [](const status_t& s) { return s.error_target_percent == 0.001 && !s.target_met; }, 5))
+      << daemon_->Log();
+  for (std::int64_t seq = 1; seq <= 100; ++seq) {
+    client.Send(seq, kEdge / 2, kEdge / 2, 0.001);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const auto forces = client.Forces();
+  ASSERT_FALSE(forces.empty());
+  EXPECT_TRUE(forces.back().flags & force_feedback_t::FLAG_ERROR_TARGET_EXCEEDED);
+  command.error_target_percent = -3;  // invalid: refused, target unchanged
+  client.Command(command);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(client.LastStatus()->error_target_percent, 0.001);
+}
+
+}  // namespace
+}  // namespace hapticsim
