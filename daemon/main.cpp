@@ -182,6 +182,12 @@ int Serve(const Arguments& args) {
     return 0;
   }
 
+  // Signals go to the supervisor loop below only: blocked before any thread (the logger's
+  // included) starts, so every thread inherits the mask and none takes the default action.
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   auto logger = MakeLogger(config.log_level);
   spdlog::info("hapticsimd {} starting; config {}", CodeVersion(),
                default_missing ? "built-in defaults (no " + args.config + ")" : args.config);
@@ -190,12 +196,6 @@ int Serve(const Arguments& args) {
                  "may be paged, running on",
                  std::strerror(errno));
   }
-  // Signals go to the supervisor loop below only: every thread started from here blocks them.
-  sigset_t signals;
-  sigemptyset(&signals);
-  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
   MapState map = LoadMap(config.error_map);
   double target = config.error_target_percent;
   std::optional<RegionConfiguration> pinned;

@@ -3,7 +3,12 @@
 // daemon's default udpm:// URL is used as in production and no packet leaves the namespace.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
 
 #include <atomic>
 #include <chrono>
@@ -224,6 +229,49 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheFlagsFollow) {
   client.Command(command);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->error_target_percent, 0.001);
+}
+
+// The systemd protocol without systemd: the test is the notify socket.
+TEST(HapticsimdSystemd, ReportsReadyPingsTheWatchdogWhileServingAndSaysWhenStopping) {
+  const std::string socket_path = Temp("notify.sock");
+  std::filesystem::remove(socket_path);
+  const int fd = socket(AF_UNIX, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::strncpy(address.sun_path, socket_path.c_str(), sizeof address.sun_path - 1);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  const timeval receive_timeout{0, 100'000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
+
+  const std::string config = Temp("no-lcm.toml");
+  std::ofstream(config) << "[lcm]\nenabled = false\n";
+  setenv("NOTIFY_SOCKET", socket_path.c_str(), 1);
+  setenv("WATCHDOG_USEC", "200000", 1);  // 0.2 s: pings every 0.1 s
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("systemd.log"));
+  unsetenv("NOTIFY_SOCKET");
+  unsetenv("WATCHDOG_USEC");
+
+  std::vector<std::string> messages;
+  auto receive_for = [&](double seconds, bool until_first = false) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    char buffer[256];
+    while (Clock::now() < end && !(until_first && !messages.empty())) {
+      const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+      if (n > 0) messages.emplace_back(buffer, static_cast<size_t>(n));
+    }
+  };
+  receive_for(25, true);  // startup estimates the configuration's stability first
+  ASSERT_FALSE(messages.empty()) << daemon.Log();
+  receive_for(1.5);  // then pings every 0.1 s
+  EXPECT_EQ(messages.front().rfind("READY=1", 0), 0u) << messages.front();
+  const auto pings = std::count(messages.begin(), messages.end(), "WATCHDOG=1");
+  EXPECT_GE(pings, 10) << daemon.Log();
+  daemon.Signal(SIGTERM);
+  receive_for(1);
+  EXPECT_EQ(daemon.Wait(5), 0);
+  EXPECT_EQ(messages.back(), "STOPPING=1");
+  close(fd);
 }
 
 }  // namespace

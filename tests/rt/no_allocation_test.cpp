@@ -97,3 +97,37 @@ TEST(ErrorLookup, NeverAllocates) {
 
 }  // namespace
 }  // namespace hapticsim
+
+#include "daemon/haptic_loop.hpp"
+
+namespace hapticsim {
+namespace {
+
+// hapticsimd's primary period (input slot → contact → step → force ring) on the default
+// configuration, in and out of contact, with stale input: never touches the heap.
+TEST(DaemonPrimaryPeriod, NeverAllocates) {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  HapticLoop loop(scene, HapticLoop::Options{});
+  std::int64_t now = HapticLoop::NowNs();
+  ForceRecord record;
+  int forces = 0;
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 600; ++n, now += 1'000'000) {
+    if (n < 400) {
+      const double z = n < 100 ? -0.002 : 0.01 * (n - 100) / 300.0;
+      loop.input().Write(DeviceSample{n, now, {0.125, 0.125, z}, false});
+    }  // then the input goes stale
+    loop.PrimaryPeriod(now);
+    for (int r = 1; r < loop.regions().num_regions(); ++r) {
+      const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+    }
+    while (loop.forces().Pop(&record)) ++forces;
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_EQ(forces, 600);
+  EXPECT_TRUE(record.flags & force_flags::kInputStale);
+}
+
+}  // namespace
+}  // namespace hapticsim

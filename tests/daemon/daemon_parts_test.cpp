@@ -1,0 +1,208 @@
+// hapticsimd's parts without a network: LCM encode/decode at the Release flags, the config file,
+// the input checks, the deadline bookkeeping and the lock-free hand-overs between threads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include "core/error.hpp"
+#include "daemon/daemon_config.hpp"
+#include "daemon/deadline_monitor.hpp"
+#include "daemon/haptic_loop.hpp"
+#include "daemon/input_guard.hpp"
+#include "daemon/seqlock_slot.hpp"
+#include "daemon/spsc_ring.hpp"
+#include "hapticsim/command_t.hpp"
+#include "hapticsim/device_input_t.hpp"
+#include "hapticsim/force_feedback_t.hpp"
+#include "hapticsim/status_t.hpp"
+
+namespace hapticsim {
+namespace {
+
+template <typename T>
+T RoundTrip(const T& message) {
+  std::vector<std::uint8_t> buffer(static_cast<size_t>(message.getEncodedSize()));
+  EXPECT_EQ(message.encode(buffer.data(), 0, static_cast<int>(buffer.size())),
+            static_cast<int>(buffer.size()));
+  T back{};
+  EXPECT_EQ(back.decode(buffer.data(), 0, static_cast<int>(buffer.size())),
+            static_cast<int>(buffer.size()));
+  return back;
+}
+
+// The LCM notes: g++ 12 at -O2/-O3 can decode doubles as 0 unless -fno-strict-aliasing.
+TEST(LcmTypes, EveryTypeSurvivesEncodeAndDecodeWithItsFloatingPointValues) {
+  device_input_t input{};
+  input.utime = 123456789, input.seq = 42;
+  input.position[0] = 0.125, input.position[1] = -1.5e-3, input.position[2] = 0.0101;
+  const device_input_t input_back = RoundTrip(input);
+  EXPECT_EQ(input_back.seq, 42);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(input_back.position[c], input.position[c]);
+
+  force_feedback_t force{};
+  force.seq = 7, force.force[2] = -1.486, force.error_percent = 2.5, force.flags = 5;
+  const force_feedback_t force_back = RoundTrip(force);
+  EXPECT_EQ(force_back.force[2], -1.486);
+  EXPECT_EQ(force_back.error_percent, 2.5);
+  EXPECT_EQ(force_back.flags, 5);
+
+  status_t status{};
+  status.secondary_rate_hz = 600, status.spectral_radius = 0.9895, status.error_map = "m.hsmap";
+  status.num_regions = 2;
+  status.regions.resize(2);
+  status.regions[1].name = "secondary";
+  status.regions[1].execution_p99_us = 213.5;
+  const status_t status_back = RoundTrip(status);
+  EXPECT_EQ(status_back.spectral_radius, 0.9895);
+  EXPECT_EQ(status_back.regions[1].name, "secondary");
+  EXPECT_EQ(status_back.regions[1].execution_p99_us, 213.5);
+
+  command_t command{};
+  command.command = command_t::SET_ERROR_TARGET, command.error_target_percent = 3.25;
+  EXPECT_EQ(RoundTrip(command).error_target_percent, 3.25);
+}
+
+TEST(LcmTypes, TheDaemonsForceFlagsAreTheMessageConstants) {
+  EXPECT_EQ(force_flags::kInContact, force_feedback_t::FLAG_IN_CONTACT);
+  EXPECT_EQ(force_flags::kErrorTargetExceeded, force_feedback_t::FLAG_ERROR_TARGET_EXCEEDED);
+  EXPECT_EQ(force_flags::kLookupClamped, force_feedback_t::FLAG_LOOKUP_CLAMPED);
+  EXPECT_EQ(force_flags::kInputStale, force_feedback_t::FLAG_INPUT_STALE);
+  EXPECT_EQ(force_flags::kReconfiguring, force_feedback_t::FLAG_RECONFIGURING);
+  EXPECT_EQ(force_flags::kNoErrorMap, force_feedback_t::FLAG_NO_ERROR_MAP);
+  EXPECT_EQ(force_flags::kInputRejected, force_feedback_t::FLAG_INPUT_REJECTED);
+}
+
+std::string ConfigError(const std::string& text) {
+  const std::string path = ::testing::TempDir() + "hapticsimd_config_test.toml";
+  std::ofstream(path) << text;
+  try {
+    LoadDaemonConfig(path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DaemonConfig, DefaultsAreValidHostLocalAndRoundTrip) {
+  const DaemonConfig defaults = DefaultDaemonConfig();
+  EXPECT_NO_THROW(ValidateDaemonConfig(defaults));
+  EXPECT_NE(defaults.lcm_url.find("ttl=0"), std::string::npos);
+  const std::string path = ::testing::TempDir() + "hapticsimd_config_roundtrip.toml";
+  std::ofstream(path) << FormatDaemonConfig(defaults);
+  const DaemonConfig back = LoadDaemonConfig(path);
+  EXPECT_EQ(FormatDaemonConfig(back), FormatDaemonConfig(defaults));
+}
+
+TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
+  EXPECT_NE(ConfigError("[supervisor]\nerror_target = 5\n").find(":2: unknown key supervisor.error_target"),
+            std::string::npos)
+      << ConfigError("[supervisor]\nerror_target = 5\n");
+  EXPECT_NE(ConfigError("[supervisor]\nerror_target_percent = 0\n")
+                .find("supervisor.error_target_percent must be in (0, 100]"),
+            std::string::npos);
+  EXPECT_NE(ConfigError("[input]\nstale_after_s = \"soon\"\n").find("input.stale_after_s must be a number"),
+            std::string::npos);
+  EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 120\n").find("realtime.fifo_priority"),
+            std::string::npos);
+  EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find("hapticsimd_config_test.toml:1"), std::string::npos)
+      << ConfigError("[lcm\nurl = 3\n");
+}
+
+TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {
+  InputGuard guard(MeshSettings{}, 0.1, 5.0);
+  const std::int64_t ms = 1'000'000;
+  EXPECT_EQ(guard.Check(1, {0.125, 0.125, 0.0}, 0), InputRejection::kAccepted);
+  EXPECT_EQ(guard.Check(2, {0.125, 0.125, 0.001}, ms), InputRejection::kAccepted);  // 1 m/s
+  EXPECT_EQ(guard.Check(3, {NAN, 0.125, 0.0}, 2 * ms), InputRejection::kNonFinite);
+  EXPECT_EQ(guard.Check(3, {0.125, 0.125, INFINITY}, 2 * ms), InputRejection::kNonFinite);
+  EXPECT_EQ(guard.Check(3, {0.125, 0.125, 0.5}, 2 * ms), InputRejection::kOutsideWorkspace);
+  EXPECT_EQ(guard.Check(3, {0.125, 0.145, 0.001}, 2 * ms), InputRejection::kJump);  // 20 m/s
+  EXPECT_EQ(guard.Check(2, {0.125, 0.125, 0.001}, 2 * ms), InputRejection::kOldSequence);
+  EXPECT_EQ(guard.Check(5, {0.125, 0.125, 0.002}, 3 * ms), InputRejection::kAccepted);
+  EXPECT_EQ(guard.sequence_gaps(), 1);
+  // After a pause the same jump is a plausible move.
+  EXPECT_EQ(guard.Check(6, {0.125, 0.145, 0.002}, 1000 * ms), InputRejection::kAccepted);
+}
+
+TEST(DeadlineMonitor, CountsMissesAndReportsExecutionPercentiles) {
+  DeadlineMonitor monitor(1e-3);
+  std::int64_t t = 0;
+  for (int i = 0; i < 1000; ++i, t += 1'000'000) {
+    const std::int64_t execution = i < 990 ? 20'000 : 400'000;  // 20 µs, 1 % at 400 µs
+    monitor.Record(t, t + 5'000, t + 5'000 + execution);
+  }
+  monitor.Record(t, t + 1'500'000, t + 1'520'000);  // woke 1.5 ms late: a miss
+  const DeadlineSnapshot s = monitor.TakeSnapshot();
+  EXPECT_EQ(s.cycles, 1001);
+  EXPECT_EQ(s.misses, 1);
+  EXPECT_NEAR(s.worst_lateness_s, 1.5e-3, 1e-9);
+  EXPECT_GE(s.recent_execution_p50_s, 20e-6);
+  EXPECT_LE(s.recent_execution_p50_s, 20e-6 * 1.25);
+  EXPECT_GE(s.recent_execution_p99_s, 20e-6);
+  EXPECT_NEAR(s.recent_execution_max_s, 400e-6, 1e-9);
+  DeadlineEvent event;
+  ASSERT_TRUE(monitor.PopEvent(&event));
+  EXPECT_EQ(event.lateness_ns, 1'500'000);
+  EXPECT_FALSE(monitor.PopEvent(&event));
+  EXPECT_EQ(monitor.TakeSnapshot().recent_cycles, 0);  // the window restarts
+}
+
+// A record whose fields must always agree: a torn read would break the relation.
+struct Checked {
+  std::int64_t a = 0, b = 0, c = 0;
+};
+
+TEST(SeqlockSlot, ReadersNeverSeeATornValue) {
+  SeqlockSlot<Checked> slot;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    for (std::int64_t i = 1; i <= 2'000'000; ++i) slot.Write({i, 2 * i, 3 * i});
+    done = true;
+  });
+  std::int64_t reads = 0, last = 0;
+  while (!done) {
+    Checked value;
+    if (slot.TryRead(&value)) {
+      ++reads;
+      ASSERT_EQ(value.b, 2 * value.a);
+      ASSERT_EQ(value.c, 3 * value.a);
+      ASSERT_GE(value.a, last);  // never older than what was seen
+      last = value.a;
+    }
+  }
+  writer.join();
+  EXPECT_GT(reads, 0);
+}
+
+TEST(SpscRing, DeliversInOrderAndCountsWhatAFullRingDrops) {
+  SpscRing<Checked, 1024> ring;
+  std::atomic<bool> done{false};
+  constexpr std::int64_t kCount = 1'000'000;
+  std::thread producer([&] {
+    for (std::int64_t i = 1; i <= kCount; ++i) {
+      while (!ring.Push({i, 2 * i, 3 * i})) {
+      }
+    }
+    done = true;
+  });
+  std::int64_t expected = 1;
+  Checked value;
+  while (expected <= kCount) {
+    if (ring.Pop(&value)) {
+      ASSERT_EQ(value.a, expected);
+      ASSERT_EQ(value.c, 3 * expected);
+      ++expected;
+    }
+  }
+  producer.join();
+  SpscRing<Checked, 2> small;
+  EXPECT_TRUE(small.Push({}));
+  EXPECT_TRUE(small.Push({}));
+  EXPECT_FALSE(small.Push({}));
+  EXPECT_EQ(small.dropped(), 1u);
+}
+
+}  // namespace
+}  // namespace hapticsim
