@@ -48,6 +48,9 @@ const std::map<std::string, Setter>& Setters() {
     text("lcm.force_channel", &DaemonConfig::force_channel);
     text("lcm.status_channel", &DaemonConfig::status_channel);
     text("lcm.command_channel", &DaemonConfig::command_channel);
+    flag("shm.enabled", &DaemonConfig::shm_enabled);
+    text("shm.name", &DaemonConfig::shm_name);
+    text("shm.group", &DaemonConfig::shm_group);
     text("supervisor.error_map", &DaemonConfig::error_map);
     real("supervisor.error_target_percent", &DaemonConfig::error_target_percent);
     real("supervisor.status_rate_hz", &DaemonConfig::status_rate_hz);
@@ -118,6 +121,9 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
+  require(c.shm_name.size() > 1 && c.shm_name[0] == '/' &&
+              c.shm_name.find('/', 1) == std::string::npos,
+          "shm.name must be '/' and a name, e.g. \"/hapticsim\"");
   require(c.lcm_url.find("://") != std::string::npos,
           "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq://");
   require(c.scene.adaptivity.enabled(),
@@ -183,6 +189,9 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "force_channel = " << quote(c.force_channel) << "\n"
       << "status_channel = " << quote(c.status_channel) << "\n"
       << "command_channel = " << quote(c.command_channel) << "\n\n"
+      << "[shm]\nenabled = " << (c.shm_enabled ? "true" : "false") << "\n"
+      << "name = " << quote(c.shm_name) << "\n"
+      << "group = " << quote(c.shm_group) << "  # the driver's group; mode 0660\n\n"
       << "[supervisor]\nerror_map = " << quote(c.error_map) << "\n"
       << "error_target_percent = " << real(c.error_target_percent) << "\n"
       << "status_rate_hz = " << real(c.status_rate_hz) << "\n\n"

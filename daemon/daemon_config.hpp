@@ -23,6 +23,10 @@ struct DaemonConfig {
   std::string force_channel = "HAPTIC_FORCE";
   std::string status_channel = "HAPTIC_STATUS";
   std::string command_channel = "HAPTIC_COMMAND";
+  // [shm]
+  bool shm_enabled = false;            ///< the shared-memory interface for a local driver
+  std::string shm_name = "/hapticsim";  ///< POSIX shm name (/dev/shm/hapticsim)
+  std::string shm_group;               ///< group the driver runs in (empty: the daemon's own)
   // [supervisor]
   std::string error_map;              ///< map file (empty: none; the error is reported as -1)
   double error_target_percent = 7.0;  ///< the force-magnitude JND

@@ -9,7 +9,7 @@
 
 #include "core/async_regions.hpp"
 #include "daemon/deadline_monitor.hpp"
-#include "daemon/seqlock_slot.hpp"
+#include "core/seqlock_slot.hpp"
 #include "daemon/spsc_ring.hpp"
 
 namespace hapticsim {

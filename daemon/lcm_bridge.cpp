@@ -8,9 +8,10 @@
 
 namespace hapticsim {
 
-LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop)
+LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters)
     : config_(config),
       loop_(loop),
+      counters_(counters),
       lcm_(config.lcm_url),
       guard_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s) {
   if (!lcm_.good()) {
@@ -33,9 +34,7 @@ void LcmBridge::OnDevice(const lcm::ReceiveBuffer* buffer, const std::string&) {
   const std::array<double, 3> position{input.position[0], input.position[1], input.position[2]};
   const InputRejection verdict = guard_.Check(input.seq, position, now);
   if (verdict != InputRejection::kAccepted) {
-    counters_.inputs_rejected.fetch_add(1);
-    counters_.rejected_by_kind[static_cast<int>(verdict)].fetch_add(1);
-    last_rejection_.store(static_cast<int>(verdict));
+    counters_.Reject(verdict);
     last_accepted_.latest_rejected = true;  // the primary flags it; the simulation keeps the last
     loop_.input().Write(last_accepted_);
     return;
@@ -55,20 +54,16 @@ void LcmBridge::OnCommand(const lcm::ReceiveBuffer* buffer, const std::string&) 
   if (commands_.size() < 100) commands_.push_back(command);
 }
 
-void LcmBridge::PublishForces() {
-  ForceRecord record;
-  while (loop_.forces().Pop(&record)) {
-    force_feedback_t out{};
-    out.utime = record.utime_us;
-    out.seq = record.seq;
-    for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
-    out.error_percent = record.error_percent;
-    out.flags = record.flags;
-    if (record.seq >= 0) {  // nothing to answer before the first input
-      lcm_.publish(config_.force_channel, &out);
-      counters_.forces_published.fetch_add(1);
-    }
-  }
+void LcmBridge::Publish(const ForceRecord& record) {
+  if (record.seq < 0) return;  // nothing to answer before the first input
+  force_feedback_t out{};
+  out.utime = record.utime_us;
+  out.seq = record.seq;
+  for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
+  out.error_percent = record.error_percent;
+  out.flags = record.flags;
+  lcm_.publish(config_.force_channel, &out);
+  counters_.forces_published.fetch_add(1);
 }
 
 void LcmBridge::PostStatus(const status_t& status) {
@@ -84,24 +79,18 @@ std::optional<command_t> LcmBridge::PopCommand() {
   return command;
 }
 
-InputRejection LcmBridge::TakeLastRejection() {
-  return static_cast<InputRejection>(last_rejection_.exchange(0));
+void LcmBridge::Poll(const timespec& timeout) {
+  pollfd fd{lcm_.getFileno(), POLLIN, 0};
+  if (ppoll(&fd, 1, &timeout, nullptr) > 0 && (fd.revents & POLLIN)) lcm_.handle();
 }
 
-void LcmBridge::Run(const std::atomic<bool>& stop) {
-  pollfd fd{lcm_.getFileno(), POLLIN, 0};
-  const timespec quarter_ms{0, 250'000};
-  while (!stop.load()) {
-    if (ppoll(&fd, 1, &quarter_ms, nullptr) > 0 && (fd.revents & POLLIN)) lcm_.handle();
-    PublishForces();
-    std::optional<status_t> status;
-    {
-      std::lock_guard lock(mutex_);
-      status.swap(status_);
-    }
-    if (status) lcm_.publish(config_.status_channel, &*status);
+void LcmBridge::PublishPendingStatus() {
+  std::optional<status_t> status;
+  {
+    std::lock_guard lock(mutex_);
+    status.swap(status_);
   }
-  PublishForces();
+  if (status) lcm_.publish(config_.status_channel, &*status);
 }
 
 }  // namespace hapticsim

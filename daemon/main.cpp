@@ -29,7 +29,9 @@
 #include "core/error_sweep.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
+#include "daemon/input_counters.hpp"
 #include "daemon/lcm_bridge.hpp"
+#include "daemon/shm_server.hpp"
 #include "daemon/supervisor.hpp"
 #include "daemon/systemd_notify.hpp"
 
@@ -123,7 +125,7 @@ std::int32_t DecisionFlags(const SupervisorDecision& d) {
 
 status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
                     const SupervisorDecision& decision, double target, bool pinned,
-                    const std::string& map_path, const LcmCounters* counters) {
+                    const std::string& map_path, const InputCounters* counters) {
   status_t s{};
   s.utime = HapticLoop::NowNs() / 1000;
   s.primary_size = decision.configuration.primary_size;
@@ -211,18 +213,44 @@ int Serve(const Arguments& args) {
   HapticLoop loop(SceneWith(config.scene, decision.configuration), options);
   loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
 
+  InputCounters counters;
   std::unique_ptr<LcmBridge> bridge;
   if (config.lcm_enabled) {
-    bridge = std::make_unique<LcmBridge>(config, loop);
+    bridge = std::make_unique<LcmBridge>(config, loop, counters);
     spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
                  config.device_channel, config.force_channel, config.status_channel,
                  config.command_channel);
   }
+  std::unique_ptr<ShmServer> shm;
+  if (config.shm_enabled) {
+    shm = std::make_unique<ShmServer>(config.shm_name, config.shm_group, config.scene.mesh,
+                                      config.workspace_margin_m, config.max_speed_m_per_s, loop,
+                                      counters);
+    spdlog::info("shared memory /dev/shm{} (mode 0660{})", config.shm_name,
+                 config.shm_group.empty() ? "" : ", group " + config.shm_group);
+  }
+  if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");
   const std::string refused = loop.Start();
   if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
   std::atomic<bool> stop_io{false};
-  std::thread io;
-  if (bridge) io = std::thread([&] { bridge->Run(stop_io); });
+  // The I/O thread: everything that may block, at most 0.25 ms behind the primary thread.
+  std::thread io([&] {
+    const timespec quarter_ms{0, 250'000};
+    ForceRecord record;
+    while (!stop_io.load()) {
+      if (bridge) {
+        bridge->Poll(quarter_ms);
+      } else {
+        nanosleep(&quarter_ms, nullptr);
+      }
+      if (shm) shm->PollInput();
+      while (loop.forces().Pop(&record)) {
+        if (bridge) bridge->Publish(record);
+        if (shm) shm->Publish(record);
+      }
+      if (bridge) bridge->PublishPendingStatus();
+    }
+  });
 
   const SystemdNotifier systemd;
   // Ready once the primary loop has run a period.
@@ -267,13 +295,13 @@ int Serve(const Arguments& args) {
       while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event);
       miss_loggers[r].Flush(now);
     }
+    const auto rejection = static_cast<InputRejection>(counters.last_rejection.exchange(0));
+    if (rejection != InputRejection::kAccepted) {
+      spdlog::warn("device input rejected: {} ({} rejected so far; the last accepted input "
+                   "stays in use)",
+                   InputRejectionName(rejection), counters.inputs_rejected.load());
+    }
     if (bridge) {
-      const InputRejection rejection = bridge->TakeLastRejection();
-      if (rejection != InputRejection::kAccepted) {
-        spdlog::warn("device input rejected: {} ({} rejected so far; the last accepted input "
-                     "stays in use)",
-                     InputRejectionName(rejection), bridge->counters().inputs_rejected.load());
-      }
       while (std::optional<command_t> command = bridge->PopCommand()) {
         switch (command->command) {
           case command_t::SET_ERROR_TARGET:
@@ -317,7 +345,7 @@ int Serve(const Arguments& args) {
       }
       if (bridge) {
         bridge->PostStatus(MakeStatus(loop, snapshots, decision, target, pinned.has_value(),
-                                      map.path, &bridge->counters()));
+                                      map.path, &counters));
       }
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {

@@ -11,7 +11,7 @@
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
-#include "daemon/seqlock_slot.hpp"
+#include "core/seqlock_slot.hpp"
 #include "daemon/spsc_ring.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"

@@ -3,7 +3,10 @@
 // daemon's default udpm:// URL is used as in production and no packet leaves the namespace.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -229,6 +232,61 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheFlagsFollow) {
   client.Command(command);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->error_target_percent, 0.001);
+}
+
+// The shared-memory interface with a real second process: the example driver client.
+TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
+  const std::string name = "/hapticsim-e2e-" + std::to_string(getpid());
+  const std::string config = Temp("shm.toml");
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+                        << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm.log"));
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
+    ASSERT_TRUE(daemon.running()) << daemon.Log();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  struct stat info {};
+  ASSERT_EQ(stat(("/dev/shm" + name).c_str(), &info), 0);
+  EXPECT_EQ(info.st_mode & 0777, 0660u) << "owner and group only";
+
+  const auto result = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name,
+                                           "--duration", "2"});
+  ASSERT_EQ(result.exit_status, 0) << result.err;
+  const std::string& json = result.out;
+  auto number = [&json](const std::string& key) {
+    const size_t at = json.find("\"" + key + "\": ");
+    EXPECT_NE(at, std::string::npos) << key;
+    return std::stod(json.substr(at + key.size() + 4));
+  };
+  // Two free-running 1 kHz clocks: the primary answers the newest input at each of its periods,
+  // so an input that arrives just after another within one period is superseded. Measured:
+  // 1961 of 2000 on an idle machine, about 1600 with both cores busy.
+  EXPECT_GE(number("distinct_seqs_answered"), 1400) << json;  // of 2000 periods
+  EXPECT_LE(number("max_lag_periods"), 20) << json;
+  EXPECT_EQ(number("out_of_order"), 0) << json;
+  EXPECT_EQ(number("nonfinite_forces"), 0) << json;
+  EXPECT_GT(number("in_contact_periods"), 1000) << json;
+  EXPECT_GT(number("max_push_back_N"), 1.0) << json;  // a 1 cm press pushes back about 1.4 N
+
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  EXPECT_NE(stat(("/dev/shm" + name).c_str(), &info), 0) << "the segment outlived the daemon";
+  const auto after = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name});
+  EXPECT_EQ(after.exit_status, 2);
+  EXPECT_NE(after.err.find("cannot open shared memory"), std::string::npos) << after.err;
+}
+
+TEST(HapticsimdSharedMemory, AClientRefusesASegmentThatIsNotHapticsimds) {
+  const std::string name = "/hapticsim-foreign-" + std::to_string(getpid());
+  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(ftruncate(fd, 4096), 0);
+  close(fd);
+  const auto wrong_size = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name});
+  EXPECT_EQ(wrong_size.exit_status, 2);
+  EXPECT_NE(wrong_size.err.find("bytes; this client expects"), std::string::npos) << wrong_size.err;
+  shm_unlink(name.c_str());
 }
 
 // The systemd protocol without systemd: the test is the notify socket.

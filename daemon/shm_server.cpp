@@ -1,0 +1,46 @@
+#include "daemon/shm_server.hpp"
+
+namespace hapticsim {
+
+ShmServer::ShmServer(const std::string& name, const std::string& group, const MeshSettings& mesh,
+                     double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
+                     InputCounters& counters)
+    : mapping_(shm::MappedSegment::Create(name, group)),
+      loop_(loop),
+      counters_(counters),
+      guard_(mesh, workspace_margin_m, max_speed_m_per_s) {}
+
+void ShmServer::PollInput() {
+  shm::ShmDeviceInput input;
+  // No consistent value (nothing written yet, or a writer died mid-write): nothing new; the
+  // primary thread sees the last input age and flags it stale.
+  if (!mapping_.segment().input.Read(&input) || input.seq == last_seq_seen_) return;
+  last_seq_seen_ = input.seq;
+  counters_.inputs_received.fetch_add(1);
+  const std::int64_t now = HapticLoop::NowNs();
+  const std::array<double, 3> position{input.position_m[0], input.position_m[1],
+                                       input.position_m[2]};
+  const InputRejection verdict = guard_.Check(input.seq, position, now);
+  if (verdict != InputRejection::kAccepted) {
+    counters_.Reject(verdict);
+    last_accepted_.latest_rejected = true;
+    loop_.input().Write(last_accepted_);
+    return;
+  }
+  last_accepted_ = {input.seq, now, position, false};
+  loop_.input().Write(last_accepted_);
+}
+
+void ShmServer::Publish(const ForceRecord& record) {
+  shm::ShmForceOutput out;
+  out.seq = record.seq;
+  out.utime = record.utime_us;
+  for (int c = 0; c < 3; ++c) out.force_n[c] = record.force_n[c];
+  out.error_percent = record.error_percent;
+  out.flags = record.flags;
+  mapping_.segment().output.Write(out);
+  mapping_.segment().header.daemon_heartbeat_ns.store(record.utime_us * 1000,
+                                                      std::memory_order_relaxed);
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,35 @@
+#pragma once
+
+#include "daemon/haptic_loop.hpp"
+#include "daemon/input_counters.hpp"
+#include "daemon/input_guard.hpp"
+#include "ipc/shm_segment.hpp"
+
+namespace hapticsim {
+
+/**
+ * The shared-memory side of the I/O thread: creates the segment (ipc/shm_layout.hpp), takes each
+ * new device input from it (checked like LCM input), and writes every force back. Only the I/O
+ * thread calls PollInput and Publish.
+ */
+class ShmServer {
+ public:
+  /** @throws Error when the segment cannot be created (the message says what to check). */
+  ShmServer(const std::string& name, const std::string& group, const MeshSettings& mesh,
+            double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
+            InputCounters& counters);
+
+  void PollInput();
+  void Publish(const ForceRecord& record);
+  const std::string& name() const { return mapping_.name(); }
+
+ private:
+  shm::MappedSegment mapping_;
+  HapticLoop& loop_;
+  InputCounters& counters_;
+  InputGuard guard_;
+  std::int64_t last_seq_seen_ = -1;
+  DeviceSample last_accepted_;
+};
+
+}  // namespace hapticsim

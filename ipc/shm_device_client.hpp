@@ -1,0 +1,43 @@
+#pragma once
+
+// The client library for device-driver writers: talk to hapticsimd through shared memory.
+//
+//   hapticsim::shm::ShmDeviceClient client;              // opens "/hapticsim", checks it
+//   client.WriteInput(seq, utime_us, {x, y, z});          // every device period (1 kHz)
+//   hapticsim::shm::ShmForceOutput force;
+//   if (client.ReadForce(&force) && force.seq == seq) { /* render force.force_n */ }
+//
+// Both calls are wait-free: no locks, no allocation, no system calls. Link hapticsim_ipc.
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "ipc/shm_segment.hpp"
+
+namespace hapticsim::shm {
+
+class ShmDeviceClient {
+ public:
+  /** @throws Error when the segment is missing or not a compatible hapticsimd segment. */
+  explicit ShmDeviceClient(const std::string& name = kDefaultName)
+      : mapping_(MappedSegment::Open(name)) {}
+
+  /** The tool tip (object frame, m). Only one process may write: this is a single-writer slot. */
+  void WriteInput(std::int64_t seq, std::int64_t utime_us, const std::array<double, 3>& position_m) {
+    ShmDeviceInput input;
+    input.seq = seq;
+    input.utime = utime_us;
+    for (int c = 0; c < 3; ++c) input.position_m[c] = position_m[c];
+    mapping_.segment().input.Write(input);
+  }
+  /** The newest force; false when none is available consistently yet. */
+  bool ReadForce(ShmForceOutput* out) const { return mapping_.segment().output.Read(out); }
+  /** True while the daemon that created the segment runs. */
+  bool DaemonRunning() { return mapping_.segment().header.daemon_pid.load() != 0; }
+
+ private:
+  MappedSegment mapping_;
+};
+
+}  // namespace hapticsim::shm
