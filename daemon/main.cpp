@@ -266,7 +266,7 @@ int Serve(const Arguments& args) {
   }
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
-  std::int64_t faults_seen = 0;
+  std::int64_t faults_seen = 0, last_rejection_line_ns = 0;
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
   const timespec tick{0, 20'000'000};
   for (;;) {
@@ -295,8 +295,13 @@ int Serve(const Arguments& args) {
       while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event);
       miss_loggers[r].Flush(now);
     }
-    const auto rejection = static_cast<InputRejection>(counters.last_rejection.exchange(0));
+    // Rejections: at most log.max_lines_per_s lines; the counts are in every status message.
+    const bool may_log = (now - last_rejection_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
+    const auto rejection = may_log
+                               ? static_cast<InputRejection>(counters.last_rejection.exchange(0))
+                               : InputRejection::kAccepted;
     if (rejection != InputRejection::kAccepted) {
+      last_rejection_line_ns = now;
       spdlog::warn("device input rejected: {} ({} rejected so far; the last accepted input "
                    "stays in use)",
                    InputRejectionName(rejection), counters.inputs_rejected.load());

@@ -9,7 +9,8 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev
-  liblcm-dev liblcm-bin liblcm-java libspdlog-dev
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java libspdlog-dev default-jdk-headless
+  iproute2 util-linux systemd
   libopenmpi-dev openmpi-bin
   chromium
 )
