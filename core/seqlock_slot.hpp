@@ -45,7 +45,7 @@ class SeqlockSlot {
     for (size_t i = 0; i < kWords; ++i) words[i] = words_[i].load(std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (sequence_.load(std::memory_order_relaxed) != before) return false;
-    std::memcpy(out, words.data(), sizeof(T));
+    std::memcpy(static_cast<void*>(out), words.data(), sizeof(T));
     return true;
   }
 
