@@ -30,7 +30,15 @@ std::int64_t HapticLoop::NowNs() noexcept {
 
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene), options_(options), regions_(std::make_unique<AsyncRegions>(scene)) {
+  BuildSchedule();
+  const LatticeIndex contact = CubeContactNode(scene.mesh);
+  const double h = scene.mesh.edge_m / (scene.mesh.nodes - 1);
+  for (int c = 0; c < 3; ++c) contact_rest_[c] = contact[c] * h;
+}
+
+void HapticLoop::BuildSchedule() {
   const int count = regions_->num_regions();
+  monitors_.clear();
   tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
   lead_ns_.assign(static_cast<size_t>(count), 0);
   for (int a = 0; a < count; ++a) {
@@ -42,9 +50,16 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
       lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * inner * tick_ns_);
     }
   }
-  const LatticeIndex contact = CubeContactNode(scene.mesh);
-  const double h = scene.mesh.edge_m / (scene.mesh.nodes - 1);
-  for (int c = 0; c < 3; ++c) contact_rest_[c] = contact[c] * h;
+}
+
+void HapticLoop::Reconfigure(const Scene& scene) {
+  auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
+  const bool was_running = running_.load();
+  Stop();
+  scene_ = scene;
+  regions_ = std::move(regions);
+  BuildSchedule();
+  if (was_running) Start();
 }
 
 HapticLoop::~HapticLoop() { Stop(); }
@@ -99,7 +114,10 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
       force_faults_.fetch_add(1, std::memory_order_relaxed);
     }
   }
-  if (in_contact_) flags |= force_flags::kInContact;
+  if (in_contact_) {
+    flags |= force_flags::kInContact;
+    last_contact_ns_.store(now_ns, std::memory_order_relaxed);
+  }
   out.flags = flags;
   forces_.Push(out);
 }

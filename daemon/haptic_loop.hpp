@@ -74,6 +74,16 @@ class HapticLoop {
   std::string Start();
   /** Stops and joins the region threads. */
   void Stop();
+  /**
+   * Replaces the regions by those of `scene` (another adaptive configuration of the same object),
+   * starting from rest: call it only while the tool is out of contact and the object has settled,
+   * so nothing the user feels changes. The regions are built before the threads stop, so the
+   * loop pauses only for the restart (a few periods, no forces sent). Supervisor thread only.
+   * @throws Error for an invalid scene (the running loop is left as it was).
+   */
+  void Reconfigure(const Scene& scene);
+  /** CLOCK_MONOTONIC of the last primary period in contact, ns (0: never). */
+  std::int64_t last_contact_ns() const { return last_contact_ns_.load(std::memory_order_relaxed); }
   bool running() const { return running_.load(); }
 
   /** I/O thread: the newest accepted input. */
@@ -101,6 +111,7 @@ class HapticLoop {
   void PrimaryThread(std::int64_t origin_ns);
   void SecondaryThread(RegionIndex region, std::int64_t origin_ns);
   std::string ApplyRealtimeSettings() const;
+  void BuildSchedule();
 
   Scene scene_;
   Options options_;
@@ -110,7 +121,7 @@ class HapticLoop {
   ForceRing forces_;
   std::atomic<double> error_percent_{-1};
   std::atomic<std::int32_t> error_flags_{0};
-  std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0};
+  std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0};
   std::atomic<bool> running_{false}, stop_{false};
   std::vector<std::thread> threads_;
   std::vector<std::int64_t> lead_ns_;

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -267,6 +268,9 @@ int Serve(const Arguments& args) {
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, last_rejection_line_ns = 0;
+  std::future<SupervisorDecision> choice;        // a new choice being computed
+  std::optional<SupervisorDecision> pending;     // chosen, waiting for the tool to be away
+  constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
   const timespec tick{0, 20'000'000};
   for (;;) {
@@ -319,9 +323,14 @@ int Serve(const Arguments& args) {
             target = command->error_target_percent;
             decision.target_met = decision.have_map && decision.error_percent <= target;
             loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
-            spdlog::info("error target set to {} %: the active configuration's {} % {}", target,
-                         decision.error_percent,
+            spdlog::info("error target set to {} %: the active configuration's {} % {}; choosing "
+                         "again",
+                         target, decision.error_percent,
                          decision.target_met ? "meets it" : "EXCEEDS it");
+            // Stability estimates take up to seconds: off the supervisor's tick.
+            choice = std::async(std::launch::async, [&config, &map, target] {
+              return ChooseConfiguration(config.scene, map.map.get(), target, std::nullopt);
+            });
             break;
           case command_t::RESET:
             spdlog::info("command RESET: the simulation restarts from rest");
@@ -333,6 +342,39 @@ int Serve(const Arguments& args) {
                          command->command);
         }
       }
+    }
+    if (choice.valid() &&
+        choice.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      try {
+        SupervisorDecision chosen = choice.get();
+        if (chosen.configuration == decision.configuration) {
+          decision = chosen;
+          pending.reset();
+          loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+        } else {
+          spdlog::info("better configuration for the target: {}; switching when the tool has "
+                       "been out of contact for {} s",
+                       chosen.reason, kSettleBeforeReconfigure_s);
+          pending = chosen;
+          loop.SetErrorState(decision.error_percent,
+                             DecisionFlags(decision) | force_flags::kReconfiguring);
+        }
+      } catch (const Error& e) {
+        spdlog::error("choosing a configuration failed: {}; keeping the active one", e.what());
+      }
+    }
+    // Reconfigure only out of contact, after the object has settled: the force is zero then and
+    // the regions restart from rest, so the user feels no step.
+    if (pending && (now - loop.last_contact_ns()) * 1e-9 >= kSettleBeforeReconfigure_s) {
+      try {
+        loop.Reconfigure(SceneWith(config.scene, pending->configuration));
+        decision = *pending;
+        spdlog::info("reconfigured: {}", decision.reason);
+      } catch (const Error& e) {
+        spdlog::error("reconfiguration failed: {}; keeping the active configuration", e.what());
+      }
+      pending.reset();
+      loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
     }
     if (loop.force_faults() > faults_seen) {
       faults_seen = loop.force_faults();

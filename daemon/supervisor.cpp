@@ -67,7 +67,7 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     for (double lod : map->axes[kLod]) {
       for (double size : map->axes[kSize]) {
         for (double rate : map->axes[kRate]) {
-          const RegionConfiguration c{static_cast<int>(lod), static_cast<int>(size), rate};
+          const RegionConfiguration c{static_cast<int>(size), static_cast<int>(lod), rate};
           if (pinned && !(c == *pinned)) continue;
           LookupQuery query = LookupQuery::At(at);
           query.lo[kLod] = query.hi[kLod] = lod;

@@ -10,6 +10,7 @@
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
+#include "daemon/supervisor.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
@@ -144,6 +145,56 @@ TEST(DeadlineMonitor, CountsMissesAndReportsExecutionPercentiles) {
   EXPECT_EQ(event.lateness_ns, 1'500'000);
   EXPECT_FALSE(monitor.PopEvent(&event));
   EXPECT_EQ(monitor.TakeSnapshot().recent_cycles, 0);  // the window restarts
+}
+
+// A map with two configurations of a 9³ cube whose errors and costs the test sets: the choice
+// must follow the stability-first rules, with the configuration's fields in the right places.
+ErrorMap TwoConfigurationMap(const Scene& scene) {
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  const MapPoint at = PointOfScene(scene);
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};
+  axes[static_cast<int>(MapAxis::kSecondaryLod)] = {2};
+  axes[static_cast<int>(MapAxis::kPrimarySize)] = {1, 3};
+  axes[static_cast<int>(MapAxis::kSecondaryRate)] = {1000};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  map.samples[0].status = map.samples[1].status = SampleStatus::kOk;
+  map.samples[0].max_magnitude_percent = 5.0;  // size 1: cheap, less accurate
+  map.samples[0].cost_us_per_ms = {10, 10, 0, 0};
+  map.samples[1].max_magnitude_percent = 1.0;  // size 3: dearer, more accurate
+  map.samples[1].cost_us_per_ms = {20, 10, 0, 0};
+  return map;
+}
+
+TEST(Supervisor, ChoosesTheCheapestStableConfigurationMeetingTheTargetElseTheMostAccurate) {
+  Scene scene;
+  scene.mesh.nodes = 9;
+  ErrorMap map = TwoConfigurationMap(scene);
+  const SupervisorDecision loose = ChooseConfiguration(scene, &map, 7.0, std::nullopt);
+  EXPECT_EQ(loose.configuration.primary_size, 1);
+  EXPECT_EQ(loose.configuration.secondary_lod, 2);
+  EXPECT_EQ(loose.configuration.secondary_rate_hz, 1000);
+  EXPECT_TRUE(loose.target_met);
+  EXPECT_DOUBLE_EQ(loose.error_percent, 5.0);
+  EXPECT_LT(loose.spectral_radius, 1.0);
+
+  const SupervisorDecision tight = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
+  EXPECT_EQ(tight.configuration.primary_size, 3);
+  EXPECT_TRUE(tight.target_met);
+
+  const SupervisorDecision impossible = ChooseConfiguration(scene, &map, 0.1, std::nullopt);
+  EXPECT_EQ(impossible.configuration.primary_size, 3);  // the most accurate stable one
+  EXPECT_FALSE(impossible.target_met);
+
+  map.samples[1].status = SampleStatus::kPredictedUnstable;  // never chosen, whatever its error
+  const SupervisorDecision safe = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
+  EXPECT_EQ(safe.configuration.primary_size, 1);
+  EXPECT_FALSE(safe.target_met);
+
+  scene.adaptivity.primary_size = 3;  // without a map: the scene's own configuration
+  const SupervisorDecision no_map = ChooseConfiguration(scene, nullptr, 7.0, std::nullopt);
+  EXPECT_EQ(no_map.configuration.primary_size, 3);
+  EXPECT_FALSE(no_map.have_map);
+  EXPECT_EQ(no_map.error_percent, -1);
 }
 
 }  // namespace
