@@ -86,7 +86,8 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
   if (have && !stale) {
     const auto& p = last_input_.position_m;
     const double depth = p[2] - contact_rest_[2];
-    const bool touching = depth > 0;
+    if (depth <= 0) await_lift_off_ = false;
+    const bool touching = depth > 0 && !await_lift_off_;
     if (touching && !in_contact_) touch_down_ = p;
     in_contact_ = touching;
     displacement_ = touching ? std::array<double, 3>{p[0] - touch_down_[0],
@@ -101,6 +102,8 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
     if (q == 1) reaction = r;
   }
   ForceRecord out;
+  BlackBoxRecord box;
+  box.raw_force_n = {-reaction[0], -reaction[1], -reaction[2]};
   out.seq = last_input_.seq;
   out.utime_us = now_ns / 1000;
   out.error_percent = error_percent_.load(std::memory_order_relaxed);
@@ -120,6 +123,13 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
   }
   out.flags = flags;
   forces_.Push(out);
+  box.time_ns = now_ns;
+  box.seq = out.seq;
+  box.position_m = last_input_.position_m;
+  box.force_n = out.force_n;
+  box.error_percent = out.error_percent;
+  box.flags = flags;
+  black_box_.Push(box);
 }
 
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
@@ -152,6 +162,7 @@ std::string HapticLoop::Start() {
   if (running_) return "";
   regions_->Reset();
   in_contact_ = false;
+  await_lift_off_ = true;
   displacement_ = {0.0, 0.0, 0.0};
   stop_ = false;
   const std::int64_t origin_ns = NowNs() + 5'000'000 + lead_ns_.back();

@@ -31,6 +31,17 @@ struct ForceRecord {
   std::int32_t flags = 0;      ///< force_feedback_t::FLAG_* bits
 };
 
+/** One primary period as the black box keeps it (the last cycles are logged on a fault). */
+struct BlackBoxRecord {
+  std::int64_t time_ns = 0;  ///< the period's wake-up, CLOCK_MONOTONIC
+  std::int64_t seq = -1;
+  std::array<double, 3> position_m{};
+  std::array<double, 3> force_n{};  ///< as sent (zero out of contact or after a fault)
+  std::array<double, 3> raw_force_n{};  ///< as simulated
+  double error_percent = -1;
+  std::int32_t flags = 0;
+};
+
 /** Flags of force_feedback_t (kept equal to the LCM constants; a test checks). */
 namespace force_flags {
 inline constexpr std::int32_t kInContact = 1;
@@ -53,7 +64,9 @@ inline constexpr std::int32_t kInputRejected = 64;
  * Contact: the tool tip is in contact while it is inside the object (z > 0 in the object frame).
  * The contact node is the paper's (the front face's middle node); while in contact it follows the
  * tip's depth and its tangential motion since touch-down, so touch-down is continuous. Out of
- * contact the node is held at rest and the force is zero.
+ * contact the node is held at rest and the force is zero. After a start or restart (a reset, a
+ * fault, a reconfiguration) a tip already inside the object renders nothing until it has left
+ * the object once.
  */
 class HapticLoop {
  public:
@@ -65,6 +78,7 @@ class HapticLoop {
     std::vector<int> cpus;   ///< pin the region threads here (empty: no pinning)
   };
   using ForceRing = SpscRing<ForceRecord, 4096>;
+  using BlackBoxRing = SpscRing<BlackBoxRecord, 4096>;
 
   /** @throws Error for an invalid scene. */
   HapticLoop(const Scene& scene, const Options& options);
@@ -90,6 +104,8 @@ class HapticLoop {
   SeqlockSlot<DeviceSample>& input() { return input_; }
   /** I/O thread: the forces, one per primary period. */
   ForceRing& forces() { return forces_; }
+  /** Supervisor: every primary period's record, for the black box. */
+  BlackBoxRing& black_box() { return black_box_; }
   /** Supervisor: the error and flags every force carries from now on. */
   void SetErrorState(double error_percent, std::int32_t flags) noexcept;
   /** Supervisor: per region. */
@@ -119,6 +135,7 @@ class HapticLoop {
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
   SeqlockSlot<DeviceSample> input_;
   ForceRing forces_;
+  BlackBoxRing black_box_;
   std::atomic<double> error_percent_{-1};
   std::atomic<std::int32_t> error_flags_{0};
   std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0};
@@ -132,6 +149,9 @@ class HapticLoop {
   std::array<double, 3> touch_down_{};
   std::array<double, 3> displacement_{};
   bool in_contact_ = false;
+  // After a (re)start the tool must leave the object before it can touch again: engaging a tip
+  // that is already deep inside would step the contact from rest to its depth at once.
+  bool await_lift_off_ = true;
   DeviceSample last_input_;
 };
 

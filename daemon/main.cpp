@@ -40,6 +40,7 @@ namespace hapticsim {
 namespace {
 
 constexpr const char* kDefaultConfig = "/etc/hapticsim/hapticsimd.toml";
+constexpr size_t kBlackBoxCycles = 100;  // primary periods logged on a fault (0.1 s at 1 kHz)
 
 struct Arguments {
   std::string config = kDefaultConfig;
@@ -95,6 +96,38 @@ class MissLogger {
   double min_gap_s_;
   std::int64_t count_ = 0, first_ns_ = 0, last_ns_ = 0, last_line_ns_ = 0;
   std::int64_t worst_lateness_ns_ = 0, worst_execution_ns_ = 0;
+};
+
+// The last cycles of the primary loop, kept by the supervisor and logged when a fault happens.
+class BlackBox {
+ public:
+  explicit BlackBox(size_t cycles) : records_(cycles) {}
+  void Drain(HapticLoop& loop) {
+    BlackBoxRecord record;
+    while (loop.black_box().Pop(&record)) {
+      records_[next_ % records_.size()] = record;
+      ++next_;
+    }
+  }
+  void Dump(const std::string& why) const {
+    const size_t count = std::min(next_, records_.size());
+    spdlog::error("black box ({}): the last {} primary periods, oldest first", why, count);
+    if (count == 0) return;
+    const std::int64_t end = records_[(next_ - 1) % records_.size()].time_ns;
+    for (size_t i = next_ - count; i < next_; ++i) {
+      const BlackBoxRecord& r = records_[i % records_.size()];
+      spdlog::error("black box: t {:+.1f} ms seq {} tip ({:.4f}, {:.4f}, {:.4f}) m force sent "
+                    "({:.3f}, {:.3f}, {:.3f}) N simulated ({:.3g}, {:.3g}, {:.3g}) N error {:.2f} % "
+                    "flags 0x{:x}",
+                    (r.time_ns - end) * 1e-6, r.seq, r.position_m[0], r.position_m[1],
+                    r.position_m[2], r.force_n[0], r.force_n[1], r.force_n[2], r.raw_force_n[0],
+                    r.raw_force_n[1], r.raw_force_n[2], r.error_percent, r.flags);
+    }
+  }
+
+ private:
+  std::vector<BlackBoxRecord> records_;
+  size_t next_ = 0;
 };
 
 struct MapState {
@@ -268,6 +301,9 @@ int Serve(const Arguments& args) {
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, last_rejection_line_ns = 0;
+  BlackBox black_box(kBlackBoxCycles);
+  std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
+  constexpr int kOverrunBurst = 10;
   std::future<SupervisorDecision> choice;        // a new choice being computed
   std::optional<SupervisorDecision> pending;     // chosen, waiting for the tool to be away
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
@@ -294,10 +330,17 @@ int Serve(const Arguments& args) {
       spdlog::info("--duration {} s reached: stopping", args.duration_s);
       break;
     }
+    black_box.Drain(loop);
     for (int r = 0; r < loop.regions().num_regions(); ++r) {
       DeadlineEvent event;
-      while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event);
+      int misses = 0;
+      while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event), ++misses;
       miss_loggers[r].Flush(now);
+      // A primary that overruns again and again is a fault worth the black box (once a minute).
+      if (r == kPrimaryRegion && misses >= kOverrunBurst && now - last_overrun_dump_ns > 60'000'000'000) {
+        black_box.Dump(std::to_string(misses) + " primary periods late within 20 ms");
+        last_overrun_dump_ns = now;
+      }
     }
     // Rejections: at most log.max_lines_per_s lines; the counts are in every status message.
     const bool may_log = (now - last_rejection_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
@@ -378,8 +421,13 @@ int Serve(const Arguments& args) {
     }
     if (loop.force_faults() > faults_seen) {
       faults_seen = loop.force_faults();
+      if (now - last_fault_dump_ns > 10'000'000'000) {  // one black box per 10 s of faults
+        black_box.Dump("force fault");
+        last_fault_dump_ns = now;
+      }
       spdlog::error("force fault (non-finite or above input.max_force_n = {} N): zero force sent; "
-                    "resetting the simulation to rest",
+                    "the simulation restarts from rest and renders again after the tool has "
+                    "left the object",
                     config.max_force_n);
       loop.Stop();
       loop.Start();

@@ -229,8 +229,8 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
       15))
       << daemon_->Log();
   EXPECT_NE(daemon_->Log().find("reconfigured: primary_size 3"), std::string::npos);
-  for (std::int64_t seq = 1; seq <= 100; ++seq) {
-    client.Send(seq, kEdge / 2, kEdge / 2, 0.001);
+  for (std::int64_t seq = 1; seq <= 100; ++seq) {  // from above the surface into the object
+    client.Send(seq, kEdge / 2, kEdge / 2, seq <= 20 ? -0.002 : 0.001);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -253,6 +253,37 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   client.Send(1601, kEdge / 2, kEdge / 2, -0.002);  // lift off
   ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.primary_size == 1; }, 10))
       << daemon_->Log();
+}
+
+// Stability first: a force above input.max_force_n is never sent; the daemon zeroes it, logs the
+// black box of the last periods and restarts the simulation from rest.
+TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
+  const std::string config = Temp("fault.toml");
+  std::ofstream(config) << "[input]\nmax_force_n = 0.5\n";  // a 1 cm press gives about 1.3 N
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("fault.log"));
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 30)) << daemon.Log();
+  for (std::int64_t seq = 1; seq <= 800; ++seq) {  // from above the surface, 1 cm in
+    client.Send(seq, kEdge / 2, kEdge / 2, seq <= 50 ? -0.002 : 0.01 * std::min(1.0, (seq - 50) / 400.0));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto forces = client.Forces();
+  ASSERT_GT(forces.size(), 500u);
+  for (const auto& f : forces) {
+    EXPECT_LE(std::hypot(f.force[0], f.force[1], f.force[2]), 0.5) << "seq " << f.seq;
+  }
+  const std::string log = daemon.Log();
+  EXPECT_NE(log.find("force fault"), std::string::npos) << log;
+  // After the fault nothing is rendered until the tool leaves the object: one fault, not a storm.
+  size_t faults = 0;
+  for (size_t at = 0; (at = log.find("force fault (", at)) != std::string::npos; ++at) ++faults;
+  EXPECT_EQ(faults, 1u) << log;
+  EXPECT_FALSE(forces.back().flags & force_feedback_t::FLAG_IN_CONTACT);
+  EXPECT_NE(log.find("black box (force fault): the last"), std::string::npos) << log;
+  EXPECT_NE(log.find("black box: t +0.0 ms seq"), std::string::npos) << log;
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0);
 }
 
 // The shared-memory interface with a real second process: the example driver client.
