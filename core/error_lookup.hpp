@@ -24,10 +24,11 @@ struct LookupQuery {
 };
 
 struct LookupResult {
-  double error = 0;       ///< looked-up error (% or degrees, by field); +inf when !usable()
-  bool clamped = false;   ///< some value was outside the map: clamped to its edge, never extrapolated
-  int clamped_axis = -1;  ///< the first such axis (MapAxis), or -1
-  bool unstable = false;  ///< a sample it depends on is predicted unstable or diverged
+  double error = 0;  ///< looked-up error (% or degrees, by field); +inf when !usable()
+  bool clamped =
+      false;  ///< some value was outside the map: clamped to its edge, never extrapolated
+  int clamped_axis = -1;    ///< the first such axis (MapAxis), or -1
+  bool unstable = false;    ///< a sample it depends on is predicted unstable or diverged
   bool incomplete = false;  ///< a sample it depends on was not computed
   bool usable() const { return !unstable && !incomplete; }
 };

@@ -8,19 +8,26 @@ namespace hapticsim {
 
 std::string_view SampleStatusName(SampleStatus status) {
   switch (status) {
-    case SampleStatus::kOk: return "ok";
-    case SampleStatus::kPredictedUnstable: return "predicted unstable";
-    case SampleStatus::kDiverged: return "diverged";
-    case SampleStatus::kNotComputed: return "not computed";
+    case SampleStatus::kOk:
+      return "ok";
+    case SampleStatus::kPredictedUnstable:
+      return "predicted unstable";
+    case SampleStatus::kDiverged:
+      return "diverged";
+    case SampleStatus::kNotComputed:
+      return "not computed";
   }
   return "unknown";
 }
 
 std::string_view ErrorFieldName(ErrorField field) {
   switch (field) {
-    case ErrorField::kL2: return "l2_percent";
-    case ErrorField::kMagnitude: return "max_magnitude_percent";
-    case ErrorField::kDirection: return "max_direction_deg";
+    case ErrorField::kL2:
+      return "l2_percent";
+    case ErrorField::kMagnitude:
+      return "max_magnitude_percent";
+    case ErrorField::kDirection:
+      return "max_direction_deg";
   }
   return "unknown";
 }
@@ -36,9 +43,12 @@ ErrorField ParseErrorField(std::string_view name) {
 
 double FieldOf(const MapSample& sample, ErrorField field) {
   switch (field) {
-    case ErrorField::kL2: return sample.l2_percent;
-    case ErrorField::kMagnitude: return sample.max_magnitude_percent;
-    case ErrorField::kDirection: return sample.max_direction_deg;
+    case ErrorField::kL2:
+      return sample.l2_percent;
+    case ErrorField::kMagnitude:
+      return sample.max_magnitude_percent;
+    case ErrorField::kDirection:
+      return sample.max_direction_deg;
   }
   return 0;
 }
@@ -70,9 +80,9 @@ ErrorMap ErrorMap::MakeGrid(const std::array<std::vector<double>, kNumMapAxes>& 
     HAPTICSIM_THROW_UNLESS(!values.empty(), std::string(AxisInfo(a).scene_key) +
                                                 ": a grid axis needs at least one value");
     for (size_t i = 1; i < values.size(); ++i) {
-      HAPTICSIM_THROW_UNLESS(values[i] > values[i - 1],
-                             std::string(AxisInfo(a).scene_key) +
-                                 ": grid values must be strictly increasing");
+      HAPTICSIM_THROW_UNLESS(
+          values[i] > values[i - 1],
+          std::string(AxisInfo(a).scene_key) + ": grid values must be strictly increasing");
     }
   }
   map.samples.resize(map.GridSize());
@@ -101,8 +111,8 @@ std::uint64_t ErrorMap::ResultsChecksum() const {
   };
   for (const MapSample& s : samples) {
     mix(s.point.data(), sizeof s.point);
-    for (double v : {s.l2_percent, s.max_magnitude_percent, s.max_direction_deg,
-                     s.reference_peak_n, s.spectral_radius}) {
+    for (double v : {s.l2_percent, s.max_magnitude_percent, s.max_direction_deg, s.reference_peak_n,
+                     s.spectral_radius}) {
       mix(&v, sizeof v);
     }
     mix(&s.status, sizeof s.status);

@@ -29,12 +29,12 @@ inline constexpr int kMapCostRegions = 4;
 
 /** One point of the map: where it is, and how the adaptive force compared with the reference. */
 struct MapSample {
-  MapPoint point{};                    ///< the nine parameters (MapAxis order), SI units
-  double l2_percent = 0;               ///< relative L2 force error over the trial, %
-  double max_magnitude_percent = 0;    ///< worst | |F| − |F_ref| |, % of the reference peak
-  double max_direction_deg = 0;        ///< worst angle where |F_ref| ≥ threshold × peak, degrees
-  double reference_peak_n = 0;         ///< peak |F_ref| over the trial, N
-  double spectral_radius = 0;          ///< coupled spectral radius per common period
+  MapPoint point{};                  ///< the nine parameters (MapAxis order), SI units
+  double l2_percent = 0;             ///< relative L2 force error over the trial, %
+  double max_magnitude_percent = 0;  ///< worst | |F| − |F_ref| |, % of the reference peak
+  double max_direction_deg = 0;      ///< worst angle where |F_ref| ≥ threshold × peak, degrees
+  double reference_peak_n = 0;       ///< peak |F_ref| over the trial, N
+  double spectral_radius = 0;        ///< coupled spectral radius per common period
   std::array<double, kMapCostRegions> cost_us_per_ms{};  ///< compute µs per simulated ms
   SampleStatus status = SampleStatus::kNotComputed;
   std::int8_t status_region = kNoRegion;  ///< region index, kCouplingRegion, or kNoRegion
@@ -62,11 +62,11 @@ double FieldOf(const MapSample& sample, ErrorField field);
 struct ErrorMap {
   /** Where the map came from: written to and read from the file's metadata. */
   struct Provenance {
-    std::string scene_toml;     ///< the base scene (every key), TOML
-    std::string model;          ///< the deformation model and its version
-    std::string code_version;   ///< hapticsim's version and git revision
-    std::string grid;           ///< "paper", "quick", "scene", a file name, or "monte-carlo N seed S"
-    std::string shard = "1/1";  ///< the slice this file holds, "I/N" (1-based)
+    std::string scene_toml;    ///< the base scene (every key), TOML
+    std::string model;         ///< the deformation model and its version
+    std::string code_version;  ///< hapticsim's version and git revision
+    std::string grid;  ///< "paper", "quick", "scene", a file name, or "monte-carlo N seed S"
+    std::string shard = "1/1";         ///< the slice this file holds, "I/N" (1-based)
     double direction_threshold = 0.1;  ///< fraction of the peak below which direction is ignored
     bool linearity_used = false;       ///< amplitude axis derived from linearity
   };

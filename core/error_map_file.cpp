@@ -201,7 +201,8 @@ class MapFileReader {
     }
     const auto count = Read<std::uint32_t>(header, 12);
     if (count > 64) Refuse(path, "corrupted: " + std::to_string(count) + " sections");
-    if (kHeaderBytes + count * kEntryBytes > file_size) Refuse(path, "truncated inside the directory");
+    if (kHeaderBytes + count * kEntryBytes > file_size)
+      Refuse(path, "truncated inside the directory");
     const std::string directory = ReadRange(kHeaderBytes, count * kEntryBytes);
     if (Checksum(directory) != Read<std::uint64_t>(header, 16)) {
       Refuse(path, "corrupted: directory checksum mismatch");
@@ -211,8 +212,8 @@ class MapFileReader {
       std::string name(directory.data() + at, kNameBytes);
       name.resize(std::strlen(name.c_str()));
       entries_[name] = {Read<std::uint64_t>(directory, at + kNameBytes),
-                       Read<std::uint64_t>(directory, at + kNameBytes + 8),
-                       Read<std::uint64_t>(directory, at + kNameBytes + 16)};
+                        Read<std::uint64_t>(directory, at + kNameBytes + 8),
+                        Read<std::uint64_t>(directory, at + kNameBytes + 16)};
     }
   }
 
@@ -352,8 +353,8 @@ ErrorMap MergeErrorMaps(const std::vector<ErrorMap>& shards) {
                            which + "has other axes or samples than map 1");
     HAPTICSIM_THROW_UNLESS(b.scene_toml == a.scene_toml, which + "was made for another scene");
     HAPTICSIM_THROW_UNLESS(b.model == a.model && b.code_version == a.code_version,
-                           which + "was made by another model or code version (" +
-                               b.code_version + " vs " + a.code_version + ")");
+                           which + "was made by another model or code version (" + b.code_version +
+                               " vs " + a.code_version + ")");
     HAPTICSIM_THROW_UNLESS(b.grid == a.grid, which + "is from another grid (" + b.grid + ")");
     for (size_t i = 0; i < shard.samples.size(); ++i) {
       const MapSample& s = shard.samples[i];

@@ -1,10 +1,10 @@
 #include "core/error_sweep.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
-#include <algorithm>
 #include <exception>
 #include <fstream>
 #include <limits>
@@ -38,9 +38,9 @@ int Axis(MapAxis axis) { return static_cast<int>(axis); }
 // The material and input a reference depends on.
 using ReferenceKey = std::array<double, 6>;
 ReferenceKey ReferenceKeyOf(const MapPoint& p) {
-  return {p[Axis(MapAxis::kPoissonRatio)], p[Axis(MapAxis::kDensity)], p[Axis(MapAxis::kDamping)],
-          p[Axis(MapAxis::kYoungsModulus)], p[Axis(MapAxis::kAmplitude)],
-          p[Axis(MapAxis::kFrequency)]};
+  return {p[Axis(MapAxis::kPoissonRatio)], p[Axis(MapAxis::kDensity)],
+          p[Axis(MapAxis::kDamping)],      p[Axis(MapAxis::kYoungsModulus)],
+          p[Axis(MapAxis::kAmplitude)],    p[Axis(MapAxis::kFrequency)]};
 }
 
 struct Reference {
@@ -142,9 +142,8 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
                   auto target_index = index;
                   target_index[size_axis] = s;
                   target_index[Axis(MapAxis::kAmplitude)] = static_cast<int>(a);
-                  run.targets.push_back(
-                      {layout.GridIndex(target_index),
-                       ax[Axis(MapAxis::kAmplitude)][a] / amplitude});
+                  run.targets.push_back({layout.GridIndex(target_index),
+                                         ax[Axis(MapAxis::kAmplitude)][a] / amplitude});
                 }
               }
               stats->saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
@@ -218,10 +217,10 @@ void ParallelFor(std::size_t n, int jobs, const std::atomic<bool>* stop,
 
 Json SampleRecord(std::size_t index, const MapSample& s) {
   auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
-  Json record = Json::array({index, static_cast<int>(s.status), static_cast<int>(s.status_region),
-                             num(s.l2_percent), num(s.max_magnitude_percent),
-                             num(s.max_direction_deg), num(s.reference_peak_n),
-                             num(s.spectral_radius)});
+  Json record =
+      Json::array({index, static_cast<int>(s.status), static_cast<int>(s.status_region),
+                   num(s.l2_percent), num(s.max_magnitude_percent), num(s.max_direction_deg),
+                   num(s.reference_peak_n), num(s.spectral_radius)});
   for (double c : s.cost_us_per_ms) record.push_back(num(c));
   return record;
 }
@@ -244,8 +243,7 @@ void ReadSampleRecord(const Json& record, ErrorMap* map) {
 std::string Fingerprint(const ErrorMap& map, const SweepGrid& grid, const SweepOptions& options) {
   std::ostringstream text;
   text << map.provenance.scene_toml << map.provenance.model << map.provenance.code_version
-       << grid.name << options.shard_index << '/' << options.shard_count
-       << options.use_linearity;
+       << grid.name << options.shard_index << '/' << options.shard_count << options.use_linearity;
   std::uint64_t hash = 0xcbf29ce484222325ull;
   for (unsigned char c : text.str()) hash = (hash ^ c) * 0x100000001b3ull;
   for (const MapSample& s : map.samples) {
@@ -333,8 +331,8 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   map.provenance.linearity_used = linear;
   for (const MapSample& s : map.samples) SceneAtPoint(base, s.point);  // validates every point
 
-  std::vector<Task> all_tasks = grid.scattered ? ScatteredTasks(grid)
-                                               : GridTasks(base, grid, linear, &stats);
+  std::vector<Task> all_tasks =
+      grid.scattered ? ScatteredTasks(grid) : GridTasks(base, grid, linear, &stats);
   std::vector<std::size_t> mine;  // task numbers of this shard
   for (std::size_t t = options.shard_index; t < all_tasks.size(); t += options.shard_count) {
     mine.push_back(t);
@@ -490,8 +488,7 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
         samples_done += results.size();
       },
       tick, options.progress_interval_s);
-  stats.interrupted = options.stop && options.stop->load() &&
-                      samples_done.load() < stats.samples;
+  stats.interrupted = options.stop && options.stop->load() && samples_done.load() < stats.samples;
   stats.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (stats_out) *stats_out = stats;
   return map;

@@ -36,9 +36,9 @@ Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
   for (int a = 0; a < kNumMapAxes; ++a) {
     const MapAxisInfo& info = AxisInfo(a);
     if (info.integer) {
-      HAPTICSIM_THROW_UNLESS(point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
-                             std::string(info.scene_key) + " = " + FormatReal(point[a]) +
-                                 " is not a whole number");
+      HAPTICSIM_THROW_UNLESS(
+          point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
+          std::string(info.scene_key) + " = " + FormatReal(point[a]) + " is not a whole number");
       SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));
     } else {
       SetSceneValue(&scene, info.scene_key, FormatReal(point[a]));

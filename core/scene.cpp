@@ -19,7 +19,6 @@ struct KeyAccess {
   std::function<void(Scene*, std::string_view)> set;
 };
 
-
 [[noreturn]] void Reject(std::string_view key, std::string_view value, std::string_view allowed,
                          std::string_view unit) {
   std::string message = std::string(key) + " = " + std::string(value) +

@@ -50,8 +50,8 @@ SweepGrid QuickGrid() {
 SweepGrid SceneGrid(const MapPoint& scene_point) {
   SweepGrid grid = PaperGrid();
   grid.name = "scene";
-  for (MapAxis axis : {MapAxis::kPoissonRatio, MapAxis::kDensity, MapAxis::kDamping,
-                       MapAxis::kYoungsModulus}) {
+  for (MapAxis axis :
+       {MapAxis::kPoissonRatio, MapAxis::kDensity, MapAxis::kDamping, MapAxis::kYoungsModulus}) {
     const int a = static_cast<int>(axis);
     grid.axes[a] = {scene_point[a]};
   }

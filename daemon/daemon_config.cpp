@@ -60,8 +60,8 @@ const std::map<std::string, Setter>& Setters() {
     real("input.workspace_margin_m", &DaemonConfig::workspace_margin_m);
     real("input.max_force_n", &DaemonConfig::max_force_n);
     s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
-      c->fifo_priority = static_cast<int>(Get<std::int64_t>(n, "realtime.fifo_priority", w,
-                                                             "a whole number"));
+      c->fifo_priority =
+          static_cast<int>(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
     };
     s["realtime.cpus"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
       const toml::array* list = n.as_array();
@@ -115,15 +115,16 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
   require(std::find(levels.begin(), levels.end(), c.log_level) != levels.end(),
           "log.level must be one of trace, debug, info, warn, error");
-  for (const auto& [key, channel] :
-       {std::pair{"lcm.device_channel", &c.device_channel}, {"lcm.force_channel", &c.force_channel},
-        {"lcm.status_channel", &c.status_channel}, {"lcm.command_channel", &c.command_channel}}) {
+  for (const auto& [key, channel] : {std::pair{"lcm.device_channel", &c.device_channel},
+                                     {"lcm.force_channel", &c.force_channel},
+                                     {"lcm.status_channel", &c.status_channel},
+                                     {"lcm.command_channel", &c.command_channel}}) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
-  require(c.shm_name.size() > 1 && c.shm_name[0] == '/' &&
-              c.shm_name.find('/', 1) == std::string::npos,
-          "shm.name must be '/' and a name, e.g. \"/hapticsim\"");
+  require(
+      c.shm_name.size() > 1 && c.shm_name[0] == '/' && c.shm_name.find('/', 1) == std::string::npos,
+      "shm.name must be '/' and a name, e.g. \"/hapticsim\"");
   require(c.lcm_url.find("://") != std::string::npos,
           "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq://");
   require(c.scene.adaptivity.enabled(),

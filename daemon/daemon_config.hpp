@@ -24,25 +24,25 @@ struct DaemonConfig {
   std::string status_channel = "HAPTIC_STATUS";
   std::string command_channel = "HAPTIC_COMMAND";
   // [shm]
-  bool shm_enabled = false;            ///< the shared-memory interface for a local driver
+  bool shm_enabled = false;             ///< the shared-memory interface for a local driver
   std::string shm_name = "/hapticsim";  ///< POSIX shm name (/dev/shm/hapticsim)
-  std::string shm_group;               ///< group the driver runs in (empty: the daemon's own)
+  std::string shm_group;                ///< group the driver runs in (empty: the daemon's own)
   // [supervisor]
   std::string error_map;              ///< map file (empty: none; the error is reported as -1)
   double error_target_percent = 7.0;  ///< the force-magnitude JND
   double status_rate_hz = 5;
   // [input]
-  double stale_after_s = 0.05;          ///< input older than this is stale
-  bool zero_force_when_stale = true;    ///< stale: render zero force (else hold the last)
-  double max_speed_m_per_s = 5.0;       ///< faster jumps are rejected (no hand moves so)
-  double workspace_margin_m = 0.1;      ///< accepted positions: the object's box grown by this
-  double max_force_n = 50.0;            ///< a larger force is a fault: zero force, reset
+  double stale_after_s = 0.05;        ///< input older than this is stale
+  bool zero_force_when_stale = true;  ///< stale: render zero force (else hold the last)
+  double max_speed_m_per_s = 5.0;     ///< faster jumps are rejected (no hand moves so)
+  double workspace_margin_m = 0.1;    ///< accepted positions: the object's box grown by this
+  double max_force_n = 50.0;          ///< a larger force is a fault: zero force, reset
   // [realtime]
-  int fifo_priority = 0;        ///< SCHED_FIFO priority of the region threads (0: normal)
-  std::vector<int> cpus;        ///< CPUs the region threads are pinned to (empty: any)
-  bool lock_memory = false;     ///< mlockall(MCL_CURRENT | MCL_FUTURE)
+  int fifo_priority = 0;     ///< SCHED_FIFO priority of the region threads (0: normal)
+  std::vector<int> cpus;     ///< CPUs the region threads are pinned to (empty: any)
+  bool lock_memory = false;  ///< mlockall(MCL_CURRENT | MCL_FUTURE)
   // [log]
-  std::string log_level = "info";  ///< trace, debug, info, warn, error
+  std::string log_level = "info";   ///< trace, debug, info, warn, error
   double max_log_lines_per_s = 10;  ///< rate limit of repeated warnings
 };
 

@@ -53,7 +53,8 @@ DeadlineSnapshot DeadlineMonitor::TakeSnapshot() noexcept {
     s.recent_cycles += recent[b];
   }
   auto quantile = [&](double q) {
-    const auto rank = static_cast<std::int64_t>(std::ceil(q * static_cast<double>(s.recent_cycles)));
+    const auto rank =
+        static_cast<std::int64_t>(std::ceil(q * static_cast<double>(s.recent_cycles)));
     std::int64_t seen = 0;
     for (int b = 0; b < kBins; ++b) {
       seen += recent[b];

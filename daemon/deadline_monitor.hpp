@@ -10,8 +10,8 @@ namespace hapticsim {
 
 /** One late period of a real-time thread, as handed to the logging thread. */
 struct DeadlineEvent {
-  std::int64_t release_ns = 0;  ///< when the period should have started (CLOCK_MONOTONIC)
-  std::int64_t lateness_ns = 0;  ///< wake-up after the release
+  std::int64_t release_ns = 0;    ///< when the period should have started (CLOCK_MONOTONIC)
+  std::int64_t lateness_ns = 0;   ///< wake-up after the release
   std::int64_t execution_ns = 0;  ///< the period's compute time
 };
 
@@ -19,10 +19,10 @@ struct DeadlineEvent {
 struct DeadlineSnapshot {
   double period_s = 0;
   std::int64_t cycles = 0;
-  std::int64_t misses = 0;               ///< started late by more than a period, or overran it
-  double worst_lateness_s = 0;           ///< since the start
-  double recent_worst_lateness_s = 0;    ///< since the previous snapshot
-  double recent_execution_p50_s = 0;     ///< since the previous snapshot (bin upper edges)
+  std::int64_t misses = 0;             ///< started late by more than a period, or overran it
+  double worst_lateness_s = 0;         ///< since the start
+  double recent_worst_lateness_s = 0;  ///< since the previous snapshot
+  double recent_execution_p50_s = 0;   ///< since the previous snapshot (bin upper edges)
   double recent_execution_p99_s = 0;
   double recent_execution_max_s = 0;
   std::int64_t recent_cycles = 0;
@@ -40,7 +40,8 @@ class DeadlineMonitor {
   static constexpr int kBins = 72;
   using EventRing = SpscRing<DeadlineEvent, 1024>;
 
-  explicit DeadlineMonitor(double period_s) : period_ns_(static_cast<std::int64_t>(period_s * 1e9)) {}
+  explicit DeadlineMonitor(double period_s)
+      : period_ns_(static_cast<std::int64_t>(period_s * 1e9)) {}
 
   /** The periodic thread, after each period. */
   void Record(std::int64_t release_ns, std::int64_t woke_ns, std::int64_t done_ns) noexcept;
@@ -52,7 +53,9 @@ class DeadlineMonitor {
   /** Events lost because the ring was full (the logger fell behind). */
   std::size_t dropped_events() const noexcept { return events_.dropped(); }
   /** CLOCK_MONOTONIC of the last finished period, ns (0 before the first): the watchdog's pulse. */
-  std::int64_t last_done_ns() const noexcept { return last_done_ns_.load(std::memory_order_acquire); }
+  std::int64_t last_done_ns() const noexcept {
+    return last_done_ns_.load(std::memory_order_acquire);
+  }
 
   static int BinOf(std::int64_t ns) noexcept;
   static double BinUpperEdgeS(int bin) noexcept;

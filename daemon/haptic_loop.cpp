@@ -45,8 +45,7 @@ void HapticLoop::BuildSchedule() {
     const std::int64_t nominal = regions_->period_ticks(a) * regions_->schedule(a).substeps;
     monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal * tick_ns_ * 1e-9));
     if (a > 0) {
-      const std::int64_t inner =
-          regions_->period_ticks(a - 1) * regions_->schedule(a - 1).substeps;
+      const std::int64_t inner = regions_->period_ticks(a - 1) * regions_->schedule(a - 1).substeps;
       lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * inner * tick_ns_);
     }
   }
@@ -90,9 +89,9 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
     const bool touching = depth > 0 && !await_lift_off_;
     if (touching && !in_contact_) touch_down_ = p;
     in_contact_ = touching;
-    displacement_ = touching ? std::array<double, 3>{p[0] - touch_down_[0],
-                                                     p[1] - touch_down_[1], depth}
-                             : std::array<double, 3>{0.0, 0.0, 0.0};
+    displacement_ = touching
+                        ? std::array<double, 3>{p[0] - touch_down_[0], p[1] - touch_down_[1], depth}
+                        : std::array<double, 3>{0.0, 0.0, 0.0};
   }
   const int substeps = regions_->schedule(kPrimaryRegion).substeps;
   std::array<double, 3> reaction{};
@@ -148,9 +147,9 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   DeadlineMonitor& monitor = *monitors_[region];
   const int substeps = regions_->schedule(region).substeps;
   while (!stop_.load(std::memory_order_acquire)) {
-    const std::int64_t release = origin_ns +
-                                 static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
-                                 lead_ns_[region];
+    const std::int64_t release =
+        origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
+        lead_ns_[region];
     SleepUntilNs(release);
     const std::int64_t woke = NowNs();
     for (int q = 0; q < substeps; ++q) regions_->StepRegion(region);

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "core/async_regions.hpp"
-#include "daemon/deadline_monitor.hpp"
 #include "core/seqlock_slot.hpp"
+#include "daemon/deadline_monitor.hpp"
 #include "daemon/spsc_ring.hpp"
 
 namespace hapticsim {
@@ -24,11 +24,11 @@ struct DeviceSample {
 
 /** One primary period's answer, as the primary thread hands it to the I/O thread. */
 struct ForceRecord {
-  std::int64_t seq = -1;       ///< the input it answers
-  std::int64_t utime_us = 0;   ///< CLOCK_MONOTONIC, µs
+  std::int64_t seq = -1;            ///< the input it answers
+  std::int64_t utime_us = 0;        ///< CLOCK_MONOTONIC, µs
   std::array<double, 3> force_n{};  ///< on the user
   double error_percent = -1;
-  std::int32_t flags = 0;      ///< force_feedback_t::FLAG_* bits
+  std::int32_t flags = 0;  ///< force_feedback_t::FLAG_* bits
 };
 
 /** One primary period as the black box keeps it (the last cycles are logged on a fault). */
@@ -36,7 +36,7 @@ struct BlackBoxRecord {
   std::int64_t time_ns = 0;  ///< the period's wake-up, CLOCK_MONOTONIC
   std::int64_t seq = -1;
   std::array<double, 3> position_m{};
-  std::array<double, 3> force_n{};  ///< as sent (zero out of contact or after a fault)
+  std::array<double, 3> force_n{};      ///< as sent (zero out of contact or after a fault)
   std::array<double, 3> raw_force_n{};  ///< as simulated
   double error_percent = -1;
   std::int32_t flags = 0;
@@ -74,8 +74,8 @@ class HapticLoop {
     double stale_after_s = 0.05;
     bool zero_force_when_stale = true;
     double max_force_n = 50;
-    int fifo_priority = 0;   ///< SCHED_FIFO for the region threads (0: normal scheduling)
-    std::vector<int> cpus;   ///< pin the region threads here (empty: no pinning)
+    int fifo_priority = 0;  ///< SCHED_FIFO for the region threads (0: normal scheduling)
+    std::vector<int> cpus;  ///< pin the region threads here (empty: no pinning)
   };
   using ForceRing = SpscRing<ForceRecord, 4096>;
   using BlackBoxRing = SpscRing<BlackBoxRecord, 4096>;

@@ -6,11 +6,16 @@ namespace hapticsim {
 
 std::string_view InputRejectionName(InputRejection rejection) {
   switch (rejection) {
-    case InputRejection::kAccepted: return "accepted";
-    case InputRejection::kNonFinite: return "non-finite position";
-    case InputRejection::kOutsideWorkspace: return "position outside the workspace";
-    case InputRejection::kJump: return "jump faster than input.max_speed_m_per_s";
-    case InputRejection::kOldSequence: return "seq not newer than the last accepted";
+    case InputRejection::kAccepted:
+      return "accepted";
+    case InputRejection::kNonFinite:
+      return "non-finite position";
+    case InputRejection::kOutsideWorkspace:
+      return "position outside the workspace";
+    case InputRejection::kJump:
+      return "jump faster than input.max_speed_m_per_s";
+    case InputRejection::kOldSequence:
+      return "seq not newer than the last accepted";
   }
   return "unknown";
 }
@@ -28,8 +33,8 @@ InputRejection InputGuard::Check(std::int64_t seq, const std::array<double, 3>& 
     // Time between arrivals, at least half a millisecond: arrival jitter must not turn a normal
     // step into an impossible speed.
     const double dt = std::max(5e-4, (received_ns - last_ns_) * 1e-9);
-    const double dx = std::hypot(p[0] - last_position_[0], p[1] - last_position_[1],
-                                 p[2] - last_position_[2]);
+    const double dx =
+        std::hypot(p[0] - last_position_[0], p[1] - last_position_[1], p[2] - last_position_[2]);
     if (dx > max_speed_ * dt) return InputRejection::kJump;
     if (seq > last_seq_ + 1) ++gaps_;
   }

@@ -82,10 +82,11 @@ class MissLogger {
     const bool quiet = now_ns - last_ns_ > 200'000'000;
     const bool allowed = (now_ns - last_line_ns_) * 1e-9 >= min_gap_s_;
     if (!(force || (quiet && allowed))) return;
-    spdlog::warn("deadline misses: {} thread, {} periods late over {:.1f} ms (worst wake-up "
-                 "lateness {:.0f} µs, worst compute {:.0f} µs)",
-                 thread_, count_, (last_ns_ - first_ns_) * 1e-6, worst_lateness_ns_ * 1e-3,
-                 worst_execution_ns_ * 1e-3);
+    spdlog::warn(
+        "deadline misses: {} thread, {} periods late over {:.1f} ms (worst wake-up "
+        "lateness {:.0f} µs, worst compute {:.0f} µs)",
+        thread_, count_, (last_ns_ - first_ns_) * 1e-6, worst_lateness_ns_ * 1e-3,
+        worst_execution_ns_ * 1e-3);
     count_ = 0;
     worst_lateness_ns_ = worst_execution_ns_ = 0;
     last_line_ns_ = now_ns;
@@ -116,12 +117,13 @@ class BlackBox {
     const std::int64_t end = records_[(next_ - 1) % records_.size()].time_ns;
     for (size_t i = next_ - count; i < next_; ++i) {
       const BlackBoxRecord& r = records_[i % records_.size()];
-      spdlog::error("black box: t {:+.1f} ms seq {} tip ({:.4f}, {:.4f}, {:.4f}) m force sent "
-                    "({:.3f}, {:.3f}, {:.3f}) N simulated ({:.3g}, {:.3g}, {:.3g}) N error {:.2f} % "
-                    "flags 0x{:x}",
-                    (r.time_ns - end) * 1e-6, r.seq, r.position_m[0], r.position_m[1],
-                    r.position_m[2], r.force_n[0], r.force_n[1], r.force_n[2], r.raw_force_n[0],
-                    r.raw_force_n[1], r.raw_force_n[2], r.error_percent, r.flags);
+      spdlog::error(
+          "black box: t {:+.1f} ms seq {} tip ({:.4f}, {:.4f}, {:.4f}) m force sent "
+          "({:.3f}, {:.3f}, {:.3f}) N simulated ({:.3g}, {:.3g}, {:.3g}) N error {:.2f} % "
+          "flags 0x{:x}",
+          (r.time_ns - end) * 1e-6, r.seq, r.position_m[0], r.position_m[1], r.position_m[2],
+          r.force_n[0], r.force_n[1], r.force_n[2], r.raw_force_n[0], r.raw_force_n[1],
+          r.raw_force_n[2], r.error_percent, r.flags);
     }
   }
 
@@ -202,7 +204,8 @@ status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snaps
 
 int Serve(const Arguments& args) {
   DaemonConfig config;
-  const bool default_missing = args.config == kDefaultConfig && !std::filesystem::exists(args.config);
+  const bool default_missing =
+      args.config == kDefaultConfig && !std::filesystem::exists(args.config);
   config = default_missing ? DefaultDaemonConfig() : LoadDaemonConfig(args.config);
   if (!args.lcm_url.empty()) config.lcm_url = args.lcm_url;
   if (!args.error_map.empty()) config.error_map = args.error_map;
@@ -228,9 +231,10 @@ int Serve(const Arguments& args) {
   spdlog::info("hapticsimd {} starting; config {}", CodeVersion(),
                default_missing ? "built-in defaults (no " + args.config + ")" : args.config);
   if (config.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    spdlog::warn("mlockall refused ({}; needs CAP_IPC_LOCK or LimitMEMLOCK=infinity): memory "
-                 "may be paged, running on",
-                 std::strerror(errno));
+    spdlog::warn(
+        "mlockall refused ({}; needs CAP_IPC_LOCK or LimitMEMLOCK=infinity): memory "
+        "may be paged, running on",
+        std::strerror(errno));
   }
   MapState map = LoadMap(config.error_map);
   double target = config.error_target_percent;
@@ -304,8 +308,8 @@ int Serve(const Arguments& args) {
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
   constexpr int kOverrunBurst = 10;
-  std::future<SupervisorDecision> choice;        // a new choice being computed
-  std::optional<SupervisorDecision> pending;     // chosen, waiting for the tool to be away
+  std::future<SupervisorDecision> choice;             // a new choice being computed
+  std::optional<SupervisorDecision> pending;          // chosen, waiting for the tool to be away
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
   const timespec tick{0, 20'000'000};
@@ -337,7 +341,8 @@ int Serve(const Arguments& args) {
       while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event), ++misses;
       miss_loggers[r].Flush(now);
       // A primary that overruns again and again is a fault worth the black box (once a minute).
-      if (r == kPrimaryRegion && misses >= kOverrunBurst && now - last_overrun_dump_ns > 60'000'000'000) {
+      if (r == kPrimaryRegion && misses >= kOverrunBurst &&
+          now - last_overrun_dump_ns > 60'000'000'000) {
         black_box.Dump(std::to_string(misses) + " primary periods late within 20 ms");
         last_overrun_dump_ns = now;
       }
@@ -349,9 +354,10 @@ int Serve(const Arguments& args) {
                                : InputRejection::kAccepted;
     if (rejection != InputRejection::kAccepted) {
       last_rejection_line_ns = now;
-      spdlog::warn("device input rejected: {} ({} rejected so far; the last accepted input "
-                   "stays in use)",
-                   InputRejectionName(rejection), counters.inputs_rejected.load());
+      spdlog::warn(
+          "device input rejected: {} ({} rejected so far; the last accepted input "
+          "stays in use)",
+          InputRejectionName(rejection), counters.inputs_rejected.load());
     }
     if (bridge) {
       while (std::optional<command_t> command = bridge->PopCommand()) {
@@ -366,10 +372,10 @@ int Serve(const Arguments& args) {
             target = command->error_target_percent;
             decision.target_met = decision.have_map && decision.error_percent <= target;
             loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
-            spdlog::info("error target set to {} %: the active configuration's {} % {}; choosing "
-                         "again",
-                         target, decision.error_percent,
-                         decision.target_met ? "meets it" : "EXCEEDS it");
+            spdlog::info(
+                "error target set to {} %: the active configuration's {} % {}; choosing "
+                "again",
+                target, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
             // Stability estimates take up to seconds: off the supervisor's tick.
             choice = std::async(std::launch::async, [&config, &map, target] {
               return ChooseConfiguration(config.scene, map.map.get(), target, std::nullopt);
@@ -386,8 +392,7 @@ int Serve(const Arguments& args) {
         }
       }
     }
-    if (choice.valid() &&
-        choice.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    if (choice.valid() && choice.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
       try {
         SupervisorDecision chosen = choice.get();
         if (chosen.configuration == decision.configuration) {
@@ -395,9 +400,10 @@ int Serve(const Arguments& args) {
           pending.reset();
           loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
         } else {
-          spdlog::info("better configuration for the target: {}; switching when the tool has "
-                       "been out of contact for {} s",
-                       chosen.reason, kSettleBeforeReconfigure_s);
+          spdlog::info(
+              "better configuration for the target: {}; switching when the tool has "
+              "been out of contact for {} s",
+              chosen.reason, kSettleBeforeReconfigure_s);
           pending = chosen;
           loop.SetErrorState(decision.error_percent,
                              DecisionFlags(decision) | force_flags::kReconfiguring);
@@ -425,10 +431,11 @@ int Serve(const Arguments& args) {
         black_box.Dump("force fault");
         last_fault_dump_ns = now;
       }
-      spdlog::error("force fault (non-finite or above input.max_force_n = {} N): zero force sent; "
-                    "the simulation restarts from rest and renders again after the tool has "
-                    "left the object",
-                    config.max_force_n);
+      spdlog::error(
+          "force fault (non-finite or above input.max_force_n = {} N): zero force sent; "
+          "the simulation restarts from rest and renders again after the tool has "
+          "left the object",
+          config.max_force_n);
       loop.Stop();
       loop.Start();
     }
@@ -439,8 +446,8 @@ int Serve(const Arguments& args) {
         snapshots.push_back(loop.monitor(r).TakeSnapshot());
       }
       if (bridge) {
-        bridge->PostStatus(MakeStatus(loop, snapshots, decision, target, pinned.has_value(),
-                                      map.path, &counters));
+        bridge->PostStatus(
+            MakeStatus(loop, snapshots, decision, target, pinned.has_value(), map.path, &counters));
       }
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {
@@ -468,9 +475,10 @@ int Serve(const Arguments& args) {
 
 int main(int argc, char** argv) {
   hapticsim::Arguments args;
-  CLI::App app{"hapticsimd: the haptic force daemon — device input in, force and its looked-up "
-               "error out at 1 kHz (LCM, host-local by default: ttl=0)",
-               "hapticsimd"};
+  CLI::App app{
+      "hapticsimd: the haptic force daemon — device input in, force and its looked-up "
+      "error out at 1 kHz (LCM, host-local by default: ttl=0)",
+      "hapticsimd"};
   app.add_option("--config,-c", args.config, "Configuration file (TOML)")->capture_default_str();
   app.add_flag("--check-config", args.check_config, "Validate the configuration and exit");
   app.add_flag("--print-config", args.print_config, "Print the configuration in effect and exit");

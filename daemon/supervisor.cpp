@@ -88,9 +88,9 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     }
   }
   if (candidates.empty()) {  // no map, or nothing usable in it: the scene's own configuration
-    const RegionConfiguration own = pinned.value_or(RegionConfiguration{
-        scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
-        scene.adaptivity.secondary_rate_hz});
+    const RegionConfiguration own = pinned.value_or(
+        RegionConfiguration{scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
+                            scene.adaptivity.secondary_rate_hz});
     candidates.push_back({own, -1, 0, false});
     if (!pinned) {
       RegionConfiguration equal = own;
@@ -100,13 +100,14 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
   }
   const bool have_map = candidates.front().error >= 0;
   // Cheapest first among those meeting the target; then the most accurate of the rest.
-  std::stable_sort(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
-    const bool a_meets = a.error >= 0 && a.error <= target_percent;
-    const bool b_meets = b.error >= 0 && b.error <= target_percent;
-    if (a_meets != b_meets) return a_meets;
-    if (a_meets) return a.cost < b.cost;
-    return a.error < b.error;
-  });
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [&](const Candidate& a, const Candidate& b) {
+                     const bool a_meets = a.error >= 0 && a.error <= target_percent;
+                     const bool b_meets = b.error >= 0 && b.error <= target_percent;
+                     if (a_meets != b_meets) return a_meets;
+                     if (a_meets) return a.cost < b.cost;
+                     return a.error < b.error;
+                   });
   SupervisorDecision decision;
   decision.have_map = have_map;
   for (const Candidate& candidate : candidates) {
@@ -131,10 +132,10 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     decision.reason = reason.str();
     return decision;
   }
-  throw Error(pinned ? "the pinned configuration " + Describe(*pinned) +
-                           " is not stable on this scene"
-                     : "no stable configuration for this scene (checked " +
-                           std::to_string(decision.stability_checks) + ")");
+  throw Error(pinned
+                  ? "the pinned configuration " + Describe(*pinned) + " is not stable on this scene"
+                  : "no stable configuration for this scene (checked " +
+                        std::to_string(decision.stability_checks) + ")");
 }
 
 }  // namespace hapticsim

@@ -19,13 +19,13 @@ struct RegionConfiguration {
 struct SupervisorDecision {
   RegionConfiguration configuration;
   bool have_map = false;
-  double error_percent = -1;      ///< looked-up worst magnitude error, % (-1 without a map)
+  double error_percent = -1;  ///< looked-up worst magnitude error, % (-1 without a map)
   bool target_met = false;
-  bool clamped = false;           ///< the scene is outside the map on some axis
-  double spectral_radius = 0;     ///< coupled, verified before choosing
-  double cost_us_per_ms = 0;      ///< mean measured cost in the map (0 without a map)
-  int stability_checks = 0;       ///< candidates whose stability was estimated
-  std::string reason;             ///< one line for the log
+  bool clamped = false;        ///< the scene is outside the map on some axis
+  double spectral_radius = 0;  ///< coupled, verified before choosing
+  double cost_us_per_ms = 0;   ///< mean measured cost in the map (0 without a map)
+  int stability_checks = 0;    ///< candidates whose stability was estimated
+  std::string reason;          ///< one line for the log
 };
 
 /**

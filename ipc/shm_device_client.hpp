@@ -24,7 +24,8 @@ class ShmDeviceClient {
       : mapping_(MappedSegment::Open(name)) {}
 
   /** The tool tip (object frame, m). Only one process may write: this is a single-writer slot. */
-  void WriteInput(std::int64_t seq, std::int64_t utime_us, const std::array<double, 3>& position_m) {
+  void WriteInput(std::int64_t seq, std::int64_t utime_us,
+                  const std::array<double, 3>& position_m) {
     ShmDeviceInput input;
     input.seq = seq;
     input.utime = utime_us;

@@ -26,18 +26,18 @@ inline constexpr const char* kDefaultName = "/hapticsim";
 
 /** The tool tip, written by the driver every device period. Object frame, as in LCM. */
 struct ShmDeviceInput {
-  std::int64_t seq = 0;        ///< increases by one per write; answered in ShmForceOutput::seq
-  std::int64_t utime = 0;      ///< driver's clock, µs
-  double position_m[3] = {};   ///< tool-tip position, m
+  std::int64_t seq = 0;       ///< increases by one per write; answered in ShmForceOutput::seq
+  std::int64_t utime = 0;     ///< driver's clock, µs
+  double position_m[3] = {};  ///< tool-tip position, m
 };
 
 /** The force, written by the daemon every primary period. */
 struct ShmForceOutput {
-  std::int64_t seq = -1;       ///< the input it answers (-1: none yet)
-  std::int64_t utime = 0;      ///< daemon's CLOCK_MONOTONIC, µs
-  double force_n[3] = {};      ///< force on the user, N
-  double error_percent = -1;   ///< looked-up error, % (-1: no map)
-  std::int32_t flags = 0;      ///< force_feedback_t::FLAG_* bits
+  std::int64_t seq = -1;      ///< the input it answers (-1: none yet)
+  std::int64_t utime = 0;     ///< daemon's CLOCK_MONOTONIC, µs
+  double force_n[3] = {};     ///< force on the user, N
+  double error_percent = -1;  ///< looked-up error, % (-1: no map)
+  std::int32_t flags = 0;     ///< force_feedback_t::FLAG_* bits
 };
 
 struct ShmHeader {

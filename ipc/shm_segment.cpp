@@ -20,8 +20,9 @@ std::string Why() { return std::strerror(errno); }
 }  // namespace
 
 MappedSegment MappedSegment::Create(const std::string& name, const std::string& group) {
-  HAPTICSIM_THROW_UNLESS(name.size() > 1 && name[0] == '/' && name.find('/', 1) == std::string::npos,
-                         "shm.name = \"" + name + "\": must be one '/' then a name, e.g. /hapticsim");
+  HAPTICSIM_THROW_UNLESS(
+      name.size() > 1 && name[0] == '/' && name.find('/', 1) == std::string::npos,
+      "shm.name = \"" + name + "\": must be one '/' then a name, e.g. /hapticsim");
   shm_unlink(name.c_str());  // a segment left by a crashed daemon
   const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   HAPTICSIM_THROW_UNLESS(fd >= 0, "cannot create shared memory " + name + ": " + Why());

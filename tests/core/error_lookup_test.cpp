@@ -1,11 +1,11 @@
 #include "core/error_lookup.hpp"
 
-#include "core/error.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+
+#include "core/error.hpp"
 
 namespace hapticsim {
 namespace {

@@ -1,12 +1,12 @@
 #include "core/error_map_file.hpp"
 
-#include "core/error.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+
+#include "core/error.hpp"
 
 namespace hapticsim {
 namespace {

@@ -7,10 +7,9 @@
 #include <fstream>
 
 #include "core/async_regions.hpp"
+#include "core/error.hpp"
 #include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
-
-#include "core/error.hpp"
 
 namespace hapticsim {
 namespace {
@@ -144,7 +143,9 @@ TEST(ErrorSweep, AResumedSweepSkipsJournalledTasksAndEndsWithTheSameMap) {
   ASSERT_GE(lines.size(), 4u);
   {
     std::ofstream out(journal, std::ios::trunc);
-    out << lines[0] << "\n" << lines[1] << "\n" << lines[2] << "\n"
+    out << lines[0] << "\n"
+        << lines[1] << "\n"
+        << lines[2] << "\n"
         << lines[3].substr(0, lines[3].size() / 2);
   }
   options.resume = true;

@@ -94,13 +94,15 @@ TEST(DaemonConfig, DefaultsAreValidHostLocalAndRoundTrip) {
 }
 
 TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
-  EXPECT_NE(ConfigError("[supervisor]\nerror_target = 5\n").find(":2: unknown key supervisor.error_target"),
+  EXPECT_NE(ConfigError("[supervisor]\nerror_target = 5\n")
+                .find(":2: unknown key supervisor.error_target"),
             std::string::npos)
       << ConfigError("[supervisor]\nerror_target = 5\n");
   EXPECT_NE(ConfigError("[supervisor]\nerror_target_percent = 0\n")
                 .find("supervisor.error_target_percent must be in (0, 100]"),
             std::string::npos);
-  EXPECT_NE(ConfigError("[input]\nstale_after_s = \"soon\"\n").find("input.stale_after_s must be a number"),
+  EXPECT_NE(ConfigError("[input]\nstale_after_s = \"soon\"\n")
+                .find("input.stale_after_s must be a number"),
             std::string::npos);
   EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 120\n").find("realtime.fifo_priority"),
             std::string::npos);

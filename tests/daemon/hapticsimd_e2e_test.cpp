@@ -1,9 +1,9 @@
 // hapticsimd end to end on a real LCM bus: run only inside a private network namespace
 // (tests/support/in_private_netns.sh creates one: loopback up, a multicast route on it), so the
 // daemon's default udpm:// URL is used as in production and no packet leaves the namespace.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -11,18 +11,17 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstring>
-
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <optional>
 #include <set>
-#include <functional>
 #include <thread>
 
 #include "hapticsim/command_t.hpp"
@@ -37,7 +36,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kEdge = 0.25;  // the default cube
 
-std::string Temp(const std::string& name) { return ::testing::TempDir() + "hapticsimd_e2e_" + name; }
+std::string Temp(const std::string& name) {
+  return ::testing::TempDir() + "hapticsimd_e2e_" + name;
+}
 
 // A two-configuration map for the default scene, made by the real sweep (a few seconds): the
 // primary sizes 1 (cheaper, about 2.7 % error) and 3 (about 0.4 %).
@@ -46,8 +47,8 @@ const std::string& SmallMap() {
     const std::string grid = Temp("grid.toml"), map = Temp("map.hsmap");
     std::ofstream(grid) << "[axes]\nsecondary_lod = [2]\nprimary_size = [1, 3]\n"
                            "secondary_rate = [1000.0]\nfrequency = [1.0]\n";
-    const auto result = testing::RunCommand(
-        {HAPTICSIM_CLI_PATH, "sweep", "--grid", grid, "--out", map, "--json"});
+    const auto result =
+        testing::RunCommand({HAPTICSIM_CLI_PATH, "sweep", "--grid", grid, "--out", map, "--json"});
     EXPECT_EQ(result.exit_status, 0) << result.err;
     return map;
   }();
@@ -135,7 +136,8 @@ class HapticsimdEndToEnd : public ::testing::Test {
 TEST_F(HapticsimdEndToEnd, AnswersDeviceInputWithForceErrorAndItsSeq) {
   Client client;
   ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 30))
-      << "no status from the daemon; its log:\n" << daemon_->Log();
+      << "no status from the daemon; its log:\n"
+      << daemon_->Log();
   std::set<std::int64_t> sent;
   auto next = Clock::now();
   for (std::int64_t seq = 1; seq <= 1300; ++seq) {
@@ -190,10 +192,10 @@ TEST_F(HapticsimdEndToEnd, BadInputIsRejectedCountedAndTheDaemonKeepsServing) {
     client.Send(seq, kEdge / 2, kEdge / 2, 0.002);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  client.Send(51, NAN, kEdge / 2, 0.002);             // non-finite
-  client.Send(52, kEdge / 2, kEdge / 2, 5.0);         // far outside the workspace
-  client.Send(53, kEdge / 2 + 0.2, kEdge / 2, 0.002); // a jump no hand can make in 1 ms
-  client.Send(40, kEdge / 2, kEdge / 2, 0.002);       // an old seq
+  client.Send(51, NAN, kEdge / 2, 0.002);              // non-finite
+  client.Send(52, kEdge / 2, kEdge / 2, 5.0);          // far outside the workspace
+  client.Send(53, kEdge / 2 + 0.2, kEdge / 2, 0.002);  // a jump no hand can make in 1 ms
+  client.Send(40, kEdge / 2, kEdge / 2, 0.002);        // an old seq
   client.SendRaw("this is not an LCM message");
   ASSERT_TRUE(client.WaitForStatus(
       [](const status_t& s) { return s.inputs_rejected >= 4 && s.decode_errors >= 1; }, 5))
@@ -264,7 +266,8 @@ TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
   Client client;
   ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 30)) << daemon.Log();
   for (std::int64_t seq = 1; seq <= 800; ++seq) {  // from above the surface, 1 cm in
-    client.Send(seq, kEdge / 2, kEdge / 2, seq <= 50 ? -0.002 : 0.01 * std::min(1.0, (seq - 50) / 400.0));
+    client.Send(seq, kEdge / 2, kEdge / 2,
+                seq <= 50 ? -0.002 : 0.01 * std::min(1.0, (seq - 50) / 400.0));
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -302,8 +305,8 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
   ASSERT_EQ(stat(("/dev/shm" + name).c_str(), &info), 0);
   EXPECT_EQ(info.st_mode & 0777, 0660u) << "owner and group only";
 
-  const auto result = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name,
-                                           "--duration", "2"});
+  const auto result =
+      testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name, "--duration", "2"});
   ASSERT_EQ(result.exit_status, 0) << result.err;
   const std::string& json = result.out;
   auto number = [&json](const std::string& key) {

@@ -23,15 +23,9 @@ std::string Slurp(const std::string& path) {
   return buffer.str();
 }
 
-}  // namespace
-
-CommandResult RunCommand(const std::vector<std::string>& argv) {
-  char out_path[] = "/tmp/hapticsim-test-out-XXXXXX";
-  char err_path[] = "/tmp/hapticsim-test-err-XXXXXX";
-  const int out_fd = mkstemp(out_path);
-  const int err_fd = mkstemp(err_path);
-  if (out_fd < 0 || err_fd < 0) throw std::runtime_error("mkstemp failed");
-
+// Starts argv[0] (no PATH search) with its stdout and stderr on the given descriptors.
+// Returns the pid, or -1 when it could not be started.
+pid_t Spawn(const std::vector<std::string>& argv, int out_fd, int err_fd) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, out_fd, STDOUT_FILENO);
@@ -42,10 +36,23 @@ CommandResult RunCommand(const std::vector<std::string>& argv) {
   pid_t pid = 0;
   const int spawned = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  return spawned == 0 ? pid : -1;
+}
+
+}  // namespace
+
+CommandResult RunCommand(const std::vector<std::string>& argv) {
+  char out_path[] = "/tmp/hapticsim-test-out-XXXXXX";
+  char err_path[] = "/tmp/hapticsim-test-err-XXXXXX";
+  const int out_fd = mkstemp(out_path);
+  const int err_fd = mkstemp(err_path);
+  if (out_fd < 0 || err_fd < 0) throw std::runtime_error("mkstemp failed");
+
+  const pid_t pid = Spawn(argv, out_fd, err_fd);
   close(out_fd);
   close(err_fd);
   CommandResult result;
-  if (spawned == 0) {
+  if (pid > 0) {
     int status = 0;
     waitpid(pid, &status, 0);
     result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -62,19 +69,9 @@ BackgroundProcess::BackgroundProcess(const std::vector<std::string>& argv,
     : log_path_(log_path) {
   const int log_fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (log_fd < 0) throw std::runtime_error("cannot write " + log_path);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, log_fd, STDOUT_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, log_fd, STDERR_FILENO);
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  pid_ = Spawn(argv, log_fd, log_fd);
   close(log_fd);
-  if (spawned != 0) throw std::runtime_error("cannot start " + argv[0]);
-  pid_ = pid;
+  if (pid_ < 0) throw std::runtime_error("cannot start " + argv[0]);
 }
 
 BackgroundProcess::~BackgroundProcess() {

@@ -6,22 +6,15 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "tests/support/run_command.hpp"
+#include "tests/support/hapticsim_cli.hpp"
 
 namespace hapticsim {
 namespace {
 
 using testing::CommandResult;
 
-CommandResult Hapticsim(std::vector<std::string> args) {
-  args.insert(args.begin(), HAPTICSIM_CLI_PATH);
-  return testing::RunCommand(args);
-}
-
-nlohmann::json Json(const CommandResult& result) {
-  EXPECT_EQ(result.exit_status, 0) << result.err;
-  return nlohmann::json::parse(result.out);
-}
+using testing::Hapticsim;
+using testing::Json;
 
 std::string Temp(const std::string& name) { return ::testing::TempDir() + "hsmap_cli_" + name; }
 
@@ -89,8 +82,9 @@ TEST(ErrorMapCli, LookupInterpolatesClampsWithAFlagAndRefusesUnknownAxes) {
                                       "primary_size=3", "--set", "secondary_rate=1000", "--json"}));
   EXPECT_FALSE(inside["clamped"].get<bool>());
   EXPECT_GE(inside["error"].get<double>(), 0.0);
-  const auto outside = Json(Hapticsim({"lookup", map, "--set", "youngs_modulus=90000", "--set",
-                                       "primary_size=3", "--set", "secondary_rate=1000", "--json"}));
+  const auto outside =
+      Json(Hapticsim({"lookup", map, "--set", "youngs_modulus=90000", "--set", "primary_size=3",
+                      "--set", "secondary_rate=1000", "--json"}));
   EXPECT_TRUE(outside["clamped"].get<bool>());
   EXPECT_EQ(outside["clamped_axis"], "youngs_modulus");
   const CommandResult bad = Hapticsim({"lookup", map, "--set", "stiffness=3"});

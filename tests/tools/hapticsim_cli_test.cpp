@@ -1,35 +1,28 @@
 // The hapticsim binary as a user runs it: exit statuses, JSON shapes, files written, and the
 // messages bad input gets.
+#include "tests/support/hapticsim_cli.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "tests/support/run_command.hpp"
-
 namespace hapticsim {
 namespace {
 
 using testing::CommandResult;
 
-CommandResult Hapticsim(std::vector<std::string> args) {
-  args.insert(args.begin(), HAPTICSIM_CLI_PATH);
-  return testing::RunCommand(args);
-}
-
-nlohmann::json Json(const CommandResult& result) {
-  EXPECT_EQ(result.exit_status, 0) << result.err;
-  return nlohmann::json::parse(result.out);
-}
+using testing::Hapticsim;
+using testing::Json;
 
 std::string Temp(const std::string& name) { return ::testing::TempDir() + name; }
 
 TEST(HapticsimCli, HelpListsTheSubcommands) {
   const CommandResult result = Hapticsim({"--help"});
   EXPECT_EQ(result.exit_status, 0);
-  for (const char* sub : {"simulate", "static", "stability", "scene", "sweep", "map", "lookup",
-                          "analyze"}) {
+  for (const char* sub :
+       {"simulate", "static", "stability", "scene", "sweep", "map", "lookup", "analyze"}) {
     EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
   }
 }

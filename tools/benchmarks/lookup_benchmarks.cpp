@@ -1,6 +1,6 @@
 // The run-time error lookup on a map the size of the paper's grid (77,760 points), and loading
-// one lookup table (with the samples' status) from disk: both must fit the daemon's budgets (a lookup per 1 kHz period, a
-// load well under a millisecond per table).
+// one lookup table (with the samples' status) from disk: both must fit the daemon's budgets (a
+// lookup per 1 kHz period, a load well under a millisecond per table).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -24,9 +24,7 @@ ErrorMap PaperSizedMap() {
 }
 
 // A query between grid points on every continuous axis: 2^7 corners.
-MapPoint BetweenGridPoints() {
-  return {0.43, 900, 15, 12000, 0.007, 0.8, 2, 3, 750};
-}
+MapPoint BetweenGridPoints() { return {0.43, 900, 15, 12000, 0.007, 0.8, 2, 3, 750}; }
 
 void BM_LookupPoint(benchmark::State& state) {
   const ErrorLookup lookup(PaperSizedMap(), ErrorField::kMagnitude);

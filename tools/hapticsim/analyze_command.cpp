@@ -72,8 +72,8 @@ void WriteReport(const ErrorMap& map, const PartialCorrelationTable& table, Erro
   for (const MapSample& s : map.samples) {
     nlohmann::json row = nlohmann::json::array();
     for (double v : s.point) row.push_back(Rounded(v));
-    for (double v : {s.l2_percent, s.max_magnitude_percent, s.max_direction_deg,
-                     s.reference_peak_n, s.total_cost_us_per_ms()}) {
+    for (double v : {s.l2_percent, s.max_magnitude_percent, s.max_direction_deg, s.reference_peak_n,
+                     s.total_cost_us_per_ms()}) {
       row.push_back(Rounded(v));
     }
     row.push_back(static_cast<int>(s.status));
@@ -117,9 +117,9 @@ int Run(const AnalyzeOptions& o) {
   if (!o.report.empty()) WriteReport(map, table, field, o.report);
   if (o.json) {
     nlohmann::ordered_json out = {{"map", o.map},
-                          {"field", ErrorFieldName(field)},
-                          {"samples", table.samples},
-                          {"correlations", CorrelationsJson(table)}};
+                                  {"field", ErrorFieldName(field)},
+                                  {"samples", table.samples},
+                                  {"correlations", CorrelationsJson(table)}};
     if (!o.report.empty()) out["report"] = o.report;
     std::cout << out.dump(2) << "\n";
     return kExitOk;
@@ -128,8 +128,9 @@ int Run(const AnalyzeOptions& o) {
             << "controlling for the others (" << table.samples << " ok samples of "
             << map.samples.size() << ")\n\n"
             << std::left << std::setw(18) << "parameter" << std::right << std::setw(11)
-            << "Pearson r" << std::setw(11) << "p" << std::setw(13) << "Spearman ρ"
-            << std::setw(11) << "p" << "\n";
+            << "Pearson r" << std::setw(11) << "p" << std::setw(13) << "Spearman ρ" << std::setw(11)
+            << "p"
+            << "\n";
   auto cell = [](const std::optional<Correlation>& c, bool p) {
     char buffer[32];
     if (!c) return std::string("—");

@@ -1,10 +1,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "core/error.hpp"
 #include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
 #include "core/scene_toml.hpp"
-#include "core/error.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 
@@ -53,8 +53,8 @@ int Run(const LookupCommandOptions& o) {
     }
     const size_t colon = value.find(':');
     query.lo[axis] = ParseNumber(key, value.substr(0, colon));
-    query.hi[axis] = colon == std::string::npos ? query.lo[axis]
-                                                : ParseNumber(key, value.substr(colon + 1));
+    query.hi[axis] =
+        colon == std::string::npos ? query.lo[axis] : ParseNumber(key, value.substr(colon + 1));
   }
   const LookupResult result = lookup.Lookup(query);
   const char* unit = field == ErrorField::kDirection ? "°" : "%";

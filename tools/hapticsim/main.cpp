@@ -28,10 +28,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", hapticsim::CodeVersion());
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every subcommand");
-  const std::vector<Command> commands{AddSimulateCommand(app), AddStaticCommand(app),
+  const std::vector<Command> commands{AddSimulateCommand(app),  AddStaticCommand(app),
                                       AddStabilityCommand(app), AddSceneCommand(app),
-                                      AddSweepCommand(app), AddMapCommand(app),
-                                      AddLookupCommand(app), AddAnalyzeCommand(app)};
+                                      AddSweepCommand(app),     AddMapCommand(app),
+                                      AddLookupCommand(app),    AddAnalyzeCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

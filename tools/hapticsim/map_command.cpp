@@ -4,8 +4,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/error_map_file.hpp"
 #include "core/error.hpp"
+#include "core/error_map_file.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 
@@ -61,8 +61,8 @@ int Info(const MapCommandOptions& o) {
   }
   std::cout << "Error map " << o.map << " (format " << kErrorMapFormatVersion << ", "
             << (map.grid ? "grid" : "scattered") << ")\n"
-            << "  made by " << p.code_version << " from grid '" << p.grid << "', shard "
-            << p.shard << (p.linearity_used ? ", amplitude axis from linearity" : "") << "\n"
+            << "  made by " << p.code_version << " from grid '" << p.grid << "', shard " << p.shard
+            << (p.linearity_used ? ", amplitude axis from linearity" : "") << "\n"
             << "  model: " << p.model << "\n"
             << "  samples: " << map.samples.size() << " — ok " << ok << ", predicted unstable "
             << map.CountStatus(SampleStatus::kPredictedUnstable) << ", diverged "

@@ -4,10 +4,10 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "core/error.hpp"
 #include "core/error_map_file.hpp"
 #include "core/error_sweep.hpp"
 #include "core/sweep_grid_file.hpp"
-#include "core/error.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/progress_line.hpp"
@@ -115,9 +115,8 @@ int Run(const SweepCommandOptions& o) {
             << "  ok " << map.CountStatus(SampleStatus::kOk) << ", predicted unstable "
             << map.CountStatus(SampleStatus::kPredictedUnstable) << " (not simulated), diverged "
             << map.CountStatus(SampleStatus::kDiverged) << "\n"
-            << "  runs made: " << stats.reference_trials << " references, "
-            << stats.adaptive_trials << " adaptive trials, " << stats.stability_estimates
-            << " coupled-stability estimates"
+            << "  runs made: " << stats.reference_trials << " references, " << stats.adaptive_trials
+            << " adaptive trials, " << stats.stability_estimates << " coupled-stability estimates"
             << (stats.samples_resumed ? ", " + std::to_string(stats.samples_resumed) +
                                             " samples resumed from the journal"
                                       : "")
@@ -152,8 +151,9 @@ Command AddSweepCommand(CLI::App& parent) {
                   "analysis; lookup needs a grid)")
       ->type_name("N");
   app->add_option("--seed", o->seed, "Random seed of --monte-carlo")->capture_default_str();
-  app->add_option("--jobs,-j", o->jobs, "Worker threads")->capture_default_str()->check(
-      CLI::Range(1, 256));
+  app->add_option("--jobs,-j", o->jobs, "Worker threads")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
   app->add_option("--out,-o", o->out, "Map file to write")->capture_default_str();
   app->add_flag("--resume", o->resume,
                 "Continue an interrupted sweep from OUT.journal (same command otherwise)");

@@ -27,9 +27,10 @@ std::int64_t NowNs() {
 int main(int argc, char** argv) {
   std::string name = hapticsim::shm::kDefaultName;
   double duration_s = 2.0, depth_m = 0.01, edge_m = 0.25;
-  CLI::App app{"hapticsim-shm-client: drive hapticsimd through shared memory at 1 kHz and "
-               "summarise its answers as JSON",
-               "hapticsim-shm-client"};
+  CLI::App app{
+      "hapticsim-shm-client: drive hapticsimd through shared memory at 1 kHz and "
+      "summarise its answers as JSON",
+      "hapticsim-shm-client"};
   app.add_option("--name", name, "Shared-memory name")->capture_default_str();
   app.add_option("--duration", duration_s, "Seconds to run")->capture_default_str();
   app.add_option("--depth", depth_m, "Deepest press into the object, m")->capture_default_str();
@@ -45,16 +46,19 @@ int main(int argc, char** argv) {
     const std::int64_t start = NowNs() + 1'000'000;
     for (std::int64_t seq = 1; seq <= periods; ++seq) {
       const std::int64_t release = start + (seq - 1) * 1'000'000;
-      timespec at{static_cast<time_t>(release / 1'000'000'000), static_cast<long>(release % 1'000'000'000)};
+      timespec at{static_cast<time_t>(release / 1'000'000'000),
+                  static_cast<long>(release % 1'000'000'000)};
       while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &at, nullptr) == EINTR) {
       }
       // Above the surface for the first fifth, then a press of depth_m and back (1 Hz shape).
       const double t = static_cast<double>(seq) / periods;
-      const double z = t < 0.2 ? -0.002 : depth_m * 0.5 * (1 - std::cos(2 * M_PI * (t - 0.2) / 0.8));
+      const double z =
+          t < 0.2 ? -0.002 : depth_m * 0.5 * (1 - std::cos(2 * M_PI * (t - 0.2) / 0.8));
       client.WriteInput(seq, release / 1000, {edge_m / 2, edge_m / 2, z});
       // Read the answer just before the next period.
       const std::int64_t read_at = release + 900'000;
-      timespec then{static_cast<time_t>(read_at / 1'000'000'000), static_cast<long>(read_at % 1'000'000'000)};
+      timespec then{static_cast<time_t>(read_at / 1'000'000'000),
+                    static_cast<long>(read_at % 1'000'000'000)};
       while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &then, nullptr) == EINTR) {
       }
       hapticsim::shm::ShmForceOutput force;
@@ -69,15 +73,15 @@ int main(int argc, char** argv) {
       if (force.flags & 8) ++stale;
       max_push_back = std::max(max_push_back, -force.force_n[2]);
     }
-    std::printf("{\"periods\": %lld, \"answered_same_period\": %lld, \"distinct_seqs_answered\": %zu, "
-                "\"max_lag_periods\": %lld, \"out_of_order\": %lld, \"nonfinite_forces\": %lld, "
-                "\"in_contact_periods\": %lld, \"stale_periods\": %lld, \"max_push_back_N\": %.6g, "
-                "\"daemon_running\": %s}\n",
-                static_cast<long long>(periods), static_cast<long long>(answered_same_period),
-                seen.size(), static_cast<long long>(max_lag), static_cast<long long>(out_of_order),
-                static_cast<long long>(nonfinite), static_cast<long long>(in_contact),
-                static_cast<long long>(stale), max_push_back,
-                client.DaemonRunning() ? "true" : "false");
+    std::printf(
+        "{\"periods\": %lld, \"answered_same_period\": %lld, \"distinct_seqs_answered\": %zu, "
+        "\"max_lag_periods\": %lld, \"out_of_order\": %lld, \"nonfinite_forces\": %lld, "
+        "\"in_contact_periods\": %lld, \"stale_periods\": %lld, \"max_push_back_N\": %.6g, "
+        "\"daemon_running\": %s}\n",
+        static_cast<long long>(periods), static_cast<long long>(answered_same_period), seen.size(),
+        static_cast<long long>(max_lag), static_cast<long long>(out_of_order),
+        static_cast<long long>(nonfinite), static_cast<long long>(in_contact),
+        static_cast<long long>(stale), max_push_back, client.DaemonRunning() ? "true" : "false");
     return 0;
   } catch (const hapticsim::Error& e) {
     std::fprintf(stderr, "hapticsim-shm-client: error: %s\n", e.what());

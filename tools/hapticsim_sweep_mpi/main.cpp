@@ -62,11 +62,11 @@ int Sweep(const Options& o, int rank, int size) {
   }
   const ErrorMap merged = MergeErrorMaps(shards);
   SaveErrorMap(merged, o.out);
-  std::printf("{\"map\": \"%s\", \"ranks\": %d, \"samples\": %zu, \"not_computed\": %zu, "
-              "\"results_checksum\": %llu}\n",
-              o.out.c_str(), size, merged.samples.size(),
-              merged.CountStatus(SampleStatus::kNotComputed),
-              static_cast<unsigned long long>(merged.ResultsChecksum()));
+  std::printf(
+      "{\"map\": \"%s\", \"ranks\": %d, \"samples\": %zu, \"not_computed\": %zu, "
+      "\"results_checksum\": %llu}\n",
+      o.out.c_str(), size, merged.samples.size(), merged.CountStatus(SampleStatus::kNotComputed),
+      static_cast<unsigned long long>(merged.ResultsChecksum()));
   return 0;
 }
 
@@ -78,9 +78,10 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   Options o;
-  CLI::App app{"hapticsim-sweep-mpi: hapticsim sweep across MPI ranks (one shard per rank, "
-               "merged by rank 0)",
-               "hapticsim-sweep-mpi"};
+  CLI::App app{
+      "hapticsim-sweep-mpi: hapticsim sweep across MPI ranks (one shard per rank, "
+      "merged by rank 0)",
+      "hapticsim-sweep-mpi"};
   hapticsim::cli::AddSceneOptions(&app, &o.scene);
   app.add_option("--grid", o.grid, "paper, quick, scene or FILE.toml")->capture_default_str();
   app.add_option("--monte-carlo", o.monte_carlo, "N scattered points instead of a grid");
