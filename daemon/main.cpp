@@ -137,7 +137,7 @@ struct MapState {
   std::unique_ptr<ErrorMap> map;
 };
 
-MapState LoadMap(const std::string& path) {
+MapState LoadMap(const std::string& path, bool reload = false) {
   MapState state{path, nullptr};
   if (path.empty()) return state;
   try {
@@ -145,8 +145,10 @@ MapState LoadMap(const std::string& path) {
     spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
                  state.map->provenance.grid, state.map->provenance.code_version);
   } catch (const Error& e) {
-    spdlog::error("{}; running without an error map (forces carry error -1 and the no-map flag)",
-                  e.what());
+    spdlog::error("{}; {}", e.what(),
+                  reload ? "keeping the map loaded before"
+                         : "running without an error map (forces carry error -1 and the no-map "
+                           "flag)");
   }
   return state;
 }
@@ -322,7 +324,7 @@ int Serve(const Arguments& args) {
     }
     if (signal == SIGHUP) {
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
-      MapState reloaded = LoadMap(config.error_map);
+      MapState reloaded = LoadMap(config.error_map, true);
       if (reloaded.map || config.error_map.empty()) {
         map = std::move(reloaded);
         decision = ChooseConfiguration(config.scene, map.map.get(), target, decision.configuration);

@@ -289,6 +289,34 @@ TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
   EXPECT_EQ(daemon.Wait(5), 0);
 }
 
+// SIGHUP reloads the map; a damaged one is refused and the loaded one kept, and the loop runs on.
+TEST(HapticsimdReload, ACorruptMapOnReloadIsRefusedAndTheDaemonKeepsServing) {
+  const std::string map = Temp("reload.hsmap");
+  std::filesystem::copy_file(SmallMap(), map, std::filesystem::copy_options::overwrite_existing);
+  const std::string config = Temp("reload.toml");
+  std::ofstream(config) << "[supervisor]\nerror_map = \"" << map << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("reload.log"));
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.error_percent > 0; }, 30))
+      << daemon.Log();
+  const double error = client.LastStatus()->error_percent;
+  std::filesystem::resize_file(map, std::filesystem::file_size(map) / 2);  // truncated
+  daemon.Signal(SIGHUP);
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (daemon.Log().find("truncated") == std::string::npos && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_NE(daemon.Log().find("refused: truncated"), std::string::npos) << daemon.Log();
+  EXPECT_NE(daemon.Log().find("keeping the map loaded before"), std::string::npos);
+  const std::int64_t cycles = client.LastStatus()->regions[0].cycles;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(daemon.running()) << daemon.Log();
+  EXPECT_GT(client.LastStatus()->regions[0].cycles, cycles + 200) << "the loop stopped";
+  EXPECT_EQ(client.LastStatus()->error_percent, error) << "the loaded map was dropped";
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0);
+}
+
 // The shared-memory interface with a real second process: the example driver client.
 TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
   const std::string name = "/hapticsim-e2e-" + std::to_string(getpid());
