@@ -4,8 +4,10 @@
 //
 //   hapticsimd [--config /etc/hapticsim/hapticsimd.toml] [--check-config] [--print-config]
 //
-// Signals: SIGTERM/SIGINT stop cleanly; SIGHUP reloads the error map (a bad one is refused and
-// the old one kept). Exit status: 0 clean stop, 2 bad configuration, 1 anything else.
+// Signals: SIGTERM/SIGINT stop cleanly; SIGHUP reloads the config's [supervisor] and [log] keys
+// and the error map (a bad config or map is refused and the running one kept), then chooses the
+// configuration again (switched only while nothing touches the object).
+// Exit status: 0 clean stop, 2 bad configuration, 1 anything else.
 #include <signal.h>
 #include <spdlog/async.h>
 #include <spdlog/sinks/stdout_sinks.h>
@@ -134,14 +136,14 @@ class BlackBox {
 
 struct MapState {
   std::string path;
-  std::unique_ptr<ErrorMap> map;
+  std::shared_ptr<const ErrorMap> map;  // shared with a choice being computed
 };
 
 MapState LoadMap(const std::string& path, bool reload = false) {
   MapState state{path, nullptr};
   if (path.empty()) return state;
   try {
-    state.map = std::make_unique<ErrorMap>(LoadErrorMap(path));
+    state.map = std::make_shared<const ErrorMap>(LoadErrorMap(path));
     spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
                  state.map->provenance.grid, state.map->provenance.code_version);
   } catch (const Error& e) {
@@ -323,13 +325,35 @@ int Serve(const Arguments& args) {
       break;
     }
     if (signal == SIGHUP) {
+      // The supervisor's keys and the map take effect now; the others need a restart.
+      if (!default_missing) {
+        try {
+          DaemonConfig fresh = LoadDaemonConfig(args.config);
+          if (!args.error_map.empty()) fresh.error_map = args.error_map;
+          if (!args.lcm_url.empty()) fresh.lcm_url = args.lcm_url;
+          target = fresh.error_target_percent;
+          config.error_target_percent = fresh.error_target_percent;
+          config.error_map = fresh.error_map;
+          config.status_rate_hz = fresh.status_rate_hz;
+          config.max_log_lines_per_s = fresh.max_log_lines_per_s;
+          config.log_level = fresh.log_level;
+          logger->set_level(spdlog::level::from_str(config.log_level));
+          if (FormatDaemonConfig(fresh) != FormatDaemonConfig(config)) {
+            spdlog::warn("SIGHUP: {} changed keys outside [supervisor] and [log]; they take "
+                         "effect at the next restart",
+                         args.config);
+          }
+        } catch (const Error& e) {
+          spdlog::error("SIGHUP: config reload refused: {}; keeping the running configuration",
+                        e.what());
+        }
+      }
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
       MapState reloaded = LoadMap(config.error_map, true);
-      if (reloaded.map || config.error_map.empty()) {
-        map = std::move(reloaded);
-        decision = ChooseConfiguration(config.scene, map.map.get(), target, decision.configuration);
-        loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
-      }
+      if (reloaded.map || config.error_map.empty()) map = std::move(reloaded);
+      choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target] {
+        return ChooseConfiguration(scene, m.get(), target, std::nullopt);
+      });
     }
     const std::int64_t now = HapticLoop::NowNs();
     if (args.duration_s > 0 && (now - start_ns) * 1e-9 >= args.duration_s) {
@@ -379,8 +403,8 @@ int Serve(const Arguments& args) {
                 "again",
                 target, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
             // Stability estimates take up to seconds: off the supervisor's tick.
-            choice = std::async(std::launch::async, [&config, &map, target] {
-              return ChooseConfiguration(config.scene, map.map.get(), target, std::nullopt);
+            choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target] {
+              return ChooseConfiguration(scene, m.get(), target, std::nullopt);
             });
             break;
           case command_t::RESET:
@@ -439,6 +463,7 @@ int Serve(const Arguments& args) {
           "left the object",
           config.max_force_n);
       loop.Stop();
+      faults_seen = loop.force_faults();  // the periods between the count and the stop included
       loop.Start();
     }
     if (now >= next_status_ns) {

@@ -313,6 +313,18 @@ TEST(HapticsimdReload, ACorruptMapOnReloadIsRefusedAndTheDaemonKeepsServing) {
   ASSERT_TRUE(daemon.running()) << daemon.Log();
   EXPECT_GT(client.LastStatus()->regions[0].cycles, cycles + 200) << "the loop stopped";
   EXPECT_EQ(client.LastStatus()->error_percent, error) << "the loaded map was dropped";
+
+  // A config with a mistake is refused whole; a good one changes the target at once.
+  std::ofstream(config) << "[supervisor]\nerror_map = \"" << map << "\"\nerror_target = 3\n";
+  daemon.Signal(SIGHUP);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_NE(daemon.Log().find("config reload refused"), std::string::npos) << daemon.Log();
+  std::ofstream(config) << "[supervisor]\nerror_map = \"" << map
+                        << "\"\nerror_target_percent = 3.5\n";
+  daemon.Signal(SIGHUP);
+  EXPECT_TRUE(client.WaitForStatus([](const status_t& s) { return s.error_target_percent == 3.5; },
+                                   5))
+      << daemon.Log();
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0);
 }
