@@ -30,11 +30,14 @@
 #include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
 #include "core/error_sweep.hpp"
+#include "daemon/black_box.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
 #include "daemon/lcm_bridge.hpp"
+#include "daemon/miss_logger.hpp"
 #include "daemon/shm_server.hpp"
+#include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"
 #include "daemon/systemd_notify.hpp"
 
@@ -65,75 +68,6 @@ std::shared_ptr<spdlog::logger> MakeLogger(const std::string& level) {
   return logger;
 }
 
-// Collapses deadline misses into one line per burst: a burst ends after 200 ms without a miss.
-class MissLogger {
- public:
-  MissLogger(std::string thread, double max_lines_per_s)
-      : thread_(std::move(thread)), min_gap_s_(1.0 / max_lines_per_s) {}
-
-  void Add(const DeadlineEvent& event) {
-    if (count_ == 0) first_ns_ = event.release_ns;
-    ++count_;
-    last_ns_ = event.release_ns;
-    worst_lateness_ns_ = std::max(worst_lateness_ns_, event.lateness_ns);
-    worst_execution_ns_ = std::max(worst_execution_ns_, event.execution_ns);
-  }
-
-  void Flush(std::int64_t now_ns, bool force = false) {
-    if (count_ == 0) return;
-    const bool quiet = now_ns - last_ns_ > 200'000'000;
-    const bool allowed = (now_ns - last_line_ns_) * 1e-9 >= min_gap_s_;
-    if (!(force || (quiet && allowed))) return;
-    spdlog::warn(
-        "deadline misses: {} thread, {} periods late over {:.1f} ms (worst wake-up "
-        "lateness {:.0f} µs, worst compute {:.0f} µs)",
-        thread_, count_, (last_ns_ - first_ns_) * 1e-6, worst_lateness_ns_ * 1e-3,
-        worst_execution_ns_ * 1e-3);
-    count_ = 0;
-    worst_lateness_ns_ = worst_execution_ns_ = 0;
-    last_line_ns_ = now_ns;
-  }
-
- private:
-  std::string thread_;
-  double min_gap_s_;
-  std::int64_t count_ = 0, first_ns_ = 0, last_ns_ = 0, last_line_ns_ = 0;
-  std::int64_t worst_lateness_ns_ = 0, worst_execution_ns_ = 0;
-};
-
-// The last cycles of the primary loop, kept by the supervisor and logged when a fault happens.
-class BlackBox {
- public:
-  explicit BlackBox(size_t cycles) : records_(cycles) {}
-  void Drain(HapticLoop& loop) {
-    BlackBoxRecord record;
-    while (loop.black_box().Pop(&record)) {
-      records_[next_ % records_.size()] = record;
-      ++next_;
-    }
-  }
-  void Dump(const std::string& why) const {
-    const size_t count = std::min(next_, records_.size());
-    spdlog::error("black box ({}): the last {} primary periods, oldest first", why, count);
-    if (count == 0) return;
-    const std::int64_t end = records_[(next_ - 1) % records_.size()].time_ns;
-    for (size_t i = next_ - count; i < next_; ++i) {
-      const BlackBoxRecord& r = records_[i % records_.size()];
-      spdlog::error(
-          "black box: t {:+.1f} ms seq {} tip ({:.4f}, {:.4f}, {:.4f}) m force sent "
-          "({:.3f}, {:.3f}, {:.3f}) N simulated ({:.3g}, {:.3g}, {:.3g}) N error {:.2f} % "
-          "flags 0x{:x}",
-          (r.time_ns - end) * 1e-6, r.seq, r.position_m[0], r.position_m[1], r.position_m[2],
-          r.force_n[0], r.force_n[1], r.force_n[2], r.raw_force_n[0], r.raw_force_n[1],
-          r.raw_force_n[2], r.error_percent, r.flags);
-    }
-  }
-
- private:
-  std::vector<BlackBoxRecord> records_;
-  size_t next_ = 0;
-};
-
 struct MapState {
   std::string path;
   std::shared_ptr<const ErrorMap> map;  // shared with a choice being computed
@@ -161,49 +95,6 @@ std::int32_t DecisionFlags(const SupervisorDecision& d) {
   if (d.have_map && !d.target_met) flags |= force_flags::kErrorTargetExceeded;
   if (d.clamped) flags |= force_flags::kLookupClamped;
   return flags;
-}
-
-status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
-                    const SupervisorDecision& decision, double target, bool pinned,
-                    const std::string& map_path, const InputCounters* counters) {
-  status_t s{};
-  s.utime = HapticLoop::NowNs() / 1000;
-  s.primary_size = decision.configuration.primary_size;
-  s.secondary_lod = decision.configuration.secondary_lod;
-  s.secondary_rate_hz = decision.configuration.secondary_rate_hz;
-  s.spectral_radius = decision.spectral_radius;
-  s.error_target_percent = target;
-  s.error_percent = decision.error_percent;
-  s.target_met = decision.target_met;
-  s.pinned = pinned;
-  s.error_map = decision.have_map ? map_path : "";
-  if (counters) {
-    s.inputs_received = counters->inputs_received.load();
-    s.inputs_rejected = counters->inputs_rejected.load();
-    s.decode_errors = counters->decode_errors.load();
-    s.forces_published = counters->forces_published.load();
-  }
-  s.stale_periods = loop.stale_periods();
-  const AsyncRegions& regions = loop.regions();
-  s.num_regions = regions.num_regions();
-  for (int r = 0; r < regions.num_regions(); ++r) {
-    const DeadlineSnapshot& d = snapshots[r];
-    region_status_t region{};
-    region.name = regions.partition().RegionName(r);
-    region.nodes = regions.partition().num_nodes(r);
-    region.rate_hz = regions.schedule(r).rate_hz;
-    region.substeps = regions.schedule(r).substeps;
-    region.critical_dt_s = regions.schedule(r).alone.critical_dt_s;
-    region.cycles = d.cycles;
-    region.deadline_misses = d.misses;
-    region.worst_lateness_us = d.worst_lateness_s * 1e6;
-    region.recent_lateness_us = d.recent_worst_lateness_s * 1e6;
-    region.execution_p50_us = d.recent_execution_p50_s * 1e6;
-    region.execution_p99_us = d.recent_execution_p99_s * 1e6;
-    region.execution_max_us = d.recent_execution_max_s * 1e6;
-    s.regions.push_back(region);
-  }
-  return s;
 }
 
 int Serve(const Arguments& args) {
@@ -339,9 +230,10 @@ int Serve(const Arguments& args) {
           config.log_level = fresh.log_level;
           logger->set_level(spdlog::level::from_str(config.log_level));
           if (FormatDaemonConfig(fresh) != FormatDaemonConfig(config)) {
-            spdlog::warn("SIGHUP: {} changed keys outside [supervisor] and [log]; they take "
-                         "effect at the next restart",
-                         args.config);
+            spdlog::warn(
+                "SIGHUP: {} changed keys outside [supervisor] and [log]; they take "
+                "effect at the next restart",
+                args.config);
           }
         } catch (const Error& e) {
           spdlog::error("SIGHUP: config reload refused: {}; keeping the running configuration",

@@ -1,0 +1,48 @@
+#include "daemon/status_report.hpp"
+
+namespace hapticsim {
+
+status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
+                    const SupervisorDecision& decision, double target, bool pinned,
+                    const std::string& map_path, const InputCounters* counters) {
+  status_t s{};
+  s.utime = HapticLoop::NowNs() / 1000;
+  s.primary_size = decision.configuration.primary_size;
+  s.secondary_lod = decision.configuration.secondary_lod;
+  s.secondary_rate_hz = decision.configuration.secondary_rate_hz;
+  s.spectral_radius = decision.spectral_radius;
+  s.error_target_percent = target;
+  s.error_percent = decision.error_percent;
+  s.target_met = decision.target_met;
+  s.pinned = pinned;
+  s.error_map = decision.have_map ? map_path : "";
+  if (counters) {
+    s.inputs_received = counters->inputs_received.load();
+    s.inputs_rejected = counters->inputs_rejected.load();
+    s.decode_errors = counters->decode_errors.load();
+    s.forces_published = counters->forces_published.load();
+  }
+  s.stale_periods = loop.stale_periods();
+  const AsyncRegions& regions = loop.regions();
+  s.num_regions = regions.num_regions();
+  for (int r = 0; r < regions.num_regions(); ++r) {
+    const DeadlineSnapshot& d = snapshots[r];
+    region_status_t region{};
+    region.name = regions.partition().RegionName(r);
+    region.nodes = regions.partition().num_nodes(r);
+    region.rate_hz = regions.schedule(r).rate_hz;
+    region.substeps = regions.schedule(r).substeps;
+    region.critical_dt_s = regions.schedule(r).alone.critical_dt_s;
+    region.cycles = d.cycles;
+    region.deadline_misses = d.misses;
+    region.worst_lateness_us = d.worst_lateness_s * 1e6;
+    region.recent_lateness_us = d.recent_worst_lateness_s * 1e6;
+    region.execution_p50_us = d.recent_execution_p50_s * 1e6;
+    region.execution_p99_us = d.recent_execution_p99_s * 1e6;
+    region.execution_max_us = d.recent_execution_max_s * 1e6;
+    s.regions.push_back(region);
+  }
+  return s;
+}
+
+}  // namespace hapticsim
