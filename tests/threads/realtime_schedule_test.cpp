@@ -39,7 +39,8 @@ TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
     const TrialResult virtual_time = regions.RunTrial();
     bool clean = false;
     std::string misses;
-    for (int attempt = 0; attempt < 5 && !clean; ++attempt) {
+    // A VM loses the CPU now and then for a millisecond: up to 15 one-second attempts.
+    for (int attempt = 0; attempt < 15 && !clean; ++attempt) {
       RealTimeSchedule dut(regions);
       const TrialResult threaded = dut.RunTrial();
       ASSERT_EQ(threaded.samples.size(), virtual_time.samples.size());
