@@ -19,16 +19,23 @@ struct Checked {
 
 TEST(SeqlockSlot, ReadersNeverSeeATornValue) {
   SeqlockSlot<Checked> slot;
+  // The writer goes on until the reader has read many values while it writes (or a cap), so the
+  // two really overlap whatever the scheduler does.
+  constexpr std::int64_t kReadsWanted = 100'000, kWriteCap = 500'000'000;
+  std::atomic<std::int64_t> reads{0};
   std::atomic<bool> done{false};
   std::thread writer([&] {
-    for (std::int64_t i = 1; i <= 2'000'000; ++i) slot.Write({i, 2 * i, 3 * i});
+    for (std::int64_t i = 1; i <= kWriteCap && reads.load(std::memory_order_relaxed) < kReadsWanted;
+         ++i) {
+      slot.Write({i, 2 * i, 3 * i});
+    }
     done = true;
   });
-  std::int64_t reads = 0, last = 0;
+  std::int64_t last = 0;
   while (!done) {
     Checked value;
     if (slot.TryRead(&value)) {
-      ++reads;
+      reads.fetch_add(1, std::memory_order_relaxed);
       ASSERT_EQ(value.b, 2 * value.a);
       ASSERT_EQ(value.c, 3 * value.a);
       ASSERT_GE(value.a, last);  // never older than what was seen
@@ -36,7 +43,7 @@ TEST(SeqlockSlot, ReadersNeverSeeATornValue) {
     }
   }
   writer.join();
-  EXPECT_GT(reads, 0);
+  EXPECT_GE(reads.load(), kReadsWanted);
 }
 
 TEST(SpscRing, DeliversInOrderAndCountsWhatAFullRingDrops) {
