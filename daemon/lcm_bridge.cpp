@@ -10,10 +10,10 @@ namespace hapticsim {
 
 LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters)
     : config_(config),
-      loop_(loop),
       counters_(counters),
       lcm_(config.lcm_url),
-      guard_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s) {
+      intake_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s, loop,
+              counters) {
   if (!lcm_.good()) {
     throw Error("LCM could not start on " + config.lcm_url +
                 " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
@@ -29,18 +29,7 @@ void LcmBridge::OnDevice(const lcm::ReceiveBuffer* buffer, const std::string&) {
     counters_.decode_errors.fetch_add(1);
     return;
   }
-  counters_.inputs_received.fetch_add(1);
-  const std::int64_t now = HapticLoop::NowNs();
-  const std::array<double, 3> position{input.position[0], input.position[1], input.position[2]};
-  const InputRejection verdict = guard_.Check(input.seq, position, now);
-  if (verdict != InputRejection::kAccepted) {
-    counters_.Reject(verdict);
-    last_accepted_.latest_rejected = true;  // the primary flags it; the simulation keeps the last
-    loop_.input().Write(last_accepted_);
-    return;
-  }
-  last_accepted_ = {input.seq, now, position, false};
-  loop_.input().Write(last_accepted_);
+  intake_.Offer(input.seq, {input.position[0], input.position[1], input.position[2]});
 }
 
 void LcmBridge::OnCommand(const lcm::ReceiveBuffer* buffer, const std::string&) {

@@ -9,7 +9,7 @@
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
-#include "daemon/input_guard.hpp"
+#include "daemon/input_intake.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/status_t.hpp"
 
@@ -18,7 +18,7 @@ namespace hapticsim {
 /**
  * The LCM side of the I/O thread: decodes device inputs and commands itself (so a malformed
  * message or one with the wrong fingerprint is counted, not just printed by LCM), checks inputs
- * with its InputGuard, hands accepted ones to the primary thread, publishes forces and the status
+ * through its InputIntake, publishes forces and the status
  * the supervisor posts. Poll/Publish are called from the I/O thread only; PostStatus and
  * PopCommand from the supervisor.
  */
@@ -40,11 +40,9 @@ class LcmBridge {
   void OnCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel);
 
   const DaemonConfig& config_;
-  HapticLoop& loop_;
   InputCounters& counters_;
   lcm::LCM lcm_;
-  InputGuard guard_;
-  DeviceSample last_accepted_;
+  InputIntake intake_;
   std::mutex mutex_;  // guards the two queues below (never touched by real-time threads)
   std::optional<status_t> status_;
   std::deque<command_t> commands_;

@@ -6,9 +6,7 @@ ShmServer::ShmServer(const std::string& name, const std::string& group, const Me
                      double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
                      InputCounters& counters)
     : mapping_(shm::MappedSegment::Create(name, group)),
-      loop_(loop),
-      counters_(counters),
-      guard_(mesh, workspace_margin_m, max_speed_m_per_s) {}
+      intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters) {}
 
 void ShmServer::PollInput() {
   shm::ShmDeviceInput input;
@@ -16,19 +14,7 @@ void ShmServer::PollInput() {
   // primary thread sees the last input age and flags it stale.
   if (!mapping_.segment().input.Read(&input) || input.seq == last_seq_seen_) return;
   last_seq_seen_ = input.seq;
-  counters_.inputs_received.fetch_add(1);
-  const std::int64_t now = HapticLoop::NowNs();
-  const std::array<double, 3> position{input.position_m[0], input.position_m[1],
-                                       input.position_m[2]};
-  const InputRejection verdict = guard_.Check(input.seq, position, now);
-  if (verdict != InputRejection::kAccepted) {
-    counters_.Reject(verdict);
-    last_accepted_.latest_rejected = true;
-    loop_.input().Write(last_accepted_);
-    return;
-  }
-  last_accepted_ = {input.seq, now, position, false};
-  loop_.input().Write(last_accepted_);
+  intake_.Offer(input.seq, {input.position_m[0], input.position_m[1], input.position_m[2]});
 }
 
 void ShmServer::Publish(const ForceRecord& record) {

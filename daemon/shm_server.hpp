@@ -2,7 +2,7 @@
 
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
-#include "daemon/input_guard.hpp"
+#include "daemon/input_intake.hpp"
 #include "ipc/shm_segment.hpp"
 
 namespace hapticsim {
@@ -25,11 +25,8 @@ class ShmServer {
 
  private:
   shm::MappedSegment mapping_;
-  HapticLoop& loop_;
-  InputCounters& counters_;
-  InputGuard guard_;
+  InputIntake intake_;
   std::int64_t last_seq_seen_ = -1;
-  DeviceSample last_accepted_;
 };
 
 }  // namespace hapticsim

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "daemon/haptic_loop.hpp"
+#include "daemon/input_counters.hpp"
+#include "daemon/input_guard.hpp"
+
+namespace hapticsim {
+
+/**
+ * Where a device input enters, whatever carried it (LCM or shared memory): counted, checked by
+ * an InputGuard, and handed to the primary thread — the newest accepted input, marked when a
+ * newer one was refused (the simulation keeps the last accepted one). I/O thread only.
+ */
+class InputIntake {
+ public:
+  InputIntake(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s,
+              HapticLoop& loop, InputCounters& counters)
+      : guard_(mesh, workspace_margin_m, max_speed_m_per_s), loop_(loop), counters_(counters) {}
+
+  void Offer(std::int64_t seq, const std::array<double, 3>& position_m);
+
+ private:
+  InputGuard guard_;
+  HapticLoop& loop_;
+  InputCounters& counters_;
+  DeviceSample last_accepted_;
+};
+
+}  // namespace hapticsim
