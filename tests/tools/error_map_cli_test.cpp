@@ -2,6 +2,7 @@
 // export and merge, lookup, analyze, and the HTML report rendered in a real browser.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -19,7 +20,10 @@ using testing::CommandResult;
 using testing::Hapticsim;
 using testing::Json;
 
-std::string Temp(const std::string& name) { return ::testing::TempDir() + "hsmap_cli_" + name; }
+// Per process: CTest runs each test in its own process, several at a time.
+std::string Temp(const std::string& name) {
+  return ::testing::TempDir() + "hsmap_cli_" + std::to_string(getpid()) + "_" + name;
+}
 
 // A 9³ cube, half-second trials and a grid file that varies five axes: seconds per sweep.
 const std::vector<std::string> kScene = {"--set", "mesh.nodes=9", "--set", "input.frequency=2"};
