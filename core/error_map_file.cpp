@@ -181,31 +181,29 @@ class MapFileReader {
   }
 
   void Open() {
-    const std::string& path = path_;
-    auto& in = in_;
-    if (!in) throw Error("cannot open error map " + path + ": " + std::strerror(errno));
-    in.seekg(0, std::ios::end);
-    file_size_ = static_cast<std::uint64_t>(in.tellg());
+    if (!in_) throw Error("cannot open error map " + path_ + ": " + std::strerror(errno));
+    in_.seekg(0, std::ios::end);
+    file_size_ = static_cast<std::uint64_t>(in_.tellg());
     const std::uint64_t file_size = file_size_;
-    if (file_size < sizeof kMagic) Refuse(path, "truncated: too short to be an error map");
+    if (file_size < sizeof kMagic) Refuse(path_, "truncated: too short to be an error map");
     const std::string header = ReadRange(0, std::min<std::uint64_t>(file_size, kHeaderBytes));
     if (std::memcmp(header.data(), kMagic, sizeof kMagic) != 0) {
-      Refuse(path, "not an error map file (no HSIMMAP signature)");
+      Refuse(path_, "not an error map file (no HSIMMAP signature)");
     }
-    if (file_size < kHeaderBytes) Refuse(path, "truncated inside the header");
+    if (file_size < kHeaderBytes) Refuse(path_, "truncated inside the header");
     const auto version = Read<std::uint32_t>(header, 8);
     if (version != kErrorMapFormatVersion) {
-      Refuse(path, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
-                       std::to_string(kErrorMapFormatVersion) +
-                       " (remake it with hapticsim sweep)");
+      Refuse(path_, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
+                        std::to_string(kErrorMapFormatVersion) +
+                        " (remake it with hapticsim sweep)");
     }
     const auto count = Read<std::uint32_t>(header, 12);
-    if (count > 64) Refuse(path, "corrupted: " + std::to_string(count) + " sections");
+    if (count > 64) Refuse(path_, "corrupted: " + std::to_string(count) + " sections");
     if (kHeaderBytes + count * kEntryBytes > file_size)
-      Refuse(path, "truncated inside the directory");
+      Refuse(path_, "truncated inside the directory");
     const std::string directory = ReadRange(kHeaderBytes, count * kEntryBytes);
     if (Checksum(directory) != Read<std::uint64_t>(header, 16)) {
-      Refuse(path, "corrupted: directory checksum mismatch");
+      Refuse(path_, "corrupted: directory checksum mismatch");
     }
     for (size_t i = 0; i < count; ++i) {
       const size_t at = i * kEntryBytes;

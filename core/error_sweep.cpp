@@ -390,7 +390,8 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   std::vector<std::pair<const ReferenceKey, Reference>*> reference_list;
   for (auto& entry : references) reference_list.push_back(&entry);
   std::mutex stats_mutex;
-  auto cpu_since = [](Clock::time_point t0) {
+  // Time in a worker between two points: CPU time while the machine is not oversubscribed.
+  auto seconds_since = [](Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
   ParallelFor(
@@ -408,7 +409,7 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
         reference.trial = RunReferenceTrial(CubeScene(scene), trial_options);
         reference.ok = reference.trial.outcome == TrialOutcome::kCompleted;
         std::lock_guard lock(stats_mutex);
-        stats.reference_seconds += cpu_since(t0);
+        stats.reference_seconds += seconds_since(t0);
       },
       tick, options.progress_interval_s);
   stats.reference_trials = references.size();
@@ -424,7 +425,7 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
         const auto t0 = Clock::now();
         AsyncRegions regions(SceneAtPoint(base, task.point));
         const CoupledStability coupled = regions.EstimateCoupledStability();
-        const double stability_s = cpu_since(t0);
+        const double stability_s = seconds_since(t0);
         double adaptive_s = 0;
         std::size_t trials = 0, skipped = 0;
         for (const Run& run : task.runs) {
@@ -444,7 +445,7 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
             const Scene scene = SceneAtPoint(base, run.point);
             const auto t1 = Clock::now();
             const TrialResult trial = regions.RunTrial(scene.input);
-            adaptive_s += cpu_since(t1);
+            adaptive_s += seconds_since(t1);
             ++trials;
             const double simulated_ms = trial.steps * scene.solver.dt_s * 1e3;
             for (int r = 0; r < std::min(kMapCostRegions, regions.num_regions()); ++r) {

@@ -96,7 +96,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
   const int substeps = regions_->schedule(kPrimaryRegion).substeps;
   std::array<double, 3> reaction{};
   for (int q = 1; q <= substeps; ++q) {
-    // The contact moves in equal parts over the substeps of one period (held for one substep).
+    // The device gives one position per period: every substep holds it.
     const std::array<double, 3> r = regions_->StepPrimary(displacement_);
     if (q == 1) reaction = r;
   }
@@ -173,10 +173,10 @@ std::string HapticLoop::Start() {
   return ApplyRealtimeSettings();
 }
 
-std::string HapticLoop::ApplyRealtimeSettings() const {
+std::string HapticLoop::ApplyRealtimeSettings() {
   std::string refused;
-  for (const std::thread& thread : threads_) {
-    const pthread_t handle = const_cast<std::thread&>(thread).native_handle();
+  for (std::thread& thread : threads_) {
+    const pthread_t handle = thread.native_handle();
     if (options_.fifo_priority > 0) {
       sched_param param{};
       param.sched_priority = options_.fifo_priority;

@@ -126,7 +126,7 @@ class HapticLoop {
  private:
   void PrimaryThread(std::int64_t origin_ns);
   void SecondaryThread(RegionIndex region, std::int64_t origin_ns);
-  std::string ApplyRealtimeSettings() const;
+  std::string ApplyRealtimeSettings();
   void BuildSchedule();
 
   Scene scene_;

@@ -2,7 +2,7 @@
 
 namespace hapticsim {
 
-status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
+status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>& snapshots,
                     const SupervisorDecision& decision, double target, bool pinned,
                     const std::string& map_path, const InputCounters* counters) {
   status_t s{};

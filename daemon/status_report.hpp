@@ -15,7 +15,7 @@ namespace hapticsim {
  * The status message of the running daemon: the active configuration and its verdicts, the input
  * counters, and each region's schedule and deadline statistics (`snapshots`, one per region).
  */
-status_t MakeStatus(const HapticLoop& loop, std::vector<DeadlineSnapshot>& snapshots,
+status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>& snapshots,
                     const SupervisorDecision& decision, double target, bool pinned,
                     const std::string& map_path, const InputCounters* counters);
 

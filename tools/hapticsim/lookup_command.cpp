@@ -32,9 +32,9 @@ double ParseNumber(const std::string& key, const std::string& text) {
 
 int Run(const LookupCommandOptions& o) {
   const ErrorField field = ParseErrorField(o.field);
-  const ErrorLookup lookup = LoadErrorLookup(o.map, field);
-  // Unset parameters: the map's own scene.
   const ErrorMap map = LoadErrorMap(o.map, MapLoadParts::kLookupOnly);
+  const ErrorLookup lookup(map, field);
+  // Unset parameters: the map's own scene.
   const MapPoint base = PointOfScene(ParseSceneText(map.provenance.scene_toml, o.map));
   LookupQuery query = LookupQuery::At(base);
   query.frequency_known = !o.unknown_frequency;
