@@ -349,7 +349,9 @@ TrialResult AsyncRegions::RunTrial(const InputSettings& input) {
   TrialResult result;
   result.stability = regions_[kPrimaryRegion]->schedule.alone;
   Reset();
-  const ContactTrajectory trajectory(input);
+  const Scene& scene = partition_.scene();
+  const ContactTrajectory trajectory(input, InwardNormal(scene.mesh, ContactNode(scene)));
+  const std::array<double, 3>& normal = trajectory.inward_normal();
   const double dt = 1.0 / regions_[kPrimaryRegion]->schedule.rate_hz;
   // As Scene::num_steps(), so a trial of the scene's own input matches the reference's length.
   const long steps =
@@ -367,9 +369,11 @@ TrialResult AsyncRegions::RunTrial(const InputSettings& input) {
     for (int q = 1; q <= substeps; ++q) {
       AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
       const double depth_next = trajectory.DepthAt(t + q * h);
-      const std::array<double, 3> rq = StepPrimary({0.0, 0.0, depth_next});
+      const std::array<double, 3> rq = StepPrimary(trajectory.DisplacementAt(t + q * h));
       if (q == 1) r = rq;
-      const double increment = rq[2] * (depth_next - trajectory.DepthAt(t + (q - 2) * h)) / 2.0;
+      const double reaction_along = rq[0] * normal[0] + rq[1] * normal[1] + rq[2] * normal[2];
+      const double increment =
+          reaction_along * (depth_next - trajectory.DepthAt(t + (q - 2) * h)) / 2.0;
       if (increment > 0) work += increment;
     }
     // The kinetic part alone is bounded by the same passivity budget and needs no extra K·u.
@@ -384,7 +388,7 @@ TrialResult AsyncRegions::RunTrial(const InputSettings& input) {
     }
     ForceSample sample;
     sample.t_s = t;
-    sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
+    sample.contact_displacement_m = trajectory.DisplacementAt(t);
     for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
     result.peak_force_n =
         std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));

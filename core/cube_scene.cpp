@@ -24,7 +24,7 @@ DofConstraints CubeConstraints(const HexGrid& grid, int contact_node,
 CubeScene::CubeScene(const Scene& scene)
     : scene_(scene), contact_node_(0), fixed_nodes_{}, model_([&] {
         const HexGrid grid = CubeGrid(scene);
-        const LatticeIndex contact = CubeContactNode(scene.mesh);
+        const LatticeIndex contact = ContactNode(scene);
         contact_node_ = grid.Node(contact[0], contact[1], contact[2]);
         const auto supports = CubeSupportNodes(scene.mesh);
         for (size_t i = 0; i < supports.size(); ++i) {

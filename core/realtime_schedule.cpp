@@ -52,7 +52,7 @@ struct LoopRecord {
 
 TrialResult RealTimeSchedule::RunTrial() {
   const Scene& scene = regions_.partition().scene();
-  const ContactTrajectory trajectory(scene.input);
+  const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
   const int count = regions_.num_regions();
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();
@@ -118,7 +118,7 @@ TrialResult RealTimeSchedule::RunTrial() {
     std::array<double, 3> r{};
     for (int q = 1; q <= primary_substeps; ++q) {
       const std::array<double, 3> rq =
-          regions_.StepPrimary({0.0, 0.0, trajectory.DepthAt(t + q * dt / primary_substeps)});
+          regions_.StepPrimary(trajectory.DisplacementAt(t + q * dt / primary_substeps));
       if (q == 1) r = rq;
     }
     const std::int64_t done = NowNs();
@@ -128,7 +128,7 @@ TrialResult RealTimeSchedule::RunTrial() {
 
     ForceSample& sample = result.samples[static_cast<size_t>(n)];
     sample.t_s = t;
-    sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
+    sample.contact_displacement_m = trajectory.DisplacementAt(t);
     for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
     result.peak_force_n =
         std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));

@@ -37,7 +37,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
   const double h = dt / result.substeps;
 
   CentralDifferenceIntegrator integrator(model, h);
-  const ContactTrajectory trajectory(scene.input);
+  const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
   const long steps = scene.num_steps();
   result.samples.reserve(static_cast<size_t>(steps) + 1);
 
@@ -49,8 +49,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
     const double t = n * dt;
     StepStatus status = StepStatus::kOk;
     for (int q = 1; q <= result.substeps && status == StepStatus::kOk; ++q) {
-      const std::array<double, 3> next{0.0, 0.0, trajectory.DepthAt(t + q * h)};
-      status = integrator.Step(next);
+      status = integrator.Step(trajectory.DisplacementAt(t + q * h));
       if (q == 1) {
         for (int c = 0; c < 3; ++c) reaction_at_start[c] = integrator.driven_reaction()[c];
       }
@@ -62,7 +61,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
     }
     ForceSample sample;
     sample.t_s = t;
-    sample.contact_displacement_m = {0.0, 0.0, trajectory.DepthAt(t)};
+    sample.contact_displacement_m = trajectory.DisplacementAt(t);
     const auto& reaction = reaction_at_start;
     double magnitude2 = 0;
     for (int c = 0; c < 3; ++c) {

@@ -12,7 +12,7 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
   HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
                          "asynchronous regions need adaptivity.primary_size >= 1");
   const int n = scene.mesh.nodes, last = n - 1, r = scene.adaptivity.primary_size;
-  const LatticeIndex contact = CubeContactNode(scene.mesh);
+  const LatticeIndex contact = ContactNode(scene);
 
   HybridMesh::Options options;
   options.nodes_per_axis = n;

@@ -98,6 +98,48 @@ KeyAccess Choice(SceneKeyInfo info, std::vector<std::string_view> names, Get get
                    }};
 }
 
+// input.contact_node: "middle" (the paper's node) or "ix,iy,iz". Whether the node is on the
+// surface of this mesh is checked by ValidateScene, which knows mesh.nodes.
+KeyAccess ContactNodeKey() {
+  const SceneKeyInfo info{
+      "input.contact_node", "",
+      "\"middle\" or \"ix,iy,iz\" (lattice indices from 0 to mesh.nodes - 1 of a surface node "
+      "that is not a fixed back corner)",
+      "the driven node; \"middle\" is the paper's, the middle of the front face z = 0"};
+  return KeyAccess{info,
+                   [](const Scene& scene) {
+                     const auto& node = scene.input.contact_node;
+                     std::string text = "\"";
+                     text += node ? std::to_string((*node)[0]) + "," + std::to_string((*node)[1]) +
+                                        "," + std::to_string((*node)[2])
+                                  : std::string("middle");
+                     text += '"';
+                     return text;
+                   },
+                   [info](Scene* scene, std::string_view text) {
+                     std::string_view bare = text;
+                     if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
+                       bare = bare.substr(1, bare.size() - 2);
+                     }
+                     if (bare == "middle") {
+                       scene->input.contact_node.reset();
+                       return;
+                     }
+                     LatticeIndex node{};
+                     const char* p = bare.data();
+                     const char* end = bare.data() + bare.size();
+                     for (int c = 0; c < 3; ++c) {
+                       const auto [next, ec] = std::from_chars(p, end, node[c]);
+                       const bool separator_ok = c < 2 ? (next < end && *next == ',') : next == end;
+                       if (ec != std::errc() || !separator_ok || node[c] < 0) {
+                         Reject(info.name, text, info.allowed, info.unit);
+                       }
+                       p = next + 1;
+                     }
+                     scene->input.contact_node = node;
+                   }};
+}
+
 const std::vector<KeyAccess>& KeyTable() {
   static const std::vector<KeyAccess> table = [] {
     std::vector<KeyAccess> keys;
@@ -125,7 +167,7 @@ const std::vector<KeyAccess>& KeyTable() {
         [](double v) { return v >= 0; }));
     keys.push_back(Real(
         {"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
-         "amplitude s of the contact node's motion along +z"},
+         "amplitude s of the contact node's motion along its face's inward normal"},
         [](Scene& s) -> double& { return s.input.amplitude_m; }, [](double v) { return v >= 0; }));
     keys.push_back(Real(
         {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
@@ -136,6 +178,7 @@ const std::vector<KeyAccess>& KeyTable() {
         {"press", "sine"},
         [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
         [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
+    keys.push_back(ContactNodeKey());
     keys.push_back(Real(
         {"input.periods", "", "finite and > 0", "trial length in input periods"},
         [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
@@ -288,6 +331,26 @@ void ValidateScene(const Scene& scene) {
                 " steps for the trial of input.periods / input.frequency = " +
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
+  if (const auto& node = scene.input.contact_node) {
+    const std::string text = GetSceneValue(scene, "input.contact_node");
+    const int last = scene.mesh.nodes - 1;
+    for (int c : *node) {
+      if (c > last) {
+        throw Error("input.contact_node = " + text + " is outside the mesh: its indices must be " +
+                    "from 0 to mesh.nodes - 1 = " + std::to_string(last));
+      }
+    }
+    if (!IsSurfaceNode(scene.mesh, *node)) {
+      throw Error("input.contact_node = " + text +
+                  " is inside the object: the contact node must be on the surface (some index 0 "
+                  "or " +
+                  std::to_string(last) + ")");
+    }
+    if (IsSupportNode(scene.mesh, *node)) {
+      throw Error("input.contact_node = " + text +
+                  " is a fixed back corner: the contact node must be free to move");
+    }
+  }
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 
@@ -302,11 +365,40 @@ std::array<LatticeIndex, 4> CubeSupportNodes(const MeshSettings& mesh) {
           LatticeIndex{last, last, last}};
 }
 
+LatticeIndex ContactNode(const Scene& scene) {
+  return scene.input.contact_node ? *scene.input.contact_node : CubeContactNode(scene.mesh);
+}
+
+bool IsSurfaceNode(const MeshSettings& mesh, const LatticeIndex& node) {
+  for (int c : node) {
+    if (c == 0 || c == mesh.nodes - 1) return true;
+  }
+  return false;
+}
+
+bool IsSupportNode(const MeshSettings& mesh, const LatticeIndex& node) {
+  for (const LatticeIndex& support : CubeSupportNodes(mesh)) {
+    if (support == node) return true;
+  }
+  return false;
+}
+
+std::array<double, 3> InwardNormal(const MeshSettings& mesh, const LatticeIndex& node) {
+  const int last = mesh.nodes - 1;
+  for (int axis : {2, 0, 1}) {
+    std::array<double, 3> normal{0.0, 0.0, 0.0};
+    if (node[axis] == 0) normal[axis] = 1.0;
+    if (node[axis] == last) normal[axis] = -1.0;
+    if (normal[axis] != 0.0) return normal;
+  }
+  throw Error("internal: InwardNormal of a node inside the object");
+}
+
 double PrimaryRateHz(const Scene& scene) { return 1.0 / scene.solver.dt_s; }
 
 bool PrimaryBoxCoversObject(const Scene& scene, int primary_size) {
   const int n = scene.mesh.nodes, k = scene.adaptivity.secondary_lod;
-  for (int c : CubeContactNode(scene.mesh)) {
+  for (int c : ContactNode(scene)) {
     const int lo = std::max(0, c - primary_size), hi = std::min(n - 1, c + primary_size);
     // Every coarse cell [jk, (j+1)k] overlaps (lo, hi) only if the first and last do.
     if (!(lo < k && hi > (n - 1) - k)) return false;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -9,11 +10,14 @@
 
 namespace hapticsim {
 
-/** How the device drives the contact node along the inward normal (+z). */
+/** How the device drives the contact node along its face's inward normal (+z on the front). */
 enum class Waveform {
   kPress,  ///< s·(1 − cos 2πft)/2: a smooth press into the object and back, no velocity jump
   kSine,   ///< s·sin 2πft: in and out of the object around the rest position
 };
+
+/** Lattice indices (ix, iy, iz) of a node of the cube. */
+using LatticeIndex = std::array<int, 3>;
 
 struct MeshSettings {
   int nodes = 13;        ///< nodes per axis of the cube (mesh.nodes)
@@ -25,6 +29,9 @@ struct InputSettings {
   double frequency_hz = 1.0;             ///< f, Hz (input.frequency)
   Waveform waveform = Waveform::kPress;  ///< input.waveform
   double periods = 1.0;                  ///< trial length in periods of f (input.periods)
+  /// The driven surface node (input.contact_node); none: the paper's, the middle node of the
+  /// front face. It moves along the inward normal of its face (see InwardNormal).
+  std::optional<LatticeIndex> contact_node;
 };
 
 struct SolverSettings {
@@ -106,9 +113,6 @@ std::string GetSceneValue(const Scene& scene, std::string_view key);
  */
 void ValidateScene(const Scene& scene);
 
-/** Lattice indices (ix, iy, iz) of a node of the cube. */
-using LatticeIndex = std::array<int, 3>;
-
 /**
  * The paper's contact: the middle node of the front face (z = 0); with an even node count, the
  * one just below the centre in x and y. The one definition every model of the cube uses.
@@ -118,12 +122,28 @@ LatticeIndex CubeContactNode(const MeshSettings& mesh);
 /** The paper's supports: the four corner nodes of the back face (z = edge). */
 std::array<LatticeIndex, 4> CubeSupportNodes(const MeshSettings& mesh);
 
+/** The scene's driven node: input.contact_node, or the paper's (CubeContactNode). */
+LatticeIndex ContactNode(const Scene& scene);
+
+/** True for a node on the cube's surface (some index 0 or nodes − 1). */
+bool IsSurfaceNode(const MeshSettings& mesh, const LatticeIndex& node);
+
+/** True for one of the fixed back-face corners. */
+bool IsSupportNode(const MeshSettings& mesh, const LatticeIndex& node);
+
+/**
+ * The unit inward normal of the face a surface node lies on. Nodes on an edge or a corner belong
+ * to the first of their faces in the order front/back (z), left/right (x), bottom/top (y): the
+ * paper presses along z, so the front face wins.
+ */
+std::array<double, 3> InwardNormal(const MeshSettings& mesh, const LatticeIndex& node);
+
 /** The primary region's rate 1/solver.dt, Hz. */
 double PrimaryRateHz(const Scene& scene);
 
 /**
- * True when a primary box of `primary_size` nodes around the contact, refined in whole coarse
- * cells of adaptivity.secondary_lod, would cover every cell of the object.
+ * True when a primary box of `primary_size` nodes around the scene's contact node, refined in whole
+ * coarse cells of adaptivity.secondary_lod, would cover every cell of the object.
  */
 bool PrimaryBoxCoversObject(const Scene& scene, int primary_size);
 

@@ -31,7 +31,7 @@ std::int64_t HapticLoop::NowNs() noexcept {
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene), options_(options), regions_(std::make_unique<AsyncRegions>(scene)) {
   BuildSchedule();
-  const LatticeIndex contact = CubeContactNode(scene.mesh);
+  const LatticeIndex contact = ContactNode(scene);
   const double h = scene.mesh.edge_m / (scene.mesh.nodes - 1);
   for (int c = 0; c < 3; ++c) contact_rest_[c] = contact[c] * h;
 }

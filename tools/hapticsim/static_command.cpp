@@ -13,16 +13,20 @@ namespace {
 int Run(const SceneOptions& options) {
   const Scene scene = options.Resolve();
   const CubeScene cube(scene);
-  const std::array<double, 3> driven{0.0, 0.0, scene.input.amplitude_m};
+  const std::array<double, 3> normal = InwardNormal(scene.mesh, ContactNode(scene));
+  std::array<double, 3> driven{};
+  for (int c = 0; c < 3; ++c) driven[c] = scene.input.amplitude_m * normal[c];
   const StaticSolution solution = SolveStatic(cube.model(), driven);
   const auto& r = solution.driven_reaction;
-  const double stiffness = scene.input.amplitude_m > 0 ? r[2] / scene.input.amplitude_m : 0.0;
+  // Along the press: the reaction's component on the inward normal.
+  const double along = r[0] * normal[0] + r[1] * normal[1] + r[2] * normal[2];
+  const double stiffness = scene.input.amplitude_m > 0 ? along / scene.input.amplitude_m : 0.0;
 
   if (options.json) {
     nlohmann::json out;
     out["reaction_force_N"] = {r[0], r[1], r[2]};
     out["feedback_force_N"] = {-r[0], -r[1], -r[2]};
-    out["contact_displacement_m"] = {0.0, 0.0, scene.input.amplitude_m};
+    out["contact_displacement_m"] = driven;
     out["contact_stiffness_N_per_m"] = stiffness;
     out["cg_iterations"] = solution.iterations;
     out["relative_residual"] = solution.relative_residual;
@@ -30,10 +34,11 @@ int Run(const SceneOptions& options) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << "Static contact reaction: " << scene.mesh.nodes << "³-node cube, contact pressed "
-              << Quantity(scene.input.amplitude_m, "m") << " into the object (+z)\n"
+              << Quantity(scene.input.amplitude_m, "m") << " into the object along [" << normal[0]
+              << ", " << normal[1] << ", " << normal[2] << "]\n"
               << "  reaction on the object (holds the displacement): [" << Quantity(r[0], "N")
               << ", " << Quantity(r[1], "N") << ", " << Quantity(r[2], "N") << "]\n"
-              << "  force on the user: " << Quantity(-r[2], "N") << " along z\n"
+              << "  force on the user: " << Quantity(-along, "N") << " against the press\n"
               << "  contact stiffness: " << Quantity(stiffness, "N/m") << "\n"
               << "  conjugate gradients: " << solution.iterations
               << " iterations, relative residual " << solution.relative_residual
