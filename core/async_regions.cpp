@@ -20,11 +20,15 @@ Eigen::VectorXd MaskOf(int size, const std::vector<int>& dofs) {
 }
 
 // Value at time t on the line through two snapshots (the newer one alone if they coincide).
-// Callers clamp t: a late writer must never be extrapolated far.
+// Callers clamp t from above: a late writer must never be extrapolated far. A reader that has
+// fallen behind both snapshots (its thread was late by more than the ring holds) gets the older
+// one: extrapolating backwards multiplies the difference between the snapshots by the lag, and
+// fed back through the coupling that diverges within a few late periods.
 inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
                      int i, double t) {
   const double span = newer.time_s - older.time_s;
   if (!(span > 0)) return newer.values[i];
+  t = std::max(t, older.time_s);
   return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
 }
 
