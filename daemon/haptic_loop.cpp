@@ -29,48 +29,105 @@ std::int64_t HapticLoop::NowNs() noexcept {
 }
 
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
-    : scene_(scene), options_(options), regions_(std::make_unique<AsyncRegions>(scene)) {
-  BuildSchedule();
-  const LatticeIndex contact = ContactNode(scene);
-  const double h = scene.mesh.edge_m / (scene.mesh.nodes - 1);
-  for (int c = 0; c < 3; ++c) contact_rest_[c] = contact[c] * h;
-}
-
-void HapticLoop::BuildSchedule() {
-  const int count = regions_->num_regions();
-  monitors_.clear();
-  tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
-  lead_ns_.assign(static_cast<size_t>(count), 0);
-  for (int a = 0; a < count; ++a) {
-    const std::int64_t nominal = regions_->period_ticks(a) * regions_->schedule(a).substeps;
-    monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal * tick_ns_ * 1e-9));
-    if (a > 0) {
-      const std::int64_t inner = regions_->period_ticks(a - 1) * regions_->schedule(a - 1).substeps;
-      lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * inner * tick_ns_);
-    }
-  }
-}
-
-void HapticLoop::Reconfigure(const Scene& scene) {
-  auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
-  const bool was_running = running_.load();
-  Stop();
-  scene_ = scene;
-  regions_ = std::move(regions);
-  BuildSchedule();
-  if (was_running) Start();
+    : scene_(scene),
+      options_(options),
+      nodes_(scene.mesh.nodes),
+      contact_(scene.mesh, options.engage_ramp_s) {
+  Install(scene, std::make_unique<AsyncRegions>(scene));
 }
 
 HapticLoop::~HapticLoop() { Stop(); }
+
+void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions) {
+  scene_ = scene;
+  regions_ = std::move(regions);
+  centre_ = ContactNode(scene);
+  const int count = regions_->num_regions();
+  tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
+  auto nominal_ns = [&](int a) {
+    return static_cast<double>(regions_->period_ticks(a) * regions_->schedule(a).substeps) *
+           tick_ns_;
+  };
+  if (monitors_.empty()) {  // the primary's period is fixed for the loop's life
+    primary_period_ns_ = nominal_ns(kPrimaryRegion);
+    monitors_.push_back(std::make_unique<DeadlineMonitor>(primary_period_ns_ * 1e-9));
+  }
+  monitors_.resize(1);
+  lead_ns_.assign(static_cast<size_t>(count), 0);
+  for (int a = 1; a < count; ++a) {
+    monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal_ns(a) * 1e-9));
+    // Each coarser region is released ahead of the finer one by 1.25 of the finer's period, so
+    // its boundary is published before the finer region needs it (as in RealTimeSchedule).
+    lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ns(a - 1));
+  }
+}
+
+std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
+  const double periods = std::ceil((not_before_ns - origin_ns_) / primary_period_ns_);
+  return origin_ns_ + std::llround(periods * primary_period_ns_);
+}
+
+void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
+  auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
+  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || scene.mesh.nodes != nodes_ ||
+      scene.mesh.edge_m != scene_.mesh.edge_m) {
+    throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
+  }
+  ++reconfigurations_;
+  const RestartKind restart = keep_contact ? kRestartKeepingContact : kRestartFromRest;
+  if (!running_.load()) {
+    restart_kind_.store(restart);
+    Install(scene, std::move(regions));
+    return;
+  }
+  paused_.store(false);
+  pause_requested_.store(true, std::memory_order_release);
+  // The primary acknowledges at its next release; after that it does not touch the regions.
+  const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
+  while (!paused_.load(std::memory_order_acquire)) {
+    if (NowNs() > give_up_ns) {  // a hung primary thread: replace everything the slow way
+      Stop();
+      Install(scene, std::move(regions));
+      Start();  // restarts from rest whatever `restart` asked
+      return;
+    }
+    const timespec short_wait{0, 100'000};
+    nanosleep(&short_wait, nullptr);
+  }
+  StopSecondaries();
+  Install(scene, std::move(regions));
+  // The new regions start from rest on the primary's own release grid, late enough for the
+  // secondaries to be released ahead of it.
+  const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());
+  StartSecondaries(resume_at);
+  restart_kind_.store(restart, std::memory_order_relaxed);  // published by the release below
+  resume_at_ns_.store(resume_at, std::memory_order_release);
+  pause_requested_.store(false, std::memory_order_release);
+}
+
+std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
+  const std::int64_t code = wanted_node_code_.load(std::memory_order_relaxed);
+  if (code < 0) return std::nullopt;
+  const std::int64_t n = nodes_;
+  return LatticeIndex{static_cast<int>(code / (n * n)), static_cast<int>(code / n % n),
+                      static_cast<int>(code % n)};
+}
 
 void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcept {
   error_percent_.store(error_percent, std::memory_order_relaxed);
   error_flags_.store(flags, std::memory_order_relaxed);
 }
 
-void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
+void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
   DeviceSample sample;
-  if (input_.Read(&sample)) last_input_ = sample;
+  if (input_.Read(&sample)) {
+    if (sample.seq != last_input_.seq) {
+      if (last_input_.seq >= 0) previous_input_ = last_input_;
+      periods_since_input_ = 0;
+    }
+    last_input_ = sample;
+  }
+  if (periods_since_input_ < kMaxPredictedPeriods + 1) ++periods_since_input_;
   const bool have = last_input_.seq >= 0;
   const bool stale =
       !have || static_cast<double>(now_ns - last_input_.received_ns) > options_.stale_after_s * 1e9;
@@ -81,24 +138,53 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
   }
   if (last_input_.latest_rejected) flags |= force_flags::kInputRejected;
 
-  // Stale input holds the contact where it was; fresh input moves it.
-  if (have && !stale) {
-    const auto& p = last_input_.position_m;
-    const double depth = p[2] - contact_rest_[2];
-    if (depth <= 0) await_lift_off_ = false;
-    const bool touching = depth > 0 && !await_lift_off_;
-    if (touching && !in_contact_) touch_down_ = p;
-    in_contact_ = touching;
-    displacement_ = touching
-                        ? std::array<double, 3>{p[0] - touch_down_[0], p[1] - touch_down_[1], depth}
-                        : std::array<double, 3>{0.0, 0.0, 0.0};
+  // The regions are ours this period unless a reconfiguration has paused them.
+  bool usable = true;
+  if (pause_requested_.load(std::memory_order_acquire)) {
+    paused_.store(true, std::memory_order_release);
+    usable = false;
+  } else if (release_ns < resume_at_ns_.load(std::memory_order_acquire)) {
+    usable = false;  // the new regions start at resume_at
   }
-  const int substeps = regions_->schedule(kPrimaryRegion).substeps;
+  if (usable) {
+    switch (restart_kind_.exchange(kNoRestart, std::memory_order_acq_rel)) {
+      case kRestartFromRest:
+        contact_.RestartFromRest();
+        break;
+      case kRestartKeepingContact:
+        contact_.RestartKeepingContact();
+        break;
+      default:
+        break;
+    }
+  } else {
+    paused_periods_.fetch_add(1, std::memory_order_relaxed);
+    flags |= force_flags::kReconfiguring;
+  }
+
+  // Stale input holds the contact where it was; fresh input moves it.
+  const std::optional<LatticeIndex> centre =
+      usable ? std::optional<LatticeIndex>(centre_) : std::nullopt;
+  const ContactTracker::Contact contact = have && !stale
+                                              ? contact_.Update(PredictedTip(), now_ns, centre)
+                                              : contact_.Hold(now_ns, centre);
+  in_contact_ = contact.engaged && usable;
+  displacement_ = contact.displacement_m;
+  if (contact.waiting) flags |= force_flags::kReconfiguring;
+  contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
+  const std::optional<LatticeIndex> wanted = contact_.wanted_node();
+  const std::int64_t n = nodes_;
+  wanted_node_code_.store(wanted ? ((*wanted)[0] * n + (*wanted)[1]) * n + (*wanted)[2] : -1,
+                          std::memory_order_relaxed);
+
   std::array<double, 3> reaction{};
-  for (int q = 1; q <= substeps; ++q) {
-    // The device gives one position per period: every substep holds it.
-    const std::array<double, 3> r = regions_->StepPrimary(displacement_);
-    if (q == 1) reaction = r;
+  if (usable) {
+    const int substeps = regions_->schedule(kPrimaryRegion).substeps;
+    for (int q = 1; q <= substeps; ++q) {
+      // The device gives one position per period: every substep holds it.
+      const std::array<double, 3> r = regions_->StepPrimary(displacement_);
+      if (q == 1) reaction = r;
+    }
   }
   ForceRecord out;
   BlackBoxRecord box;
@@ -131,14 +217,31 @@ void HapticLoop::PrimaryPeriod(std::int64_t now_ns) noexcept {
   black_box_.Push(box);
 }
 
+std::array<double, 3> HapticLoop::PredictedTip() const noexcept {
+  // periods_since_input_ is 1 in the period a new input arrived.
+  const int ahead = periods_since_input_ - 1;
+  const std::int64_t device_periods = last_input_.seq - previous_input_.seq;
+  if (ahead < 1 || ahead > kMaxPredictedPeriods || previous_input_.seq < 0 || device_periods < 1 ||
+      device_periods > kMaxPredictedPeriods) {
+    return last_input_.position_m;
+  }
+  std::array<double, 3> tip = last_input_.position_m;
+  for (int c = 0; c < 3; ++c) {
+    const double per_period =
+        (last_input_.position_m[c] - previous_input_.position_m[c]) / device_periods;
+    tip[c] += per_period * ahead;
+  }
+  return tip;
+}
+
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
-  DeadlineMonitor& monitor = *monitors_[kPrimaryRegion];
-  while (!stop_.load(std::memory_order_acquire)) {
+  DeadlineMonitor& monitor = *monitors_[kPrimaryRegion];  // never replaced
+  for (std::int64_t k = 0; !stop_.load(std::memory_order_acquire); ++k) {
     const std::int64_t release =
-        origin_ns + static_cast<std::int64_t>(regions_->state_ticks(kPrimaryRegion) * tick_ns_);
+        origin_ns + std::llround(static_cast<double>(k) * primary_period_ns_);
     SleepUntilNs(release);
     const std::int64_t woke = NowNs();
-    PrimaryPeriod(woke);
+    PrimaryPeriod(release, woke);
     monitor.Record(release, woke, NowNs());
   }
 }
@@ -146,7 +249,7 @@ void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
 void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   DeadlineMonitor& monitor = *monitors_[region];
   const int substeps = regions_->schedule(region).substeps;
-  while (!stop_.load(std::memory_order_acquire)) {
+  while (!stop_secondaries_.load(std::memory_order_acquire)) {
     const std::int64_t release =
         origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
         lead_ns_[region];
@@ -157,54 +260,64 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   }
 }
 
+void HapticLoop::StartSecondaries(std::int64_t origin_ns) {
+  stop_secondaries_ = false;
+  for (int a = 1; a < regions_->num_regions(); ++a) {
+    secondary_threads_.emplace_back([this, a, origin_ns] { SecondaryThread(a, origin_ns); });
+    ApplyRealtimeSettings(secondary_threads_.back());
+  }
+}
+
+void HapticLoop::StopSecondaries() {
+  stop_secondaries_ = true;
+  for (std::thread& thread : secondary_threads_) {
+    if (thread.joinable()) thread.join();
+  }
+  secondary_threads_.clear();
+}
+
 std::string HapticLoop::Start() {
   if (running_) return "";
   regions_->Reset();
-  in_contact_ = false;
-  await_lift_off_ = true;
-  displacement_ = {0.0, 0.0, 0.0};
+  restart_kind_ = kRestartFromRest;
+  pause_requested_ = false;
   stop_ = false;
   const std::int64_t origin_ns = NowNs() + 5'000'000 + lead_ns_.back();
-  threads_.emplace_back([this, origin_ns] { PrimaryThread(origin_ns); });
-  for (int a = 1; a < regions_->num_regions(); ++a) {
-    threads_.emplace_back([this, a, origin_ns] { SecondaryThread(a, origin_ns); });
-  }
+  origin_ns_ = origin_ns;
+  resume_at_ns_ = origin_ns;
+  primary_thread_ = std::thread([this, origin_ns] { PrimaryThread(origin_ns); });
+  std::string refused = ApplyRealtimeSettings(primary_thread_);
+  StartSecondaries(origin_ns);
   running_ = true;
-  return ApplyRealtimeSettings();
+  return refused;
 }
 
-std::string HapticLoop::ApplyRealtimeSettings() {
+std::string HapticLoop::ApplyRealtimeSettings(std::thread& thread) const {
   std::string refused;
-  for (std::thread& thread : threads_) {
-    const pthread_t handle = thread.native_handle();
-    if (options_.fifo_priority > 0) {
-      sched_param param{};
-      param.sched_priority = options_.fifo_priority;
-      const int error = pthread_setschedparam(handle, SCHED_FIFO, &param);
-      if (error != 0 && refused.find("SCHED_FIFO") == std::string::npos) {
-        refused += "SCHED_FIFO priority " + std::to_string(options_.fifo_priority) + " refused (" +
-                   std::strerror(error) + "; needs CAP_SYS_NICE or LimitRTPRIO); ";
-      }
+  const pthread_t handle = thread.native_handle();
+  if (options_.fifo_priority > 0) {
+    sched_param param{};
+    param.sched_priority = options_.fifo_priority;
+    const int error = pthread_setschedparam(handle, SCHED_FIFO, &param);
+    if (error != 0) {
+      refused += "SCHED_FIFO priority " + std::to_string(options_.fifo_priority) + " refused (" +
+                 std::strerror(error) + "; needs CAP_SYS_NICE or LimitRTPRIO); ";
     }
-    if (!options_.cpus.empty()) {
-      cpu_set_t set;
-      CPU_ZERO(&set);
-      for (int cpu : options_.cpus) CPU_SET(cpu, &set);
-      const int error = pthread_setaffinity_np(handle, sizeof set, &set);
-      if (error != 0 && refused.find("affinity") == std::string::npos) {
-        refused += std::string("CPU affinity refused (") + std::strerror(error) + "); ";
-      }
-    }
+  }
+  if (!options_.cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int cpu : options_.cpus) CPU_SET(cpu, &set);
+    const int error = pthread_setaffinity_np(handle, sizeof set, &set);
+    if (error != 0) refused += std::string("CPU affinity refused (") + std::strerror(error) + "); ";
   }
   return refused;
 }
 
 void HapticLoop::Stop() {
   stop_ = true;
-  for (std::thread& thread : threads_) {
-    if (thread.joinable()) thread.join();
-  }
-  threads_.clear();
+  if (primary_thread_.joinable()) primary_thread_.join();
+  StopSecondaries();
   running_ = false;
 }
 

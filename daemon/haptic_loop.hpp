@@ -4,11 +4,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "core/async_regions.hpp"
 #include "core/seqlock_slot.hpp"
+#include "daemon/contact_tracker.hpp"
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/spsc_ring.hpp"
 
@@ -61,12 +64,18 @@ inline constexpr std::int32_t kInputRejected = 64;
  * RealTimeSchedule. None of them allocates, locks, logs or does I/O; deadline misses go to
  * lock-free DeadlineMonitors that the supervisor drains.
  *
- * Contact: the tool tip is in contact while it is inside the object (z > 0 in the object frame).
- * The contact node is the paper's (the front face's middle node); while in contact it follows the
- * tip's depth and its tangential motion since touch-down, so touch-down is continuous. Out of
- * contact the node is held at rest and the force is zero. After a start or restart (a reset, a
- * fault, a reconfiguration) a tip already inside the object renders nothing until it has left
- * the object once.
+ * Contact (ContactTracker): the tool tip touching the surface picks the nearest surface node.
+ * When the regions are centred on it the node follows the tip at once; otherwise the loop renders
+ * zero force, flagged "reconfiguring", and publishes the node it wants (wanted_contact_node) for
+ * the supervisor, which centres the regions on it (Reconfigure with keep_contact); the contact
+ * then engages with its force ramped in from zero. Out of contact the force is zero. After a
+ * restart from rest (Start, a reset, a fault) a tip already inside the object renders nothing
+ * until it has left the object once.
+ *
+ * Reconfiguration is gapless: the primary thread never stops. It pauses the regions (answers
+ * every period with zero force, flagged "reconfiguring") while the supervisor joins the old
+ * secondary threads, installs the new regions and starts their threads, and resumes them on its
+ * own release grid, so every input still gets its answer.
  */
 class HapticLoop {
  public:
@@ -74,8 +83,9 @@ class HapticLoop {
     double stale_after_s = 0.05;
     bool zero_force_when_stale = true;
     double max_force_n = 50;
-    int fifo_priority = 0;  ///< SCHED_FIFO for the region threads (0: normal scheduling)
-    std::vector<int> cpus;  ///< pin the region threads here (empty: no pinning)
+    int fifo_priority = 0;       ///< SCHED_FIFO for the region threads (0: normal scheduling)
+    std::vector<int> cpus;       ///< pin the region threads here (empty: no pinning)
+    double engage_ramp_s = 0.1;  ///< a contact that engages late ramps its force in over this
   };
   using ForceRing = SpscRing<ForceRecord, 4096>;
   using BlackBoxRing = SpscRing<BlackBoxRecord, 4096>;
@@ -89,13 +99,26 @@ class HapticLoop {
   /** Stops and joins the region threads. */
   void Stop();
   /**
-   * Replaces the regions by those of `scene` (another adaptive configuration of the same object),
-   * starting from rest: call it only while the tool is out of contact and the object has settled,
-   * so nothing the user feels changes. The regions are built before the threads stop, so the
-   * loop pauses only for the restart (a few periods, no forces sent). Supervisor thread only.
-   * @throws Error for an invalid scene (the running loop is left as it was).
+   * Replaces the regions by those of `scene` (another adaptive configuration of the same object,
+   * or the same one centred on another contact node), starting from rest. The regions are built
+   * while the loop runs; the primary thread then pauses them for a few periods (zero force,
+   * flagged, every input answered) and resumes on the new ones. `keep_contact`: a touching tip
+   * engages again with its force ramped in (re-centring on it); otherwise it must lift off first
+   * (a reset). Supervisor thread only.
+   * @throws Error for an invalid scene or another primary rate (the running loop is left as it
+   *         was).
    */
-  void Reconfigure(const Scene& scene);
+  void Reconfigure(const Scene& scene, bool keep_contact = false);
+  /** The node the tool wants the regions centred on (see ContactTracker::wanted_node). */
+  std::optional<LatticeIndex> wanted_contact_node() const;
+  /** True while the tip is inside on a node the regions are not centred on (force zero). */
+  bool contact_waiting() const { return contact_waiting_.load(std::memory_order_relaxed); }
+  /** The node the regions are centred on. Supervisor thread only. */
+  const LatticeIndex& centre_node() const { return centre_; }
+  /** Regions replaced since the loop was made (Reconfigure calls that took effect). */
+  std::int64_t reconfigurations() const { return reconfigurations_; }
+  /** Primary periods answered while the regions were paused for a reconfiguration. */
+  std::int64_t paused_periods() const { return paused_periods_.load(std::memory_order_relaxed); }
   /** CLOCK_MONOTONIC of the last primary period in contact, ns (0: never). */
   std::int64_t last_contact_ns() const { return last_contact_ns_.load(std::memory_order_relaxed); }
   bool running() const { return running_.load(); }
@@ -116,42 +139,70 @@ class HapticLoop {
   std::int64_t force_faults() const { return force_faults_.load(std::memory_order_relaxed); }
 
   /**
-   * One primary period at `now_ns` (what the primary thread runs; public for the allocation test).
-   * Never allocates, locks or throws.
+   * One primary period released at `release_ns`, run at `now_ns` (what the primary thread runs;
+   * public for the allocation test). Never allocates, locks or throws.
    */
-  void PrimaryPeriod(std::int64_t now_ns) noexcept;
+  void PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept;
 
   static std::int64_t NowNs() noexcept;
 
  private:
   void PrimaryThread(std::int64_t origin_ns);
   void SecondaryThread(RegionIndex region, std::int64_t origin_ns);
-  std::string ApplyRealtimeSettings();
-  void BuildSchedule();
+  void StartSecondaries(std::int64_t origin_ns);
+  void StopSecondaries();
+  std::string ApplyRealtimeSettings(std::thread& thread) const;
+  void Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions);
+  // The first release on the primary grid at or after `not_before_ns`.
+  std::int64_t NextPrimaryRelease(std::int64_t not_before_ns) const;
 
   Scene scene_;
   Options options_;
+  const int nodes_;  // per axis; the same for every configuration of the object
   std::unique_ptr<AsyncRegions> regions_;
+  // [0] the primary's (kept across reconfigurations: its period never changes), then one per
+  // secondary region of the installed regions.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
   SeqlockSlot<DeviceSample> input_;
   ForceRing forces_;
   BlackBoxRing black_box_;
   std::atomic<double> error_percent_{-1};
   std::atomic<std::int32_t> error_flags_{0};
-  std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0};
-  std::atomic<bool> running_{false}, stop_{false};
-  std::vector<std::thread> threads_;
+  std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0},
+      paused_periods_{0};
+  std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
+  std::thread primary_thread_;
+  std::vector<std::thread> secondary_threads_;
   std::vector<std::int64_t> lead_ns_;
   double tick_ns_ = 0;
+  double primary_period_ns_ = 0;
+  std::int64_t origin_ns_ = 0;         // the primary release grid: origin + k · period
+  LatticeIndex centre_{};              // written only while the primary has paused the regions
+  std::int64_t reconfigurations_ = 0;  // supervisor thread only
+
+  // The handshake of a reconfiguration (supervisor ↔ primary thread).
+  std::atomic<bool> pause_requested_{false}, paused_{false};
+  std::atomic<std::int64_t> resume_at_ns_{0};  // new regions run from this release on
+  enum RestartKind : int { kNoRestart = 0, kRestartFromRest = 1, kRestartKeepingContact = 2 };
+  std::atomic<int> restart_kind_{kNoRestart};  // what the primary does to the contact on resume
+
+  // Published by the primary thread for the supervisor.
+  std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none
+  std::atomic<bool> contact_waiting_{false};
+
+  // Input that arrives late by a period or two (a network or a scheduler's jitter) would hold the
+  // tip still for a period and then jump: the node's inertia turns that into force chatter. A
+  // period without new input continues the tip at its last velocity (per device period, one seq
+  // per primary period) for at most this many periods, then holds it.
+  static constexpr int kMaxPredictedPeriods = 3;
+  std::array<double, 3> PredictedTip() const noexcept;
 
   // Primary thread state.
-  std::array<double, 3> contact_rest_{};  // the contact node's rest position, object frame
-  std::array<double, 3> touch_down_{};
+  ContactTracker contact_;
+  DeviceSample previous_input_;  // the accepted input before last_input_
+  int periods_since_input_ = 0;
   std::array<double, 3> displacement_{};
   bool in_contact_ = false;
-  // After a (re)start the tool must leave the object before it can touch again: engaging a tip
-  // that is already deep inside would step the contact from rest to its depth at once.
-  bool await_lift_off_ = true;
   DeviceSample last_input_;
 };
 

@@ -36,6 +36,8 @@
 #include "daemon/input_counters.hpp"
 #include "daemon/lcm_bridge.hpp"
 #include "daemon/miss_logger.hpp"
+#include "daemon/overload_watch.hpp"
+#include "daemon/regions_mover.hpp"
 #include "daemon/shm_server.hpp"
 #include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"
@@ -145,6 +147,9 @@ int Serve(const Arguments& args) {
   options.cpus = config.cpus;
   HapticLoop loop(SceneWith(config.scene, decision.configuration), options);
   loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+  spdlog::info("contact: the regions are centred on node ({}, {}, {}) and follow the tool",
+               ContactNode(config.scene)[0], ContactNode(config.scene)[1],
+               ContactNode(config.scene)[2]);
 
   InputCounters counters;
   std::unique_ptr<LcmBridge> bridge;
@@ -194,17 +199,62 @@ int Serve(const Arguments& args) {
   spdlog::info("serving: {} regions running", loop.regions().num_regions());
 
   std::vector<MissLogger> miss_loggers;
-  for (int r = 0; r < loop.regions().num_regions(); ++r) {
-    miss_loggers.emplace_back(loop.regions().partition().RegionName(r), config.max_log_lines_per_s);
-  }
+  // One per region thread; the count changes when a reconfiguration changes the regions.
+  auto match_miss_loggers = [&](std::int64_t now) {
+    if (static_cast<int>(miss_loggers.size()) == loop.regions().num_regions()) return;
+    for (auto& m : miss_loggers) m.Flush(now, true);
+    miss_loggers.clear();
+    for (int r = 0; r < loop.regions().num_regions(); ++r) {
+      miss_loggers.emplace_back(loop.regions().partition().RegionName(r),
+                                config.max_log_lines_per_s);
+    }
+  };
+  match_miss_loggers(HapticLoop::NowNs());
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, last_rejection_line_ns = 0;
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
   constexpr int kOverrunBurst = 10;
-  std::future<SupervisorDecision> choice;             // a new choice being computed
-  std::optional<SupervisorDecision> pending;          // chosen, waiting for the tool to be away
+  std::future<SupervisorDecision> choice;         // a new choice being computed
+  std::optional<RegionConfiguration> choice_pin;  // the pin that choice was asked with
+  std::optional<SupervisorDecision> pending;      // chosen, waiting for the tool to be away
+  auto choose_again = [&](const std::optional<RegionConfiguration>& pin) {
+    // Stability estimates take up to seconds: off the supervisor's tick.
+    choice_pin = pin;
+    choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target, pin] {
+      return ChooseConfiguration(scene, m.get(), target, pin);
+    });
+  };
+  // The regions run `active` centred on loop.centre_node(): the decision's configuration, or its
+  // equal-rate fallback where the decision's is unstable around that node.
+  RegionConfiguration active = decision.configuration;
+  double active_radius = decision.spectral_radius;
+  RegionsMover mover(config.scene);
+  // The error map is looked up for the configured contact node; elsewhere the error is the
+  // nearest mapped one's, flagged as clamped (the map has no contact-node axis yet).
+  const LatticeIndex mapped_node = ContactNode(config.scene);
+  auto active_flags = [&] {
+    return DecisionFlags(decision) |
+           (loop.centre_node() == mapped_node ? 0 : force_flags::kLookupClamped) |
+           (pending ? force_flags::kReconfiguring : 0);
+  };
+  // Restarts the regions from rest where they are: the tool must lift off before it feels force.
+  auto restart_from_rest = [&](const char* why) {
+    try {
+      loop.Reconfigure(SceneWith(config.scene, active, loop.centre_node()));
+    } catch (const Error& e) {
+      spdlog::error("{}: restarting the regions failed: {}; stopping and starting them", why,
+                    e.what());
+      loop.Stop();
+      loop.Start();
+    }
+  };
+  OverloadWatch overload;  // a region missing deadlines second after second
+  std::int64_t last_overload_line_ns = 0;
+  std::optional<LatticeIndex> hover_node;  // the node the tool hovers over, and since when
+  std::int64_t hover_since_ns = 0;
+  constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
   const timespec tick{0, 20'000'000};
@@ -243,9 +293,7 @@ int Serve(const Arguments& args) {
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
       MapState reloaded = LoadMap(config.error_map, true);
       if (reloaded.map || config.error_map.empty()) map = std::move(reloaded);
-      choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target] {
-        return ChooseConfiguration(scene, m.get(), target, std::nullopt);
-      });
+      choose_again(pinned);
     }
     const std::int64_t now = HapticLoop::NowNs();
     if (args.duration_s > 0 && (now - start_ns) * 1e-9 >= args.duration_s) {
@@ -257,6 +305,7 @@ int Serve(const Arguments& args) {
       DeadlineEvent event;
       int misses = 0;
       while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event), ++misses;
+      overload.Count(r, misses);
       miss_loggers[r].Flush(now);
       // A primary that overruns again and again is a fault worth the black box (once a minute).
       if (r == kPrimaryRegion && misses >= kOverrunBurst &&
@@ -289,20 +338,41 @@ int Serve(const Arguments& args) {
             }
             target = command->error_target_percent;
             decision.target_met = decision.have_map && decision.error_percent <= target;
-            loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+            loop.SetErrorState(decision.error_percent, active_flags());
             spdlog::info(
                 "error target set to {} %: the active configuration's {} % {}; choosing "
                 "again",
                 target, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
-            // Stability estimates take up to seconds: off the supervisor's tick.
-            choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target] {
-              return ChooseConfiguration(scene, m.get(), target, std::nullopt);
-            });
+            choose_again(pinned);
+            break;
+          case command_t::PIN_CONFIGURATION: {
+            const RegionConfiguration pin{command->primary_size, command->secondary_lod,
+                                          command->secondary_rate_hz};
+            if (!(pin.primary_size >= 1 && pin.secondary_lod >= 1 &&
+                  std::isfinite(pin.secondary_rate_hz) && pin.secondary_rate_hz > 0 &&
+                  pin.secondary_rate_hz <= PrimaryRateHz(config.scene))) {
+              spdlog::warn(
+                  "command PIN_CONFIGURATION refused: primary_size {} and secondary_lod {} must "
+                  "be at least 1 and secondary_rate_hz {} in (0, {}] Hz",
+                  pin.primary_size, pin.secondary_lod, pin.secondary_rate_hz,
+                  PrimaryRateHz(config.scene));
+              break;
+            }
+            spdlog::info(
+                "command PIN_CONFIGURATION: verifying primary_size {}, secondary_lod {}, "
+                "secondary_rate {} Hz",
+                pin.primary_size, pin.secondary_lod, pin.secondary_rate_hz);
+            choose_again(pin);
+            break;
+          }
+          case command_t::RELEASE_CONFIGURATION:
+            spdlog::info("command RELEASE_CONFIGURATION: choosing freely again");
+            pinned.reset();
+            choose_again(std::nullopt);
             break;
           case command_t::RESET:
             spdlog::info("command RESET: the simulation restarts from rest");
-            loop.Stop();
-            loop.Start();
+            restart_from_rest("RESET");
             break;
           default:
             spdlog::warn("command {} refused: unknown or not supported by this version",
@@ -313,35 +383,103 @@ int Serve(const Arguments& args) {
     if (choice.valid() && choice.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
       try {
         SupervisorDecision chosen = choice.get();
+        if (choice_pin) spdlog::info("configuration pinned");
+        pinned = choice_pin;
         if (chosen.configuration == decision.configuration) {
           decision = chosen;
           pending.reset();
-          loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
         } else {
           spdlog::info(
-              "better configuration for the target: {}; switching when the tool has "
-              "been out of contact for {} s",
-              chosen.reason, kSettleBeforeReconfigure_s);
+              "{} configuration: {}; switching when the tool has been out of contact for {} s",
+              pinned ? "pinned" : "better", chosen.reason, kSettleBeforeReconfigure_s);
           pending = chosen;
-          loop.SetErrorState(decision.error_percent,
-                             DecisionFlags(decision) | force_flags::kReconfiguring);
         }
+        loop.SetErrorState(decision.error_percent, active_flags());
       } catch (const Error& e) {
-        spdlog::error("choosing a configuration failed: {}; keeping the active one", e.what());
+        spdlog::error("{} failed: {}; keeping the active configuration",
+                      choice_pin ? "pinning a configuration" : "choosing a configuration",
+                      e.what());
       }
     }
-    // Reconfigure only out of contact, after the object has settled: the force is zero then and
-    // the regions restart from rest, so the user feels no step.
-    if (pending && (now - loop.last_contact_ns()) * 1e-9 >= kSettleBeforeReconfigure_s) {
-      try {
-        loop.Reconfigure(SceneWith(config.scene, pending->configuration));
-        decision = *pending;
-        spdlog::info("reconfigured: {}", decision.reason);
-      } catch (const Error& e) {
-        spdlog::error("reconfiguration failed: {}; keeping the active configuration", e.what());
+    // Moving the regions — to the pending configuration, or onto the node the tool touches or
+    // hovers over. A new configuration only out of contact, after the object has settled: the
+    // force is zero then and the regions restart from rest, so the user feels no step. A touch on
+    // another node waits (zero force, flagged) for its regions, then ramps its force in.
+    const bool settled = (now - loop.last_contact_ns()) * 1e-9 >= kSettleBeforeReconfigure_s;
+    const std::optional<LatticeIndex> wanted = loop.wanted_contact_node();
+    if (wanted != hover_node) hover_node = wanted, hover_since_ns = now;
+    if (!mover.busy()) {
+      std::optional<RegionsMover::Request> request;
+      const bool waiting = loop.contact_waiting();
+      if (pending && settled && !waiting) {
+        request = {pending->configuration, wanted.value_or(loop.centre_node()), true};
+      } else if (wanted && *wanted != loop.centre_node() &&
+                 (waiting ||
+                  (settled && (now - hover_since_ns) * 1e-9 >= kHoverBeforeRecentre_s))) {
+        request = {decision.configuration, *wanted, false};
       }
-      pending.reset();
-      loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
+      if (request && mover.may_ask(*request)) mover.Ask(*request, now);
+    }
+    try {
+      if (const std::optional<RegionsMover::Verified> moved = mover.Poll(now)) {
+        const LatticeIndex& node = moved->request.node;
+        loop.Reconfigure(SceneWith(config.scene, moved->centred.configuration, node),
+                         /*keep_contact=*/true);
+        if (moved->request.applies_pending) {
+          decision = *pending;
+          pending.reset();
+          spdlog::info("reconfigured: {}", decision.reason);
+        }
+        active = moved->centred.configuration;
+        active_radius = moved->centred.spectral_radius;
+        spdlog::info("regions centred on contact node ({}, {}, {}) {} s after it was asked for{}",
+                     node[0], node[1], node[2], moved->verify_ms * 1e-3,
+                     moved->centred.fell_back
+                         ? "; the chosen configuration is unstable around it: secondaries at "
+                           "the primary rate there"
+                         : "");
+        match_miss_loggers(now);
+        overload.Reset(now);
+        loop.SetErrorState(decision.error_percent, active_flags());
+      }
+    } catch (const Error& e) {
+      spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
+      if (pending &&
+          !mover.may_ask({pending->configuration, wanted.value_or(loop.centre_node()), true})) {
+        pending.reset();  // refused around this node: not asked again
+      }
+      loop.SetErrorState(decision.error_percent, active_flags());
+    }
+    // Deadlines before accuracy: a region that keeps missing them gets a cheaper configuration
+    // (the map's measured costs), switched like any other once the tool is away.
+    std::vector<double> rates_hz;
+    for (int r = 0; r < loop.regions().num_regions(); ++r) {
+      rates_hz.push_back(loop.regions().schedule(r).rate_hz);
+    }
+    if (const int region = overload.Check(now, rates_hz); region >= 0) {
+      const std::string name = loop.regions().partition().RegionName(region);
+      if (decision.have_map && !pinned && !choice.valid()) {
+        spdlog::error(
+            "{} thread missed {} of its {} periods in the last second, and more than 5 % in "
+            "each of the 3 before: choosing a configuration cheaper than {} µs per simulated "
+            "ms (deadlines before accuracy)",
+            name, overload.last_misses(), rates_hz[region], decision.cost_us_per_ms);
+        choice_pin.reset();
+        choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target,
+                                                 ceiling = decision.cost_us_per_ms] {
+          return ChooseConfiguration(scene, m.get(), target, std::nullopt, ceiling);
+        });
+      } else if (now - last_overload_line_ns > 60'000'000'000) {
+        last_overload_line_ns = now;
+        spdlog::error(
+            "{} thread keeps missing deadlines ({} in the last second) and the "
+            "supervisor cannot choose a cheaper configuration ({}): give it a CPU of "
+            "its own (realtime.cpus, realtime.fifo_priority) or pin a cheaper one",
+            name, overload.last_misses(),
+            pinned              ? "a configuration is pinned"
+            : decision.have_map ? "a choice is being made"
+                                : "no error map");
+      }
     }
     if (loop.force_faults() > faults_seen) {
       faults_seen = loop.force_faults();
@@ -354,9 +492,8 @@ int Serve(const Arguments& args) {
           "the simulation restarts from rest and renders again after the tool has "
           "left the object",
           config.max_force_n);
-      loop.Stop();
-      faults_seen = loop.force_faults();  // the periods between the count and the stop included
-      loop.Start();
+      restart_from_rest("force fault");
+      faults_seen = loop.force_faults();  // the periods up to the restart included
     }
     if (now >= next_status_ns) {
       next_status_ns = now + static_cast<std::int64_t>(1e9 / config.status_rate_hz);
@@ -365,8 +502,11 @@ int Serve(const Arguments& args) {
         snapshots.push_back(loop.monitor(r).TakeSnapshot());
       }
       if (bridge) {
+        SupervisorDecision shown = decision;
+        shown.configuration = active;
+        shown.spectral_radius = active_radius;
         bridge->PostStatus(
-            MakeStatus(loop, snapshots, decision, target, pinned.has_value(), map.path, &counters));
+            MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters));
       }
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {

@@ -23,6 +23,9 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
     s.forces_published = counters->forces_published.load();
   }
   s.stale_periods = loop.stale_periods();
+  for (int c = 0; c < 3; ++c) s.contact_node[c] = loop.centre_node()[c];
+  s.reconfigurations = loop.reconfigurations();
+  s.paused_periods = loop.paused_periods();
   const AsyncRegions& regions = loop.regions();
   s.num_regions = regions.num_regions();
   for (int r = 0; r < regions.num_regions(); ++r) {

@@ -44,9 +44,34 @@ Scene SceneWith(const Scene& scene, const RegionConfiguration& c) {
   return out;
 }
 
+Scene SceneWith(const Scene& scene, const RegionConfiguration& c, const LatticeIndex& node) {
+  Scene out = SceneWith(scene, c);
+  out.input.contact_node = node;
+  return out;
+}
+
+CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfiguration& configuration,
+                                     const LatticeIndex& node) {
+  const Scene centred = SceneWith(scene, configuration, node);
+  ValidateScene(centred);  // a node off the surface or on a support is refused with its reason
+  if (const std::optional<double> radius = CoupledRadius(centred, configuration)) {
+    return {configuration, *radius, false};
+  }
+  RegionConfiguration equal = configuration;
+  equal.secondary_rate_hz = PrimaryRateHz(scene);
+  if (const std::optional<double> radius = CoupledRadius(centred, equal)) {
+    return {equal, *radius, true};
+  }
+  throw Error(Describe(configuration) + " is not stable around contact node (" +
+              std::to_string(node[0]) + ", " + std::to_string(node[1]) + ", " +
+              std::to_string(node[2]) + "), not even at equal rates");
+}
+
 SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
                                        double target_percent,
-                                       const std::optional<RegionConfiguration>& pinned) {
+                                       const std::optional<RegionConfiguration>& pinned,
+                                       double below_cost_us_per_ms) {
+  const bool capped = below_cost_us_per_ms < std::numeric_limits<double>::infinity();
   struct Candidate {
     RegionConfiguration configuration;
     double error = -1, cost = 0;
@@ -82,10 +107,15 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
           const auto entry = cost.find({lod, size, rate});
           const double mean_cost =
               entry == cost.end() ? 1e9 : entry->second.first / entry->second.second;
+          if (!(mean_cost < below_cost_us_per_ms)) continue;
           candidates.push_back({c, result.error, mean_cost, result.clamped});
         }
       }
     }
+  }
+  if (candidates.empty() && capped) {
+    throw Error("no configuration in the error map is stable and cheaper than " +
+                std::to_string(below_cost_us_per_ms) + " µs per simulated ms");
   }
   if (candidates.empty()) {  // no map, or nothing usable in it: the scene's own configuration
     const RegionConfiguration own = pinned.value_or(

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -36,13 +37,37 @@ struct SupervisorDecision {
  * frequency and amplitude unknown (their worst case over the map). Without a map: the scene's own
  * configuration if stable, else equal rates (always stable when the primary rate is).
  * `pinned`: only that configuration (refused — an Error — if it is unstable).
- * @throws Error when no stable configuration exists at all.
+ * `below_cost_us_per_ms`: only configurations the map measured cheaper than this (deadlines
+ * before accuracy, when the running one keeps missing them).
+ * @throws Error when no stable configuration exists at all (or none cheaper, with a ceiling).
  */
-SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
-                                       double target_percent,
-                                       const std::optional<RegionConfiguration>& pinned);
+SupervisorDecision ChooseConfiguration(
+    const Scene& scene, const ErrorMap* map, double target_percent,
+    const std::optional<RegionConfiguration>& pinned,
+    double below_cost_us_per_ms = std::numeric_limits<double>::infinity());
 
 /** The scene with `configuration` as its adaptivity. */
 Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration);
+
+/** … and its regions centred on the surface node `node` (input.contact_node). */
+Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration,
+                const LatticeIndex& node);
+
+/** A configuration verified stable around one contact node. */
+struct CentredConfiguration {
+  RegionConfiguration configuration;  ///< the one asked for, or its equal-rate fallback
+  double spectral_radius = 0;         ///< coupled, around the node
+  bool fell_back = false;             ///< the one asked for is unstable around the node
+};
+
+/**
+ * Stability first, wherever the tool touches: verifies `configuration` with its regions centred
+ * on `node` (the regions' shapes, and so their coupling, change near the object's edges and
+ * corners). When it is unstable there, the same regions with the secondaries at the primary rate
+ * instead (stable whenever the primary rate is).
+ * @throws Error when neither is stable around the node.
+ */
+CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfiguration& configuration,
+                                     const LatticeIndex& node);
 
 }  // namespace hapticsim

@@ -10,6 +10,7 @@
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
+#include "daemon/overload_watch.hpp"
 #include "daemon/supervisor.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"
@@ -186,6 +187,12 @@ TEST(Supervisor, ChoosesTheCheapestStableConfigurationMeetingTheTargetElseTheMos
   const SupervisorDecision impossible = ChooseConfiguration(scene, &map, 0.1, std::nullopt);
   EXPECT_EQ(impossible.configuration.primary_size, 3);  // the most accurate stable one
   EXPECT_FALSE(impossible.target_met);
+  // Deadlines before accuracy: below size 3's cost only size 1 is left, and below size 1's none.
+  const SupervisorDecision cheaper =
+      ChooseConfiguration(scene, &map, 2.0, std::nullopt, tight.cost_us_per_ms);
+  EXPECT_EQ(cheaper.configuration.primary_size, 1);
+  EXPECT_FALSE(cheaper.target_met);
+  EXPECT_THROW(ChooseConfiguration(scene, &map, 2.0, std::nullopt, cheaper.cost_us_per_ms), Error);
 
   map.samples[1].status = SampleStatus::kPredictedUnstable;  // never chosen, whatever its error
   const SupervisorDecision safe = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
@@ -197,6 +204,39 @@ TEST(Supervisor, ChoosesTheCheapestStableConfigurationMeetingTheTargetElseTheMos
   EXPECT_EQ(no_map.configuration.primary_size, 3);
   EXPECT_FALSE(no_map.have_map);
   EXPECT_EQ(no_map.error_percent, -1);
+}
+
+}  // namespace
+}  // namespace hapticsim
+
+namespace hapticsim {
+namespace {
+
+TEST(OverloadWatch, ARegionMissingDeadlinesForThreeSecondsIsReportedAndABurstIsNot) {
+  constexpr std::int64_t kS = 1'000'000'000;
+  const std::vector<double> rates{1000, 600};
+  OverloadWatch watch;  // 5 % of the periods, three windows in a row
+  EXPECT_EQ(watch.Check(0, rates), -1);
+  // One bad second (a burst of 200 misses of the primary), then quiet: nothing.
+  watch.Count(0, 200);
+  EXPECT_EQ(watch.Check(kS, rates), -1);
+  EXPECT_EQ(watch.Check(2 * kS, rates), -1);
+  // The secondary misses 40 of 600 (6.7 %) every second: reported after the third.
+  for (int s = 3; s <= 4; ++s) {
+    watch.Count(1, 40);
+    EXPECT_EQ(watch.Check(s * kS, rates), -1) << s;
+  }
+  watch.Count(1, 40);
+  EXPECT_EQ(watch.Check(5 * kS, rates), 1);
+  EXPECT_EQ(watch.last_misses(), 40);
+  // Counting starts afresh; 25 of 600 (4.2 %) is under the share.
+  for (int s = 6; s <= 9; ++s) {
+    watch.Count(1, 25);
+    EXPECT_EQ(watch.Check(s * kS, rates), -1) << s;
+  }
+  // No window closes before its second is over.
+  watch.Count(0, 1000);
+  EXPECT_EQ(watch.Check(9 * kS + kS / 2, rates), -1);
 }
 
 }  // namespace

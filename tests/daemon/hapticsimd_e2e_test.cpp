@@ -257,6 +257,78 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
       << daemon_->Log();
 }
 
+// Contact anywhere: a touch on another surface node waits (zero force, flagged) while the
+// supervisor verifies and moves the regions there, then pushes back with its force ramped in.
+TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.contact_node[2] == 0; }, 30))
+      << daemon_->Log();
+  const double h = kEdge / 12;
+  auto next = Clock::now();
+  for (std::int64_t seq = 1; seq <= 1500; ++seq) {  // a brief hover over (2, 3, 0), then 6 mm in
+    const double z = seq <= 50 ? -0.002 : 0.006 * std::min(1.0, (seq - 50) / 600.0);
+    client.Send(seq, 2 * h, 3 * h, z);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::optional<status_t> status = client.LastStatus();
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->contact_node[0], 2);
+  EXPECT_EQ(status->contact_node[1], 3);
+  EXPECT_EQ(status->contact_node[2], 0);
+  EXPECT_GE(status->reconfigurations, 1);
+  EXPECT_NE(daemon_->Log().find("regions centred on contact node (2, 3, 0)"), std::string::npos)
+      << daemon_->Log();
+  int waited = 0, pushing_back = 0;
+  double previous = 0, largest_jump = 0;
+  for (const force_feedback_t& f : client.Forces()) {
+    ASSERT_TRUE(std::isfinite(f.force[2]));
+    if (!(f.flags & force_feedback_t::FLAG_IN_CONTACT)) {
+      EXPECT_EQ(f.force[2], 0.0) << "force without contact at seq " << f.seq;
+      if (f.seq > 50 && (f.flags & force_feedback_t::FLAG_RECONFIGURING)) ++waited;
+    } else {
+      // Off the node the map was made for: the error is the mapped node's, flagged as clamped.
+      EXPECT_TRUE(f.flags & force_feedback_t::FLAG_LOOKUP_CLAMPED) << f.seq;
+      if (f.seq > 1300 && f.force[2] < -0.3) ++pushing_back;
+    }
+    if (f.flags & force_feedback_t::FLAG_INPUT_STALE) continue;  // zeroed once the device stops
+    largest_jump = std::max(largest_jump, std::abs(f.force[2] - previous));
+    previous = f.force[2];
+  }
+  EXPECT_GT(waited, 10) << "the touch should wait for its regions";
+  EXPECT_GT(pushing_back, 100) << daemon_->Log();
+  EXPECT_LT(largest_jump, 0.1) << "a force step across the re-centring";
+  daemon_->Signal(SIGTERM);
+  EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
+}
+
+TEST_F(HapticsimdEndToEnd, APinnedConfigurationHoldsUntilReleasedAndAnUnstableOneIsRefused) {
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.primary_size == 1; }, 30))
+      << daemon_->Log();
+  command_t pin{};
+  pin.command = command_t::PIN_CONFIGURATION;
+  pin.primary_size = 3, pin.secondary_lod = 2, pin.secondary_rate_hz = 1000;
+  client.Command(pin);
+  ASSERT_TRUE(
+      client.WaitForStatus([](const status_t& s) { return s.pinned && s.primary_size == 3; }, 15))
+      << daemon_->Log();
+  pin.secondary_rate_hz = 5000;  // faster than the primary: refused before anything is built
+  client.Command(pin);
+  pin.secondary_rate_hz = 1000, pin.primary_size = 0;
+  client.Command(pin);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(client.LastStatus()->primary_size, 3);
+  EXPECT_NE(daemon_->Log().find("PIN_CONFIGURATION refused"), std::string::npos) << daemon_->Log();
+  command_t release{};
+  release.command = command_t::RELEASE_CONFIGURATION;
+  client.Command(release);
+  ASSERT_TRUE(
+      client.WaitForStatus([](const status_t& s) { return !s.pinned && s.primary_size == 1; }, 15))
+      << daemon_->Log();
+}
+
 // Stability first: a force above input.max_force_n is never sent; the daemon zeroes it, logs the
 // black box of the last periods and restarts the simulation from rest.
 TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
@@ -322,8 +394,8 @@ TEST(HapticsimdReload, ACorruptMapOnReloadIsRefusedAndTheDaemonKeepsServing) {
   std::ofstream(config) << "[supervisor]\nerror_map = \"" << map
                         << "\"\nerror_target_percent = 3.5\n";
   daemon.Signal(SIGHUP);
-  EXPECT_TRUE(client.WaitForStatus([](const status_t& s) { return s.error_target_percent == 3.5; },
-                                   5))
+  EXPECT_TRUE(
+      client.WaitForStatus([](const status_t& s) { return s.error_target_percent == 3.5; }, 5))
       << daemon.Log();
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0);

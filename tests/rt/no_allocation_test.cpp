@@ -118,7 +118,7 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
       const double z = n < 100 ? -0.002 : 0.01 * (n - 100) / 300.0;
       loop.input().Write(DeviceSample{n, now, {0.125, 0.125, z}, false});
     }  // then the input goes stale
-    loop.PrimaryPeriod(now);
+    loop.PrimaryPeriod(now, now);
     for (int r = 1; r < loop.regions().num_regions(); ++r) {
       const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
     }

@@ -1,0 +1,82 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/**
+ * Where the tool tip touches the object and how far it has pressed: the primary thread's contact
+ * state, as plain logic (no threads, no allocation) so it can be tested on its own.
+ *
+ * The object is the cube [0, L]³ in the object frame. The tip is in contact while it is strictly
+ * inside. At touch-down the entry face is the one the tip is least deep behind; the entry point
+ * is the tip projected on that face, and the contact node is the surface node nearest to the
+ * entry point (never one of the fixed back corners: their free neighbour instead). While in
+ * contact the node follows the tip: displacement = tip − entry point, in all three directions.
+ * The node stays the same until lift-off (as in the paper, the contact does not slide).
+ *
+ * The regions are centred on one node. A touch-down on another node waits (zero force, "waiting"
+ * set) until the regions are centred on it, then engages with its force ramped in from zero: the
+ * displacement is tip − entry point scaled by a smoothstep from 0 to 1 over `engage_ramp_s`, so
+ * neither the node's position nor its velocity jumps however deep the tip went while waiting.
+ *
+ * After a restart from rest (a reset or a fault) a tip already inside renders nothing until it has
+ * left the object once: engaging it at once would step the contact from rest to its depth.
+ */
+class ContactTracker {
+ public:
+  ContactTracker(const MeshSettings& mesh, double engage_ramp_s);
+
+  /** The result of one update. */
+  struct Contact {
+    bool engaged = false;  ///< the contact node is driven: render its reaction
+    bool waiting = false;  ///< the tip is inside, on a node the regions are not centred on
+    std::array<double, 3> displacement_m{};  ///< of the contact node (zero unless engaged)
+  };
+
+  /**
+   * One period with a fresh tip position. `centre`: the node the regions are centred on, or none
+   * while the regions are being replaced (nothing engages then).
+   */
+  Contact Update(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                 const std::optional<LatticeIndex>& centre) noexcept;
+  /** One period without fresh input: the contact holds where it was. */
+  Contact Hold(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
+
+  /** The regions restart from rest: any contact is released and must lift off first. */
+  void RestartFromRest() noexcept;
+  /** The regions restart from rest around a new centre: an engaged or waiting contact engages
+   * again with its force ramped in from zero. */
+  void RestartKeepingContact() noexcept;
+
+  /**
+   * The node the regions should be centred on: the touched node while inside, else the surface
+   * node nearest to the tip (so the regions can be moved there before it lands). None before the
+   * first input.
+   */
+  std::optional<LatticeIndex> wanted_node() const { return wanted_; }
+
+  /** The surface node nearest to a point on (or projected onto) the surface; never a support. */
+  LatticeIndex NearestContactNode(const std::array<double, 3>& surface_point_m) const noexcept;
+
+ private:
+  enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
+  Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
+
+  MeshSettings mesh_;
+  double h_ = 0;
+  std::int64_t ramp_ns_ = 0;
+  State state_ = State::kAwaitLiftOff;
+  std::array<double, 3> tip_{};
+  std::array<double, 3> entry_{};
+  bool late_ = false;  // engaged after waiting: ramped in
+  std::int64_t ramp_start_ns_ = 0;
+  LatticeIndex node_{};
+  std::optional<LatticeIndex> wanted_;
+};
+
+}  // namespace hapticsim

@@ -1,0 +1,43 @@
+#include "daemon/regions_mover.hpp"
+
+#include "core/error.hpp"
+
+namespace hapticsim {
+
+void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
+  asked_ = request;
+  asked_ns_ = now_ns;
+  if (const auto known = verdicts_.find(KeyOf(request)); known != verdicts_.end()) {
+    known_ = known->second;
+    return;
+  }
+  verifying_ = std::async(std::launch::async, [scene = scene_, request] {
+    return VerifyCentredOn(scene, request.configuration, request.node);
+  });
+}
+
+std::optional<RegionsMover::Verified> RegionsMover::Poll(std::int64_t now_ns) {
+  if (!asked_) return std::nullopt;
+  std::optional<CentredConfiguration> verdict = std::move(known_);
+  known_.reset();
+  if (!verdict) {
+    if (!verifying_.valid() ||
+        verifying_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      return std::nullopt;
+    }
+    const Request request = *asked_;
+    try {
+      verdict = verifying_.get();
+    } catch (const Error&) {
+      refused_.insert(KeyOf(request));
+      asked_.reset();
+      throw;
+    }
+    verdicts_[KeyOf(request)] = *verdict;
+  }
+  Verified done{*asked_, *verdict, (now_ns - asked_ns_) * 1e-6};
+  asked_.reset();
+  return done;
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,141 @@
+// The primary thread's contact logic on its own: which node a touch picks, how far it is driven,
+// and how a late engagement ramps in.
+#include "daemon/contact_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hapticsim {
+namespace {
+
+constexpr double kEdge = 0.25, kH = kEdge / 12;  // the default 13³ cube
+constexpr std::int64_t kMs = 1'000'000;
+
+MeshSettings Mesh() { return MeshSettings{}; }
+
+TEST(ContactTracker, ATouchOnTheCentredNodeEngagesAtOnceAndFollowsTheTip) {
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  EXPECT_FALSE(tracker.Update({0.125, 0.125, -0.002}, 0, middle).engaged);
+  EXPECT_EQ(tracker.wanted_node(), middle);
+  const auto touch = tracker.Update({0.126, 0.124, 0.0005}, kMs, middle);
+  EXPECT_TRUE(touch.engaged);
+  EXPECT_FALSE(touch.waiting);
+  // Entry point: the tip projected on the front face; the node follows the tip from there.
+  EXPECT_DOUBLE_EQ(touch.displacement_m[2], 0.0005);
+  EXPECT_DOUBLE_EQ(touch.displacement_m[0], 0.0);
+  const auto deeper = tracker.Update({0.127, 0.124, 0.004}, 2 * kMs, middle);
+  EXPECT_NEAR(deeper.displacement_m[0], 0.001, 1e-15);
+  EXPECT_NEAR(deeper.displacement_m[2], 0.004, 1e-15);
+  // Sliding along the surface does not change the node (the paper's contact does not slide).
+  tracker.Update({0.2, 0.124, 0.004}, 3 * kMs, middle);
+  EXPECT_EQ(tracker.wanted_node(), middle);
+  EXPECT_FALSE(tracker.Update({0.2, 0.124, -0.001}, 4 * kMs, middle).engaged);  // lift-off
+}
+
+TEST(ContactTracker, ATouchThroughAnyFacePicksTheNearestNodeOnThatFace) {
+  struct Case {
+    std::array<double, 3> outside, inside;
+    LatticeIndex node;
+    std::array<double, 3> displacement;
+  };
+  const double d = 0.001;
+  const Case cases[] = {
+      {{0.1, 0.2, -d}, {0.1, 0.2, d}, {5, 10, 0}, {0, 0, d}},                   // front, z = 0
+      {{0.1, 0.2, kEdge + d}, {0.1, 0.2, kEdge - d}, {5, 10, 12}, {0, 0, -d}},  // back
+      {{-d, 0.05, 0.12}, {d, 0.05, 0.12}, {0, 2, 6}, {d, 0, 0}},                // left, x = 0
+      {{kEdge + d, 0.05, 0.12}, {kEdge - d, 0.05, 0.12}, {12, 2, 6}, {-d, 0, 0}},
+      {{0.07, -d, 0.2}, {0.07, d, 0.2}, {3, 0, 10}, {0, d, 0}},  // bottom, y = 0
+      {{0.07, kEdge + d, 0.2}, {0.07, kEdge - d, 0.2}, {3, 12, 10}, {0, -d, 0}},
+  };
+  for (const Case& c : cases) {
+    ContactTracker tracker(Mesh(), 0.1);
+    tracker.Update(c.outside, 0, c.node);
+    EXPECT_EQ(tracker.wanted_node(), c.node) << "hovering";
+    const auto contact = tracker.Update(c.inside, kMs, c.node);
+    EXPECT_EQ(tracker.wanted_node(), c.node);
+    ASSERT_TRUE(contact.engaged);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(contact.displacement_m[k], c.displacement[k], 1e-15);
+  }
+}
+
+TEST(ContactTracker, AFixedBackCornerIsNeverTheContactNode) {
+  const ContactTracker tracker(Mesh(), 0.1);
+  // Near the corner (0, 0, 12), a little farther from it along y than along x.
+  const LatticeIndex node = tracker.NearestContactNode({0.2 * kH, 0.4 * kH, kEdge});
+  EXPECT_FALSE(IsSupportNode(Mesh(), node));
+  EXPECT_TRUE(IsSurfaceNode(Mesh(), node));
+  EXPECT_EQ(node, (LatticeIndex{0, 1, 12}));
+  EXPECT_EQ(tracker.NearestContactNode({kEdge, kEdge - 0.4 * kH, kEdge - 0.2 * kH}),
+            (LatticeIndex{12, 11, 12}));
+}
+
+TEST(ContactTracker, ATouchElsewhereWaitsThenRampsItsDepthInFromZero) {
+  const double ramp_s = 0.1;
+  ContactTracker tracker(Mesh(), ramp_s);
+  const LatticeIndex middle{6, 6, 0}, side{2, 3, 0};
+  tracker.Update({2 * kH, 3 * kH, -0.001}, 0, middle);
+  EXPECT_EQ(tracker.wanted_node(), side);
+  // Pressing on at 10 mm/s while the regions are still around the middle: zero, waiting.
+  std::int64_t t = 0;
+  double z = 0;
+  for (int n = 1; n <= 200; ++n) {
+    t = n * kMs, z = 1e-5 * n;
+    const auto c = tracker.Update({2 * kH, 3 * kH, z}, t, middle);
+    ASSERT_TRUE(c.waiting);
+    ASSERT_FALSE(c.engaged);
+    ASSERT_EQ(c.displacement_m[2], 0.0);
+  }
+  EXPECT_EQ(tracker.wanted_node(), side);
+  // The regions move (none while they are replaced), then the contact engages at zero depth and
+  // the 2 mm it went in the meantime ramps in over ramp_s, on top of the tip's own motion.
+  EXPECT_TRUE(tracker.Update({2 * kH, 3 * kH, z}, t += kMs, std::nullopt).waiting);
+  double previous = 0, largest_step = 0;
+  const double engaged_at_depth = z + 1e-5;
+  for (int n = 0; n <= 150; ++n, t += kMs) {
+    z += 1e-5;
+    const auto c = tracker.Update({2 * kH, 3 * kH, z}, t, side);
+    ASSERT_TRUE(c.engaged);
+    if (n == 0) EXPECT_NEAR(c.displacement_m[2], 0.0, 1e-15);
+    largest_step = std::max(largest_step, c.displacement_m[2] - previous);
+    previous = c.displacement_m[2];
+  }
+  EXPECT_NEAR(previous, z, 1e-15);  // fully in after the ramp
+  // d(w·D)/dn = w'·D + w·D': a smoothstep's steepest slope is 1.5 per ramp (100 periods) and D
+  // is at most the depth at the ramp's end; the tip adds its 0.01 mm per period.
+  const double depth_at_ramp_end = engaged_at_depth + 100 * 1e-5;
+  EXPECT_LT(largest_step, 1.5 * depth_at_ramp_end / 100 + 1e-5);
+  EXPECT_GT(largest_step, engaged_at_depth / 100);
+}
+
+TEST(ContactTracker, AfterARestartFromRestATipInsideMustLiftOffFirst) {
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  tracker.Update({0.125, 0.125, -0.001}, 0, middle);
+  EXPECT_TRUE(tracker.Update({0.125, 0.125, 0.003}, kMs, middle).engaged);
+  tracker.RestartFromRest();
+  EXPECT_FALSE(tracker.Update({0.125, 0.125, 0.004}, 2 * kMs, middle).engaged);
+  EXPECT_FALSE(tracker.Hold(3 * kMs, middle).engaged);
+  tracker.Update({0.125, 0.125, -0.001}, 4 * kMs, middle);
+  EXPECT_TRUE(tracker.Update({0.125, 0.125, 0.001}, 5 * kMs, middle).engaged);
+  // A fresh tracker (a started loop) behaves the same: a tip already inside waits for lift-off.
+  ContactTracker fresh(Mesh(), 0.1);
+  EXPECT_FALSE(fresh.Update({0.125, 0.125, 0.004}, 0, middle).engaged);
+}
+
+TEST(ContactTracker, ARestartKeepingContactEngagesAgainFromZero) {
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  tracker.Update({0.125, 0.125, -0.001}, 0, middle);
+  tracker.Update({0.125, 0.125, 0.003}, kMs, middle);
+  tracker.RestartKeepingContact();
+  const auto again = tracker.Update({0.125, 0.125, 0.003}, 2 * kMs, middle);
+  EXPECT_TRUE(again.engaged);
+  EXPECT_NEAR(again.displacement_m[2], 0.0, 1e-15);
+  EXPECT_NEAR(tracker.Hold(52 * kMs, middle).displacement_m[2], 0.0015, 1e-12);  // half way
+  EXPECT_NEAR(tracker.Hold(102 * kMs, middle).displacement_m[2], 0.003, 1e-15);  // all the way
+}
+
+}  // namespace
+}  // namespace hapticsim
