@@ -43,6 +43,16 @@ class DeadlineMonitor {
   explicit DeadlineMonitor(double period_s)
       : period_ns_(static_cast<std::int64_t>(period_s * 1e9)) {}
 
+  /**
+   * Continues the run-long counts (periods, misses, worst lateness) of the monitor this one
+   * replaces, so a thread's statistics survive a reconfiguration. Before the thread starts.
+   */
+  void CarryOver(const DeadlineMonitor& previous) noexcept {
+    cycles_.store(previous.cycles_.load());
+    misses_.store(previous.misses_.load());
+    worst_lateness_ns_.store(previous.worst_lateness_ns_.load());
+  }
+
   /** The periodic thread, after each period. */
   void Record(std::int64_t release_ns, std::int64_t woke_ns, std::int64_t done_ns) noexcept;
 

@@ -52,10 +52,14 @@ void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regio
     primary_period_ns_ = nominal_ns(kPrimaryRegion);
     monitors_.push_back(std::make_unique<DeadlineMonitor>(primary_period_ns_ * 1e-9));
   }
+  std::vector<std::unique_ptr<DeadlineMonitor>> replaced(
+      std::make_move_iterator(monitors_.begin() + 1), std::make_move_iterator(monitors_.end()));
   monitors_.resize(1);
   lead_ns_.assign(static_cast<size_t>(count), 0);
   for (int a = 1; a < count; ++a) {
     monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal_ns(a) * 1e-9));
+    // The a-th secondary thread's statistics run on across reconfigurations.
+    if (a - 1 < static_cast<int>(replaced.size())) monitors_.back()->CarryOver(*replaced[a - 1]);
     // Each coarser region is released ahead of the finer one by 1.25 of the finer's period, so
     // its boundary is published before the finer region needs it (as in RealTimeSchedule).
     lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ns(a - 1));
@@ -187,6 +191,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     }
   }
   ForceRecord out;
+  out.period = periods_run_++;
   BlackBoxRecord box;
   box.raw_force_n = {-reaction[0], -reaction[1], -reaction[2]};
   out.seq = last_input_.seq;

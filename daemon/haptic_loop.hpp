@@ -27,6 +27,7 @@ struct DeviceSample {
 
 /** One primary period's answer, as the primary thread hands it to the I/O thread. */
 struct ForceRecord {
+  std::int64_t period = -1;         ///< the primary period, counting every one since the start
   std::int64_t seq = -1;            ///< the input it answers
   std::int64_t utime_us = 0;        ///< CLOCK_MONOTONIC, µs
   std::array<double, 3> force_n{};  ///< on the user
@@ -199,7 +200,8 @@ class HapticLoop {
 
   // Primary thread state.
   ContactTracker contact_;
-  DeviceSample previous_input_;  // the accepted input before last_input_
+  DeviceSample previous_input_;   // the accepted input before last_input_
+  std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
   int periods_since_input_ = 0;
   std::array<double, 3> displacement_{};
   bool in_contact_ = false;

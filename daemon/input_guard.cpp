@@ -28,6 +28,11 @@ InputRejection InputGuard::Check(std::int64_t seq, const std::array<double, 3>& 
   for (double x : p) {
     if (x < -margin_m_ || x > edge_m_ + margin_m_) return InputRejection::kOutsideWorkspace;
   }
+  // A device silent for a while starts a new session: a restarted driver counts from 1 again and
+  // its tool may be anywhere, so neither the old seq nor the old position applies.
+  if (have_last_ && static_cast<double>(received_ns - last_ns_) * 1e-9 > kNewSessionAfter_s) {
+    have_last_ = false;
+  }
   if (have_last_) {
     if (seq <= last_seq_) return InputRejection::kOldSequence;
     // Time between arrivals, at least half a millisecond: arrival jitter must not turn a normal

@@ -26,6 +26,9 @@ std::string_view InputRejectionName(InputRejection rejection);
  */
 class InputGuard {
  public:
+  /** Silence after which the next input starts a new session (any seq, any position), s. */
+  static constexpr double kNewSessionAfter_s = 0.5;
+
   InputGuard(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s)
       : edge_m_(mesh.edge_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}
 

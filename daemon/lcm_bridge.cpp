@@ -47,6 +47,7 @@ void LcmBridge::Publish(const ForceRecord& record) {
   if (record.seq < 0) return;  // nothing to answer before the first input
   force_feedback_t out{};
   out.utime = record.utime_us;
+  out.period = record.period;
   out.seq = record.seq;
   for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
   out.error_percent = record.error_percent;

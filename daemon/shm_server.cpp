@@ -19,12 +19,15 @@ void ShmServer::PollInput() {
 
 void ShmServer::Publish(const ForceRecord& record) {
   shm::ShmForceOutput out;
+  out.period = record.period;
   out.seq = record.seq;
   out.utime = record.utime_us;
   for (int c = 0; c < 3; ++c) out.force_n[c] = record.force_n[c];
   out.error_percent = record.error_percent;
   out.flags = record.flags;
-  mapping_.segment().output.Write(out);
+  shm::ShmSegment& segment = mapping_.segment();
+  segment.outputs[record.period % shm::kOutputSlots].Write(out);
+  segment.newest_output.store(record.period, std::memory_order_release);
   mapping_.segment().header.daemon_heartbeat_ns.store(record.utime_us * 1000,
                                                       std::memory_order_relaxed);
 }

@@ -6,9 +6,11 @@
 //   client.WriteInput(seq, utime_us, {x, y, z});          // every device period (1 kHz)
 //   hapticsim::shm::ShmForceOutput force;
 //   if (client.ReadForce(&force) && force.seq == seq) { /* render force.force_n */ }
+//   client.ReadForcesSince(last_period, [&](const ShmForceOutput& f) { /* log every answer */ });
 //
 // Both calls are wait-free: no locks, no allocation, no system calls. Link hapticsim_ipc.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -33,7 +35,28 @@ class ShmDeviceClient {
     mapping_.segment().input.Write(input);
   }
   /** The newest force; false when none is available consistently yet. */
-  bool ReadForce(ShmForceOutput* out) const { return mapping_.segment().output.Read(out); }
+  bool ReadForce(ShmForceOutput* out) const {
+    const ShmSegment& s = mapping_.segment();
+    const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
+    return newest >= 0 && s.outputs[newest % kOutputSlots].Read(out) && out->period >= 0;
+  }
+  /**
+   * Every answer after period `after` that the ring still holds, oldest first, to `each`; returns
+   * the newest period seen (`after` when there is nothing new). Answers older than the ring
+   * (the caller was away longer than kOutputSlots periods) are skipped: their periods are
+   * missing from what `each` sees.
+   */
+  template <class Each>
+  std::int64_t ReadForcesSince(std::int64_t after, Each&& each) const {
+    const ShmSegment& s = mapping_.segment();
+    const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
+    for (std::int64_t p = std::max(after + 1, newest - kOutputSlots + 1); p <= newest; ++p) {
+      ShmForceOutput out;
+      // The slot may have been overwritten by a newer period meanwhile: then p is gone.
+      if (s.outputs[p % kOutputSlots].Read(&out) && out.period == p) each(out);
+    }
+    return std::max(after, newest);
+  }
   /** True while the daemon that created the segment runs. */
   bool DaemonRunning() { return mapping_.segment().header.daemon_pid.load() != 0; }
 

@@ -21,7 +21,7 @@
 namespace hapticsim::shm {
 
 inline constexpr char kMagic[8] = {'H', 'S', 'I', 'M', 'S', 'H', 'M', '1'};
-inline constexpr std::uint32_t kLayoutVersion = 1;
+inline constexpr std::uint32_t kLayoutVersion = 2;
 inline constexpr const char* kDefaultName = "/hapticsim";
 
 /** The tool tip, written by the driver every device period. Object frame, as in LCM. */
@@ -33,12 +33,16 @@ struct ShmDeviceInput {
 
 /** The force, written by the daemon every primary period. */
 struct ShmForceOutput {
+  std::int64_t period = -1;   ///< the daemon's primary period, counting every one from 0
   std::int64_t seq = -1;      ///< the input it answers (-1: none yet)
   std::int64_t utime = 0;     ///< daemon's CLOCK_MONOTONIC, µs
   double force_n[3] = {};     ///< force on the user, N
   double error_percent = -1;  ///< looked-up error, % (-1: no map)
   std::int32_t flags = 0;     ///< force_feedback_t::FLAG_* bits
 };
+
+/** Answers the ring keeps: 64 ms at 1 kHz. */
+inline constexpr int kOutputSlots = 64;
 
 struct ShmHeader {
   char magic[8];
@@ -54,7 +58,11 @@ struct ShmHeader {
 struct ShmSegment {
   ShmHeader header;
   alignas(64) SeqlockSlot<ShmDeviceInput> input;
-  alignas(64) SeqlockSlot<ShmForceOutput> output;
+  // The answers, in a ring: period p's answer goes to outputs[p % kOutputSlots], then p is
+  // published as newest_output. A driver descheduled for a few periods reads what it missed
+  // (up to kOutputSlots periods back) instead of losing it.
+  alignas(64) std::atomic<std::int64_t> newest_output{-1};
+  alignas(64) SeqlockSlot<ShmForceOutput> outputs[kOutputSlots];
 };
 
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&

@@ -125,6 +125,11 @@ TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {
   EXPECT_EQ(guard.sequence_gaps(), 1);
   // After a pause the same jump is a plausible move.
   EXPECT_EQ(guard.Check(6, {0.125, 0.145, 0.002}, 1000 * ms), InputRejection::kAccepted);
+  // A driver restarted after more than half a second of silence counts from 1 again: a new
+  // session, accepted; within the half second the old seq is still refused.
+  EXPECT_EQ(guard.Check(1, {0.125, 0.145, 0.002}, 1400 * ms), InputRejection::kOldSequence);
+  EXPECT_EQ(guard.Check(1, {0.2, 0.1, -0.01}, 1501 * ms), InputRejection::kAccepted);
+  EXPECT_EQ(guard.Check(2, {0.2, 0.1, -0.01}, 1502 * ms), InputRejection::kAccepted);
 }
 
 TEST(DeadlineMonitor, CountsMissesAndReportsExecutionPercentiles) {
