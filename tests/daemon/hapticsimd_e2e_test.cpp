@@ -20,6 +20,7 @@
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <thread>
@@ -497,6 +498,97 @@ TEST(HapticsimdSystemd, ReportsReadyPingsTheWatchdogWhileServingAndSaysWhenStopp
   EXPECT_EQ(daemon.Wait(5), 0);
   EXPECT_EQ(messages.back(), "STOPPING=1");
   close(fd);
+}
+
+}  // namespace
+}  // namespace hapticsim
+
+namespace hapticsim {
+namespace {
+
+// `hapticsim device` against a running daemon, over both transports, as a rig would use it; and
+// a recorded session replayed into it.
+TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSession) {
+  const std::string name = "/hapticsim-device-" + std::to_string(getpid());
+  const std::string config = Temp("device.toml");
+  std::ofstream(config) << "[shm]\nenabled = true\nname = \"" << name << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("device.log"));
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
+    ASSERT_TRUE(daemon.running()) << daemon.Log();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // Record the LCM session while the device presses over LCM.
+  const std::string log = Temp("session.lcmlog");
+  std::filesystem::remove(log);
+  testing::BackgroundProcess logger(
+      {LCM_LOGGER_PATH, "--lcm-url=udpm://239.255.76.67:7667?ttl=0", "--quiet", log},
+      Temp("logger.log"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto lcm =
+      testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--input", "press", "--duration", "2",
+                           "--json", "--max-unanswered", "400", "--max-force-step", "0.2"});
+  logger.Signal(SIGINT);
+  logger.Wait(5);
+  ASSERT_EQ(lcm.exit_status, 0) << lcm.out << lcm.err << daemon.Log();
+  const auto report = nlohmann::json::parse(lcm.out);
+  EXPECT_EQ(report["inputs_sent"], 2000);
+  EXPECT_EQ(report["nonfinite_forces"], 0);
+  EXPECT_EQ(report["force_out_of_contact"], 0);
+  EXPECT_GT(report["contact_answers"].get<int>(), 500) << lcm.out;  // the press is in for ~0.6 s
+  EXPECT_GT(report["latency_us"]["median"].get<double>(), 0);
+  EXPECT_GE(report["latency_us"]["max"].get<double>(), report["latency_us"]["p99"].get<double>());
+  EXPECT_EQ(report["daemon"]["regions"][0]["name"], "primary");
+  EXPECT_TRUE(report["limits_met"].get<bool>());
+
+  // Shared memory, a seeded random walk: every daemon answer reaches the device.
+  const auto shm = testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--transport", "shm",
+                                        "--shm-name", name, "--input", "walk", "--seed", "7",
+                                        "--duration", "3", "--json", "--max-lost", "0"});
+  EXPECT_EQ(shm.exit_status, 0) << shm.out << shm.err;
+  const auto walk = nlohmann::json::parse(shm.out);
+  EXPECT_EQ(walk["lost_answers"], 0);
+  EXPECT_EQ(walk["duplicated_answers"], 0);
+  EXPECT_GT(walk["contact_answers"].get<int>(), 100) << shm.out;
+
+  // An impossible limit: the exit status says so.
+  const auto strict =
+      testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--duration", "1", "--max-p99-us", "1"});
+  EXPECT_EQ(strict.exit_status, 4) << strict.out << strict.err;
+  EXPECT_NE(strict.out.find("EXCEEDED: --max-p99-us"), std::string::npos) << strict.out;
+
+  // The recorded session: summarised and exported (hapticsim log) ...
+  ASSERT_TRUE(std::filesystem::exists(log)) << logger.Log();
+  const std::string csv = Temp("session.csv");
+  const auto summary =
+      testing::RunCommand({HAPTICSIM_CLI_PATH, "log", log, "--json", "--csv", csv});
+  ASSERT_EQ(summary.exit_status, 0) << summary.err;
+  const auto recorded = nlohmann::json::parse(summary.out);
+  EXPECT_EQ(recorded["channels"]["HAPTIC_DEVICE"]["messages"], 2000) << summary.out;
+  EXPECT_NEAR(recorded["channels"]["HAPTIC_DEVICE"]["rate_hz"].get<double>(), 1000, 20);
+  EXPECT_GT(recorded["channels"]["HAPTIC_FORCE"]["messages"].get<int>(), 1900);
+  EXPECT_GT(recorded["forces"]["in_contact"].get<int>(), 500);
+  EXPECT_GT(recorded["forces"]["magnitude_N"]["max"].get<double>(), 1.0);  // a 1 cm press
+  std::ifstream rows(csv);
+  std::string header;
+  std::getline(rows, header);
+  EXPECT_EQ(header.rfind("time_s,channel,seq,period,x_m", 0), 0u) << header;
+  int lines = 0;
+  for (std::string line; std::getline(rows, line);) ++lines;
+  EXPECT_EQ(lines, recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>() +
+                       recorded["channels"]["HAPTIC_FORCE"]["messages"].get<int>());
+  // ... and replayed into the daemon: the same press, so the same contact.
+  const auto replay = testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--input", "replay",
+                                           "--replay", log, "--duration", "2", "--json"});
+  ASSERT_EQ(replay.exit_status, 0) << replay.out << replay.err;
+  EXPECT_GT(nlohmann::json::parse(replay.out)["contact_answers"].get<int>(), 500) << replay.out;
+
+  const auto missing = testing::RunCommand(
+      {HAPTICSIM_CLI_PATH, "device", "--input", "replay", "--replay", Temp("nothing.lcmlog")});
+  EXPECT_EQ(missing.exit_status, 2);
+  EXPECT_NE(missing.err.find("cannot open it as an LCM log"), std::string::npos) << missing.err;
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
 }  // namespace

@@ -9,8 +9,9 @@ namespace hapticsim::cli {
 enum ExitStatus : int {
   kExitOk = 0,
   kExitInternalError = 1,
-  kExitBadInput = 2,  ///< bad command line, scene file or value: the message names the key
-  kExitUnstable = 3,  ///< the run was refused as unstable or diverged
+  kExitBadInput = 2,        ///< bad command line, scene file or value: the message names the key
+  kExitUnstable = 3,        ///< the run was refused as unstable or diverged
+  kExitLimitsExceeded = 4,  ///< device / soak: a --max-* limit or a check failed
 };
 
 /** A registered subcommand: its CLI11 app and what to run when it was chosen. */
@@ -27,5 +28,9 @@ Command AddSweepCommand(CLI::App& parent);
 Command AddMapCommand(CLI::App& parent);
 Command AddLookupCommand(CLI::App& parent);
 Command AddAnalyzeCommand(CLI::App& parent);
+Command AddDeviceCommand(CLI::App& parent);
+Command AddLogCommand(CLI::App& parent);
+/** argc/argv: soak runs itself again inside a private network namespace. */
+Command AddSoakCommand(CLI::App& parent, int argc, char** argv);
 
 }  // namespace hapticsim::cli

@@ -8,9 +8,12 @@
 //   hapticsim map info|export|merge                              inspect and join map files
 //   hapticsim lookup MAP --set key=value                         the run-time error lookup
 //   hapticsim analyze MAP [--report report.html]                 Table I and the HTML report
+//   hapticsim device [--transport lcm|shm] [--input press|sine|walk|replay]   simulated device
+//   hapticsim soak [--duration 60] [--json]                      daemon + device, checked
+//   hapticsim log SESSION.lcmlog [--csv out.csv]                 a recorded session
 //
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
-// 1 anything else.
+// 4 a device or soak limit exceeded, 1 anything else.
 #include <iostream>
 #include <string>
 #include <vector>
@@ -31,7 +34,9 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands{AddSimulateCommand(app),  AddStaticCommand(app),
                                       AddStabilityCommand(app), AddSceneCommand(app),
                                       AddSweepCommand(app),     AddMapCommand(app),
-                                      AddLookupCommand(app),    AddAnalyzeCommand(app)};
+                                      AddLookupCommand(app),    AddAnalyzeCommand(app),
+                                      AddDeviceCommand(app),    AddSoakCommand(app, argc, argv),
+                                      AddLogCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

@@ -1,0 +1,107 @@
+#include "device/device_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <lcm/lcm-cpp.hpp>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "hapticsim/device_input_t.hpp"
+
+namespace hapticsim::device {
+namespace {
+
+std::vector<std::array<double, 3>> ReadReplay(const std::string& path, const std::string& channel) {
+  lcm::LogFile log(path, "r");
+  if (!log.good()) throw Error("--replay " + path + ": cannot open it as an LCM log");
+  std::vector<std::array<double, 3>> positions;
+  std::int64_t undecodable = 0;
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    if (event->channel != channel) continue;
+    device_input_t input;
+    if (input.decode(event->data, 0, event->datalen) < 0) {
+      ++undecodable;
+      continue;
+    }
+    positions.push_back({input.position[0], input.position[1], input.position[2]});
+  }
+  if (positions.empty()) {
+    throw Error("--replay " + path + ": no device_input_t on channel " + channel +
+                (undecodable ? " (" + std::to_string(undecodable) + " messages did not decode)"
+                             : std::string()));
+  }
+  return positions;
+}
+
+}  // namespace
+
+DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.seed) {
+  if (!(s.edge_m > 0)) throw Error("--edge must be positive, m");
+  if (!(s.amplitude_m >= 0 && s.amplitude_m < s.edge_m)) {
+    throw Error("--amplitude must be in [0, edge), m");
+  }
+  if (!(s.frequency_hz > 0)) throw Error("--frequency must be positive, Hz");
+  if (!(s.walk_speed_m_per_s > 0)) throw Error("--walk-speed must be positive, m/s");
+  for (double c : s.at_m) {
+    if (!(c >= 0 && c <= s.edge_m)) throw Error("--at must lie on the front face: 0 ≤ x, y ≤ edge");
+  }
+  if (s.kind == "replay") {
+    replay_ = ReadReplay(s.replay_path, s.replay_channel);
+  } else if (s.kind == "walk") {
+    to_ = {s.at_m[0], s.at_m[1], 0.0};  // the walk starts above --at
+    from_ = to_ = NewWaypoint(false);
+    inside_next_ = true;
+  } else if (s.kind != "press" && s.kind != "sine") {
+    throw Error("--input " + s.kind + ": use press, sine, walk or replay");
+  }
+}
+
+std::array<double, 3> DeviceMotion::NewWaypoint(bool inside) {
+  // A step of up to 3 cm across the face from the last waypoint, kept away from the edges so
+  // every touch lands on the front face.
+  std::uniform_real_distribution<double> step(-0.03, 0.03);
+  std::uniform_real_distribution<double> depth(0.2 * settings_.amplitude_m, settings_.amplitude_m);
+  std::uniform_real_distribution<double> height(0.001, 0.01);
+  const double lo = 0.1 * settings_.edge_m, hi = 0.9 * settings_.edge_m;
+  const double x = std::clamp(to_[0] + step(random_), lo, hi);
+  const double y = std::clamp(to_[1] + step(random_), lo, hi);
+  return {x, y, inside ? depth(random_) : -height(random_)};
+}
+
+std::array<double, 3> DeviceMotion::NextWalk() {
+  if (period_ - leg_start_ >= leg_periods_) {
+    from_ = to_;
+    to_ = NewWaypoint(inside_next_);
+    inside_next_ = !inside_next_;
+    const double distance = std::hypot(to_[0] - from_[0], to_[1] - from_[1], to_[2] - from_[2]);
+    // A smoothstep's top speed is 1.5 × its mean.
+    leg_periods_ = std::max<std::int64_t>(
+        1, std::llround(1.5 * distance / settings_.walk_speed_m_per_s * settings_.rate_hz));
+    leg_start_ = period_;
+  }
+  const double tau = static_cast<double>(period_ - leg_start_ + 1) / leg_periods_;
+  const double w = tau * tau * (3 - 2 * tau);
+  std::array<double, 3> tip{};
+  for (int c = 0; c < 3; ++c) tip[c] = from_[c] + w * (to_[c] - from_[c]);
+  return tip;
+}
+
+std::array<double, 3> DeviceMotion::Next() {
+  const double t = static_cast<double>(period_) / settings_.rate_hz;
+  const double phase = 2 * std::numbers::pi * settings_.frequency_hz * t;
+  std::array<double, 3> tip{settings_.at_m[0], settings_.at_m[1], 0.0};
+  if (settings_.kind == "press") {
+    tip[2] = -settings_.hover_m +
+             (settings_.amplitude_m + settings_.hover_m) * 0.5 * (1 - std::cos(phase));
+  } else if (settings_.kind == "sine") {
+    tip[2] = settings_.amplitude_m * std::sin(phase);
+  } else if (settings_.kind == "walk") {
+    tip = NextWalk();
+  } else {
+    tip = replay_[std::min<std::size_t>(static_cast<std::size_t>(period_), replay_.size() - 1)];
+  }
+  ++period_;
+  return tip;
+}
+
+}  // namespace hapticsim::device

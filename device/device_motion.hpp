@@ -1,0 +1,61 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace hapticsim::device {
+
+/** What the simulated device does with its tool tip (object frame, m; see device_input_t). */
+struct MotionSettings {
+  std::string kind = "press";                ///< press | sine | walk | replay
+  double edge_m = 0.25;                      ///< the daemon's cube edge
+  double amplitude_m = 0.01;                 ///< press depth / sine amplitude / deepest walk press
+  double frequency_hz = 1.0;                 ///< press and sine
+  std::array<double, 2> at_m{0.125, 0.125};  ///< press and sine: the point on the front face
+  double hover_m = 0.002;                    ///< press: how far above the surface it starts
+  double walk_speed_m_per_s = 0.05;          ///< walk: top speed between waypoints
+  unsigned seed = 1;                         ///< walk
+  std::string replay_path;                   ///< replay: an LCM log of device_input_t
+  std::string replay_channel = "HAPTIC_DEVICE";
+  double rate_hz = 1000;  ///< device periods per second
+};
+
+/**
+ * The tool tip, period by period, reproducibly:
+ * - press: from `hover_m` above the front face at `at_m` to `amplitude_m` deep and back,
+ *   (1 − cos 2πft)/2 — the paper's press;
+ * - sine: amplitude·sin 2πft around the surface at `at_m`, touching down and lifting off every
+ *   period;
+ * - walk: a seeded random walk over the front face from above `at_m` — waypoints up to 3 cm
+ *   apart, alternately above the surface and pressed into it (up to `amplitude_m`), joined at up to
+ *   `walk_speed_m_per_s` with smooth starts and stops, so it touches down and lifts off at a
+ *   different surface point each time;
+ * - replay: the positions of a recorded LCM log's device inputs, in order, then the last held.
+ */
+class DeviceMotion {
+ public:
+  /** @throws Error for bad settings or an unreadable replay log (the message says which). */
+  explicit DeviceMotion(const MotionSettings& settings);
+
+  /** The tip for the next period. */
+  std::array<double, 3> Next();
+  /** Periods a replay holds (0 for the generated motions, which go on forever). */
+  std::int64_t replay_periods() const { return static_cast<std::int64_t>(replay_.size()); }
+
+ private:
+  std::array<double, 3> NextWalk();
+  std::array<double, 3> NewWaypoint(bool inside);
+
+  MotionSettings settings_;
+  std::int64_t period_ = 0;
+  std::mt19937_64 random_;
+  std::array<double, 3> from_{}, to_{};
+  std::int64_t leg_start_ = 0, leg_periods_ = 1;
+  bool inside_next_ = true;
+  std::vector<std::array<double, 3>> replay_;
+};
+
+}  // namespace hapticsim::device

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "device/device_link.hpp"
+#include "device/device_motion.hpp"
+
+namespace hapticsim::device {
+
+struct SessionSettings {
+  double duration_s = 10;
+  double rate_hz = 1000;
+  /// Bursts of bad input (NaN, far outside, a jump no hand makes, an old seq, and on LCM a
+  /// message that is no device input) starting at these times, s; each lasts 8 periods.
+  std::vector<double> bad_input_bursts_s;
+};
+
+/** Round-trip latency percentiles, µs (input sent → the first force answering it received). */
+struct LatencySummary {
+  std::int64_t count = 0;
+  double median_us = 0, p99_us = 0, p999_us = 0, max_us = 0;
+};
+
+/** One second of the run, for plots. */
+struct SecondSummary {
+  double t_s = 0;
+  LatencySummary latency;
+  std::int64_t answers = 0;
+};
+
+/** What a stream of answers (one link) looked like. */
+struct StreamSummary {
+  std::int64_t answers = 0;             ///< distinct daemon periods seen
+  std::int64_t lost_answers = 0;        ///< daemon periods between seen ones that never arrived
+  std::int64_t duplicated_answers = 0;  ///< a daemon period seen again, or out of order
+};
+
+struct SessionReport {
+  std::int64_t inputs_sent = 0;  ///< good inputs (bad ones are counted apart)
+  std::int64_t bad_inputs_sent = 0;
+  std::int64_t unanswered_inputs = 0;    ///< good inputs no force ever answered
+  std::int64_t late_answers = 0;         ///< first answer more than one period after sending
+  StreamSummary stream;                  ///< on the device's own link
+  std::optional<StreamSummary> monitor;  ///< on the listening LCM link, when there is one
+  LatencySummary latency;
+  std::int64_t nonfinite_forces = 0;
+  std::int64_t force_out_of_contact = 0;  ///< a non-zero force without the in-contact flag
+  double largest_force_step_n = 0;        ///< between consecutive answers in contact, fresh input
+  std::int64_t contact_answers = 0;
+  std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
+  std::int64_t answers_after_last_burst = 0;
+  std::optional<status_t> status;  ///< the daemon's last status (LCM)
+  std::vector<SecondSummary> seconds;
+  double duration_s = 0;
+};
+
+/** Percentiles of `values_us` (sorted in place). */
+LatencySummary Summarise(std::vector<double>& values_us);
+
+/**
+ * The simulated device's loop: one input per period on absolute CLOCK_MONOTONIC releases,
+ * answers collected from `link` (and, when given, counted on `monitor`, a listening LCM link),
+ * everything measured. `each_second` is called once a second with the report so far (progress).
+ */
+SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* monitor,
+                         const SessionSettings& settings,
+                         const std::function<void(const SessionReport&)>& each_second = {});
+
+}  // namespace hapticsim::device

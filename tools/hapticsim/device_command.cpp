@@ -1,0 +1,152 @@
+// hapticsim device: a simulated haptic device that drives a running hapticsimd at 1 kHz and
+// measures what comes back.
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "core/error.hpp"
+#include "device/device_link.hpp"
+#include "device/device_session.hpp"
+#include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/device_report.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+struct DeviceOptions {
+  std::string transport = "lcm";
+  std::string lcm_url = device::kHostLocalLcmUrl;
+  std::string shm_name = "/hapticsim";
+  std::string device_channel = "HAPTIC_DEVICE", force_channel = "HAPTIC_FORCE",
+              status_channel = "HAPTIC_STATUS";
+  device::MotionSettings motion;
+  std::vector<double> at;
+  double duration_s = 10;
+  std::vector<double> bad_input_at_s;
+  bool json = false;
+  DeviceLimits limits;
+};
+
+int Run(DeviceOptions o) {
+  if (!o.at.empty()) {
+    HAPTICSIM_THROW_UNLESS(o.at.size() == 2, "--at takes two numbers: X,Y on the front face, m");
+    o.motion.at_m = {o.at[0], o.at[1]};
+  } else {
+    o.motion.at_m = {o.motion.edge_m / 2, o.motion.edge_m / 2};
+  }
+  HAPTICSIM_THROW_UNLESS(o.duration_s > 0, "--duration must be positive, s");
+  device::DeviceMotion motion(o.motion);
+  if (o.motion.kind == "replay" && o.duration_s <= 0) o.duration_s = motion.replay_periods() / 1e3;
+  std::unique_ptr<device::DeviceLink> link;
+  if (o.transport == "lcm") {
+    link = device::MakeLcmLink(o.lcm_url, o.device_channel, o.force_channel, o.status_channel);
+  } else if (o.transport == "shm") {
+    link = device::MakeShmLink(o.shm_name);
+  } else {
+    throw Error("--transport " + o.transport + ": use lcm or shm");
+  }
+  device::SessionSettings settings;
+  settings.duration_s = o.duration_s;
+  settings.bad_input_bursts_s = o.bad_input_at_s;
+  const bool terminal = isatty(STDERR_FILENO);
+  const device::SessionReport report =
+      device::RunSession(motion, *link, nullptr, settings, [&](const device::SessionReport& r) {
+        if (!terminal) return;
+        const device::SecondSummary& s = r.seconds.back();
+        std::fprintf(
+            stderr,
+            "\rdevice %s: %3.0f / %.0f s, %lld sent, %lld answers, %lld lost; "
+            "last second p99 %.0f µs, max %.0f µs   ",
+            link->name().c_str(), s.t_s, o.duration_s, static_cast<long long>(r.inputs_sent),
+            static_cast<long long>(r.stream.answers), static_cast<long long>(r.stream.lost_answers),
+            s.latency.p99_us, s.latency.max_us);
+      });
+  if (terminal) std::fprintf(stderr, "\n");
+  const std::vector<std::string> exceeded = ExceededLimits(report, o.limits);
+  if (o.json) {
+    nlohmann::json out = ReportJson(report);
+    out["transport"] = o.transport;
+    out["input"] = o.motion.kind;
+    out["limits_met"] = exceeded.empty();
+    out["limits_exceeded"] = exceeded;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::cout << "Simulated device over " << o.transport << ", " << o.motion.kind << " input, "
+              << o.duration_s << " s at 1 kHz:\n"
+              << ReportText(report);
+    if (exceeded.empty()) {
+      std::cout << "  limits                     met\n";
+    } else {
+      std::cout << "  limits                     EXCEEDED:";
+      for (const std::string& name : exceeded) std::cout << " " << name;
+      std::cout << "\n";
+    }
+  }
+  if (report.stream.answers == 0) {
+    std::cerr << "hapticsim device: no answer from hapticsimd over " << o.transport
+              << (o.transport == "lcm" ? " on " + o.lcm_url : " in /dev/shm" + o.shm_name)
+              << ": is it running, with that interface enabled?\n";
+    return kExitLimitsExceeded;
+  }
+  return exceeded.empty() ? kExitOk : kExitLimitsExceeded;
+}
+
+}  // namespace
+
+Command AddDeviceCommand(CLI::App& parent) {
+  auto options = std::make_shared<DeviceOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "device",
+      "Simulated haptic device: drive a running hapticsimd at 1 kHz over LCM or shared memory "
+      "with reproducible input, and measure round-trip latency, missing and late answers, force "
+      "sanity and the daemon's deadline statistics. Exit status 4 when a --max-* limit is "
+      "exceeded (or nothing answered).");
+  app->add_option("--transport", options->transport, "lcm or shm")->capture_default_str();
+  app->add_option("--lcm-url", options->lcm_url, "LCM URL (the default stays on this host: ttl=0)")
+      ->capture_default_str();
+  app->add_option("--shm-name", options->shm_name, "Shared-memory segment")->capture_default_str();
+  app->add_option("--device-channel", options->device_channel)->capture_default_str();
+  app->add_option("--force-channel", options->force_channel)->capture_default_str();
+  app->add_option("--status-channel", options->status_channel)->capture_default_str();
+  app->add_option("--input", options->motion.kind,
+                  "press (the paper's), sine, walk (seeded random walk with touch-downs at "
+                  "different points) or replay (an LCM log)")
+      ->capture_default_str();
+  app->add_option("--amplitude", options->motion.amplitude_m,
+                  "Press depth, sine amplitude, deepest walk press, m")
+      ->capture_default_str();
+  app->add_option("--frequency", options->motion.frequency_hz, "Press and sine frequency, Hz")
+      ->capture_default_str();
+  app->add_option("--at", options->at,
+                  "Press and sine point on the front face: X,Y in m "
+                  "(default: its middle)")
+      ->delimiter(',')
+      ->expected(2);
+  app->add_option("--edge", options->motion.edge_m, "The daemon's cube edge, m")
+      ->capture_default_str();
+  app->add_option("--seed", options->motion.seed, "Random walk seed")->capture_default_str();
+  app->add_option("--walk-speed", options->motion.walk_speed_m_per_s, "Random walk top speed, m/s")
+      ->capture_default_str();
+  app->add_option("--replay", options->motion.replay_path,
+                  "LCM log (lcm-logger) whose device inputs to replay (with --input replay)");
+  app->add_option("--replay-channel", options->motion.replay_channel)->capture_default_str();
+  app->add_option("--duration", options->duration_s, "Seconds to run")->capture_default_str();
+  app->add_option("--bad-input-at", options->bad_input_at_s,
+                  "Inject a burst of bad input at these times, s (NaN, far outside, a jump, an "
+                  "old seq; on LCM also a message of no type)")
+      ->delimiter(',');
+  app->add_flag("--json", options->json, "Print the summary as JSON");
+  app->add_option("--max-p99-us", options->limits.p99_us, "Limit: p99 round trip, µs");
+  app->add_option("--max-latency-us", options->limits.max_latency_us,
+                  "Limit: worst round trip, µs");
+  app->add_option("--max-unanswered", options->limits.unanswered, "Limit: inputs never answered");
+  app->add_option("--max-late-percent", options->limits.late_percent,
+                  "Limit: answers later than one period, % of inputs");
+  app->add_option("--max-lost", options->limits.lost, "Limit: daemon answers never received");
+  app->add_option("--max-force-step", options->limits.force_step_n,
+                  "Limit: largest force change between periods in contact, N");
+  return {app, [options] { return Run(*options); }};
+}
+
+}  // namespace hapticsim::cli

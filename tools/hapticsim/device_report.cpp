@@ -1,0 +1,156 @@
+#include "tools/hapticsim/device_report.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include "hapticsim/force_feedback_t.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+constexpr std::pair<std::int32_t, const char*> kFlagNames[] = {
+    {force_feedback_t::FLAG_IN_CONTACT, "in contact"},
+    {force_feedback_t::FLAG_ERROR_TARGET_EXCEEDED, "error target exceeded"},
+    {force_feedback_t::FLAG_LOOKUP_CLAMPED, "lookup clamped"},
+    {force_feedback_t::FLAG_INPUT_STALE, "input stale"},
+    {force_feedback_t::FLAG_RECONFIGURING, "reconfiguring"},
+    {force_feedback_t::FLAG_NO_ERROR_MAP, "no error map"},
+    {force_feedback_t::FLAG_INPUT_REJECTED, "input rejected"},
+};
+
+nlohmann::json LatencyJson(const device::LatencySummary& l) {
+  return {{"count", l.count},
+          {"median", l.median_us},
+          {"p99", l.p99_us},
+          {"p999", l.p999_us},
+          {"max", l.max_us}};
+}
+
+nlohmann::json StreamJson(const device::StreamSummary& s) {
+  return {{"answers", s.answers},
+          {"lost_answers", s.lost_answers},
+          {"duplicated_answers", s.duplicated_answers}};
+}
+
+}  // namespace
+
+std::string FlagNames(std::int32_t flags) {
+  std::string names;
+  for (const auto& [bit, name] : kFlagNames) {
+    if (flags & bit) names += (names.empty() ? "" : ", ") + std::string(name);
+  }
+  return names.empty() ? "none" : names;
+}
+
+std::vector<std::string> ExceededLimits(const device::SessionReport& r, const DeviceLimits& l) {
+  std::vector<std::string> exceeded;
+  auto check = [&](double limit, double value, const char* name) {
+    if (limit >= 0 && value > limit) exceeded.push_back(name);
+  };
+  check(l.p99_us, r.latency.p99_us, "--max-p99-us");
+  check(l.max_latency_us, r.latency.max_us, "--max-latency-us");
+  check(l.unanswered, static_cast<double>(r.unanswered_inputs), "--max-unanswered");
+  check(l.late_percent,
+        r.inputs_sent > 0 ? 100.0 * static_cast<double>(r.late_answers) / r.inputs_sent : 0.0,
+        "--max-late-percent");
+  check(l.lost, static_cast<double>(r.stream.lost_answers), "--max-lost");
+  check(l.force_step_n, r.largest_force_step_n, "--max-force-step");
+  if (r.nonfinite_forces > 0) exceeded.push_back("non-finite forces (never allowed)");
+  return exceeded;
+}
+
+nlohmann::json ReportJson(const device::SessionReport& r) {
+  nlohmann::json out = {{"duration_s", r.duration_s},
+                        {"inputs_sent", r.inputs_sent},
+                        {"bad_inputs_sent", r.bad_inputs_sent},
+                        {"unanswered_inputs", r.unanswered_inputs},
+                        {"late_answers", r.late_answers},
+                        {"answers", r.stream.answers},
+                        {"lost_answers", r.stream.lost_answers},
+                        {"duplicated_answers", r.stream.duplicated_answers},
+                        {"latency_us", LatencyJson(r.latency)},
+                        {"nonfinite_forces", r.nonfinite_forces},
+                        {"force_out_of_contact", r.force_out_of_contact},
+                        {"largest_force_step_N", r.largest_force_step_n},
+                        {"contact_answers", r.contact_answers},
+                        {"flags_seen", FlagNames(r.flags_seen)},
+                        {"answers_after_last_bad_input", r.answers_after_last_burst}};
+  if (r.monitor) out["lcm_monitor"] = StreamJson(*r.monitor);
+  if (r.status) {
+    nlohmann::json regions = nlohmann::json::array();
+    for (const region_status_t& region : r.status->regions) {
+      regions.push_back({{"name", region.name},
+                         {"rate_hz", region.rate_hz},
+                         {"cycles", region.cycles},
+                         {"deadline_misses", region.deadline_misses},
+                         {"worst_lateness_us", region.worst_lateness_us},
+                         {"execution_p99_us", region.execution_p99_us}});
+    }
+    out["daemon"] = {
+        {"primary_size", r.status->primary_size},
+        {"secondary_lod", r.status->secondary_lod},
+        {"secondary_rate_hz", r.status->secondary_rate_hz},
+        {"error_percent", r.status->error_percent},
+        {"error_target_percent", r.status->error_target_percent},
+        {"target_met", r.status->target_met},
+        {"inputs_rejected", r.status->inputs_rejected},
+        {"decode_errors", r.status->decode_errors},
+        {"reconfigurations", r.status->reconfigurations},
+        {"contact_node",
+         {r.status->contact_node[0], r.status->contact_node[1], r.status->contact_node[2]}},
+        {"regions", regions}};
+  }
+  nlohmann::json seconds = nlohmann::json::array();
+  for (const device::SecondSummary& s : r.seconds) {
+    seconds.push_back({{"t_s", s.t_s},
+                       {"answers", s.answers},
+                       {"latency_median_us", s.latency.median_us},
+                       {"latency_p99_us", s.latency.p99_us},
+                       {"latency_max_us", s.latency.max_us}});
+  }
+  out["seconds"] = seconds;
+  return out;
+}
+
+std::string ReportText(const device::SessionReport& r) {
+  std::ostringstream text;
+  char line[256];
+  auto add = [&](const char* format, auto... values) {
+    std::snprintf(line, sizeof line, format, values...);
+    text << line << "\n";
+  };
+  add("  inputs sent                %lld (+ %lld bad, injected)",
+      static_cast<long long>(r.inputs_sent), static_cast<long long>(r.bad_inputs_sent));
+  add("  unanswered inputs          %lld", static_cast<long long>(r.unanswered_inputs));
+  add("  late answers (> 1 period)  %lld", static_cast<long long>(r.late_answers));
+  add("  answers                    %lld (lost %lld, duplicated %lld)",
+      static_cast<long long>(r.stream.answers), static_cast<long long>(r.stream.lost_answers),
+      static_cast<long long>(r.stream.duplicated_answers));
+  if (r.monitor) {
+    add("  answers on LCM (monitor)   %lld (lost %lld, duplicated %lld)",
+        static_cast<long long>(r.monitor->answers), static_cast<long long>(r.monitor->lost_answers),
+        static_cast<long long>(r.monitor->duplicated_answers));
+  }
+  add("  round trip                 median %.0f µs, p99 %.0f µs, p99.9 %.0f µs, max %.0f µs",
+      r.latency.median_us, r.latency.p99_us, r.latency.p999_us, r.latency.max_us);
+  add("  forces                     %lld non-finite, %lld non-zero out of contact, largest step "
+      "%.4f N between periods in contact",
+      static_cast<long long>(r.nonfinite_forces), static_cast<long long>(r.force_out_of_contact),
+      r.largest_force_step_n);
+  add("  in contact                 %lld answers", static_cast<long long>(r.contact_answers));
+  text << "  flags seen                 " << FlagNames(r.flags_seen) << "\n";
+  if (r.status) {
+    add("  daemon                     primary_size %d, secondary_lod %d, %.0f Hz; error %.2f %% "
+        "(target %.1f %%)",
+        r.status->primary_size, r.status->secondary_lod, r.status->secondary_rate_hz,
+        r.status->error_percent, r.status->error_target_percent);
+    for (const region_status_t& region : r.status->regions) {
+      add("  daemon %-19s %lld deadline misses in %lld periods, worst lateness %.0f µs",
+          (region.name + " thread").c_str(), static_cast<long long>(region.deadline_misses),
+          static_cast<long long>(region.cycles), region.worst_lateness_us);
+    }
+  }
+  return text.str();
+}
+
+}  // namespace hapticsim::cli

@@ -1,0 +1,391 @@
+// hapticsim soak: hapticsimd and the simulated device together for a long run, in a private
+// network namespace, with the checks its users care about.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "core/error.hpp"
+#include "device/device_link.hpp"
+#include "device/device_session.hpp"
+#include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/device_report.hpp"
+#include "tools/hapticsim/line_chart.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kInNetnsVariable = "HAPTICSIM_SOAK_IN_PRIVATE_NETNS";
+
+struct SoakOptions {
+  double duration_s = 60;
+  double warm_up_s = -1;  // default: a tenth of the run, at least 5 s
+  std::string daemon;
+  std::string error_map;
+  std::string report_dir = "soak-report";
+  std::string input = "walk";
+  unsigned seed = 1;
+  double max_lcm_loss_percent = 1.0;
+  double max_rss_growth_kib = 2048;
+  bool json = false;
+};
+
+struct ResourceSample {
+  double t_s = 0;
+  double rss_kib = 0;
+  double cpu_percent = 0;
+};
+
+fs::path SelfPath() { return fs::read_symlink("/proc/self/exe"); }
+
+std::string DefaultDaemon() {
+  const fs::path here = SelfPath().parent_path();
+  for (const fs::path& candidate : {here / "hapticsimd", here / ".." / "daemon" / "hapticsimd"}) {
+    if (fs::exists(candidate)) return fs::canonical(candidate).string();
+  }
+  throw Error("hapticsimd not found next to " + SelfPath().string() + ": give it with --daemon");
+}
+
+// The soak's own LCM must never reach a real network: run again inside a user + network
+// namespace of our own (loopback only, a multicast route on it), as the tests do.
+[[noreturn]] void ReexecInPrivateNetns(int argc, char** argv) {
+  setenv(kInNetnsVariable, "1", 1);
+  std::vector<std::string> args{"unshare",
+                                "--user",
+                                "--map-root-user",
+                                "--net",
+                                "sh",
+                                "-c",
+                                "ip link set lo up && ip route add 224.0.0.0/4 dev lo && "
+                                "exec \"$@\"",
+                                "sh",
+                                SelfPath().string()};
+  for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
+  std::vector<char*> raw;
+  for (std::string& a : args) raw.push_back(a.data());
+  raw.push_back(nullptr);
+  execvp("unshare", raw.data());
+  throw Error(std::string("cannot start a private network namespace (unshare: ") +
+              std::strerror(errno) + "); user namespaces must be allowed");
+}
+
+bool ReadProc(pid_t pid, double* rss_kib, double* cpu_ticks) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string key;
+  *rss_kib = 0;
+  while (status >> key) {
+    if (key == "VmRSS:") {
+      status >> *rss_kib;
+      break;
+    }
+    status.ignore(1 << 12, '\n');
+  }
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  // Fields after the command name (which may hold spaces): state is field 3; utime 14, stime 15.
+  std::istringstream rest(line.substr(line.rfind(')') + 2));
+  std::string field;
+  double utime = 0, stime = 0;
+  for (int f = 3; f <= 15 && rest >> field; ++f) {
+    if (f == 14) utime = std::stod(field);
+    if (f == 15) stime = std::stod(field);
+  }
+  *cpu_ticks = utime + stime;
+  return *rss_kib > 0;
+}
+
+std::string TailOf(const std::string& path, std::size_t lines) {
+  std::ifstream in(path);
+  std::vector<std::string> all;
+  for (std::string line; std::getline(in, line);) all.push_back(line);
+  std::string out;
+  for (std::size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i) {
+    out += "  " + all[i] + "\n";
+  }
+  return out;
+}
+
+void WriteHtml(const fs::path& path, const nlohmann::json& summary,
+               const device::SessionReport& report, const std::vector<ResourceSample>& resources) {
+  std::vector<double> t, median, p99, max;
+  for (const device::SecondSummary& s : report.seconds) {
+    t.push_back(s.t_s);
+    median.push_back(s.latency.median_us);
+    p99.push_back(s.latency.p99_us);
+    max.push_back(s.latency.max_us);
+  }
+  std::vector<double> rt, rss, cpu;
+  for (const ResourceSample& r : resources) {
+    rt.push_back(r.t_s);
+    rss.push_back(r.rss_kib / 1024);
+    cpu.push_back(r.cpu_percent);
+  }
+  std::ofstream out(path);
+  out << "<!doctype html><html><head><meta charset='utf-8'><title>hapticsim soak</title>"
+      << "<style>body{font-family:sans-serif;max-width:800px;margin:2em auto}"
+      << "pre{background:#f6f6f6;padding:1em;overflow:auto}</style></head><body>"
+      << "<h1>hapticsimd soak: " << (summary["passed"].get<bool>() ? "passed" : "FAILED") << "</h1>"
+      << LineChartSvg("Round trip, input sent to force received, per second", "time (s)", "µs", t,
+                      {{"median", median}, {"p99", p99}, {"max", max}})
+      << LineChartSvg("hapticsimd resident memory", "time (s)", "MiB", rt, {{"RSS", rss}})
+      << LineChartSvg("hapticsimd CPU", "time (s)", "% of one core", rt, {{"CPU", cpu}})
+      << "<h2>Summary</h2><pre>" << summary.dump(2) << "</pre></body></html>\n";
+}
+
+int RunSoak(const SoakOptions& o) {
+  HAPTICSIM_THROW_UNLESS(o.duration_s >= 5, "--duration must be at least 5 s");
+  const double warm_up = o.warm_up_s >= 0 ? o.warm_up_s : std::max(5.0, o.duration_s / 10);
+  HAPTICSIM_THROW_UNLESS(warm_up < o.duration_s, "--warm-up must be shorter than --duration");
+  const std::string daemon = o.daemon.empty() ? DefaultDaemon() : o.daemon;
+  const fs::path dir = fs::absolute(o.report_dir);
+  fs::create_directories(dir);
+  const std::string shm_name = "/hapticsim_soak_" + std::to_string(getpid());
+  const fs::path config = dir / "hapticsimd.toml", log = dir / "hapticsimd.log";
+  {
+    std::ofstream c(config);
+    c << "# written by hapticsim soak\n[shm]\nenabled = true\nname = \"" << shm_name << "\"\n";
+    if (!o.error_map.empty()) {
+      c << "[supervisor]\nerror_map = \"" << fs::absolute(o.error_map).string() << "\"\n";
+    }
+  }
+  std::cerr << "hapticsim soak: " << daemon << " for " << o.duration_s
+            << " s in a private network namespace; report in " << dir.string() << "/\n";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    dup2(fd, 1), dup2(fd, 2);
+    execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), nullptr);
+    _exit(127);
+  }
+  auto stop_daemon = [&](int* status) {
+    kill(pid, SIGTERM);
+    for (int i = 0; i < 100; ++i) {
+      if (waitpid(pid, status, WNOHANG) == pid) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, status, 0);
+    return false;
+  };
+  std::unique_ptr<device::DeviceLink> link;
+  for (int i = 0; i < 300 && !link; ++i) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      throw Error("hapticsimd exited before serving; its log:\n" + TailOf(log, 20));
+    }
+    try {
+      link = device::MakeShmLink(shm_name);
+    } catch (const Error&) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  if (!link) {
+    int status = 0;
+    stop_daemon(&status);
+    throw Error("hapticsimd did not open " + shm_name + " within 30 s; its log:\n" +
+                TailOf(log, 20));
+  }
+  auto monitor = device::MakeLcmLink(device::kHostLocalLcmUrl, "HAPTIC_DEVICE", "HAPTIC_FORCE",
+                                     "HAPTIC_STATUS");
+
+  std::vector<ResourceSample> resources;
+  std::mutex resources_mutex;
+  std::atomic<bool> sampling{true};
+  const auto start = std::chrono::steady_clock::now();
+  std::thread sampler([&] {
+    const double ticks_per_s = static_cast<double>(sysconf(_SC_CLK_TCK));
+    double last_ticks = -1;
+    auto last_time = start;
+    while (sampling) {
+      double rss = 0, ticks = 0;
+      const auto now = std::chrono::steady_clock::now();
+      if (ReadProc(pid, &rss, &ticks)) {
+        const double dt = std::chrono::duration<double>(now - last_time).count();
+        ResourceSample s{
+            std::chrono::duration<double>(now - start).count(), rss,
+            last_ticks >= 0 && dt > 0 ? 100 * (ticks - last_ticks) / ticks_per_s / dt : 0};
+        last_ticks = ticks, last_time = now;
+        std::lock_guard lock(resources_mutex);
+        resources.push_back(s);
+      }
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+  });
+
+  device::MotionSettings motion_settings;
+  motion_settings.kind = o.input;
+  motion_settings.seed = o.seed;
+  device::DeviceMotion motion(motion_settings);
+  device::SessionSettings settings;
+  settings.duration_s = o.duration_s;
+  // Bad input twice: a third and two thirds of the way.
+  settings.bad_input_bursts_s = {o.duration_s / 3, 2 * o.duration_s / 3};
+  const bool terminal = isatty(STDERR_FILENO);
+  const device::SessionReport report = device::RunSession(
+      motion, *link, monitor.get(), settings, [&](const device::SessionReport& r) {
+        const device::SecondSummary& s = r.seconds.back();
+        const bool plain = !terminal && static_cast<long>(s.t_s) % 10 == 0;
+        if (!terminal && !plain) return;
+        std::fprintf(
+            stderr, "%ssoak: %4.0f / %.0f s, %lld answers, %lld lost on shm; p99 %.0f µs%s",
+            terminal ? "\r" : "", s.t_s, o.duration_s, static_cast<long long>(r.stream.answers),
+            static_cast<long long>(r.stream.lost_answers), s.latency.p99_us,
+            terminal ? "   " : "\n");
+      });
+  if (terminal) std::fprintf(stderr, "\n");
+  sampling = false;
+  sampler.join();
+  int status = 0;
+  const bool stopped_in_time = stop_daemon(&status);
+  const bool clean_exit = stopped_in_time && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+
+  // Memory after the warm-up against the end.
+  double rss_warm = 0, rss_end = 0, rss_max = 0, cpu_sum = 0;
+  for (const ResourceSample& s : resources) {
+    if (s.t_s <= warm_up || rss_warm == 0) rss_warm = s.rss_kib;
+    rss_end = s.rss_kib;
+    rss_max = std::max(rss_max, s.rss_kib);
+    cpu_sum += s.cpu_percent;
+  }
+  const double rss_growth = rss_end - rss_warm;
+  const device::StreamSummary lcm = report.monitor.value_or(device::StreamSummary{});
+  const double lcm_loss_percent =
+      lcm.answers + lcm.lost_answers > 0
+          ? 100.0 * static_cast<double>(lcm.lost_answers) / (lcm.answers + lcm.lost_answers)
+          : 100.0;
+  nlohmann::json misses = nlohmann::json::object();
+  if (report.status) {
+    for (const region_status_t& r : report.status->regions) {
+      misses[r.name] = {{"deadline_misses", r.deadline_misses},
+                        {"periods", r.cycles},
+                        {"miss_percent", r.cycles ? 100.0 * r.deadline_misses / r.cycles : 0.0},
+                        {"worst_lateness_us", r.worst_lateness_us}};
+    }
+  }
+  const nlohmann::json checks = {
+      {"no_nonfinite_force", report.nonfinite_forces == 0},
+      {"no_lost_answers_shm", report.stream.lost_answers == 0},
+      {"no_duplicated_answers_shm", report.stream.duplicated_answers == 0},
+      {"lcm_loss_within_budget", lcm_loss_percent <= o.max_lcm_loss_percent},
+      {"memory_flat_after_warm_up", rss_growth <= o.max_rss_growth_kib},
+      {"answering_after_bad_input", report.answers_after_last_burst > 0},
+      {"no_force_out_of_contact", report.force_out_of_contact == 0},
+      {"daemon_stopped_cleanly", clean_exit}};
+  bool passed = true;
+  for (const auto& [name, ok] : checks.items()) passed = passed && ok.get<bool>();
+  nlohmann::json summary = {
+      {"passed", passed},
+      {"checks", checks},
+      {"duration_s", o.duration_s},
+      {"warm_up_s", warm_up},
+      {"input", o.input},
+      {"nonfinite_forces", report.nonfinite_forces},
+      {"lost_answers_shm", report.stream.lost_answers},
+      {"duplicated_answers_shm", report.stream.duplicated_answers},
+      {"answers_shm", report.stream.answers},
+      {"lost_answers_lcm", lcm.lost_answers},
+      {"answers_lcm", lcm.answers},
+      {"lcm_loss_percent", lcm_loss_percent},
+      {"max_lcm_loss_percent", o.max_lcm_loss_percent},
+      {"latency_us",
+       {{"median", report.latency.median_us},
+        {"p99", report.latency.p99_us},
+        {"p999", report.latency.p999_us},
+        {"max", report.latency.max_us}}},
+      {"unanswered_inputs", report.unanswered_inputs},
+      {"bad_inputs_sent", report.bad_inputs_sent},
+      {"rss_growth_kib", rss_growth},
+      {"max_rss_growth_kib", o.max_rss_growth_kib},
+      {"rss_kib", {{"after_warm_up", rss_warm}, {"end", rss_end}, {"max", rss_max}}},
+      {"cpu_percent_mean", resources.empty() ? 0.0 : cpu_sum / resources.size()},
+      {"deadline_misses", misses},
+      {"largest_force_step_N", report.largest_force_step_n},
+      {"daemon_exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
+      {"report",
+       {{"json", (dir / "soak.json").string()},
+        {"html", (dir / "soak.html").string()},
+        {"daemon_log", log.string()}}}};
+  nlohmann::json full = summary;
+  full["device"] = ReportJson(report);
+  nlohmann::json samples = nlohmann::json::array();
+  for (const ResourceSample& s : resources) {
+    samples.push_back({{"t_s", s.t_s}, {"rss_kib", s.rss_kib}, {"cpu_percent", s.cpu_percent}});
+  }
+  full["resources"] = samples;
+  std::ofstream(dir / "soak.json") << full.dump(2) << "\n";
+  WriteHtml(dir / "soak.html", summary, report, resources);
+  if (o.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    std::cout << "hapticsimd soak, " << o.duration_s << " s (" << o.input << " input over shared "
+              << "memory, forces also watched on LCM): " << (passed ? "passed" : "FAILED") << "\n"
+              << ReportText(report);
+    std::printf("  LCM answers lost           %lld of %lld (%.3f %%, budget %.3g %%)\n",
+                static_cast<long long>(lcm.lost_answers),
+                static_cast<long long>(lcm.answers + lcm.lost_answers), lcm_loss_percent,
+                o.max_lcm_loss_percent);
+    std::printf(
+        "  resident memory            %.0f KiB after %.0f s warm-up, %.0f KiB at the end: "
+        "%+.0f KiB (tolerance %.0f KiB)\n",
+        rss_warm, warm_up, rss_end, rss_growth, o.max_rss_growth_kib);
+    for (const auto& [name, ok] : checks.items()) {
+      std::cout << "  " << (ok.get<bool>() ? "ok      " : "FAILED  ") << name << "\n";
+    }
+    std::cout << "  report: " << (dir / "soak.html").string() << "\n";
+  }
+  return passed ? kExitOk : kExitLimitsExceeded;
+}
+
+}  // namespace
+
+Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
+  auto options = std::make_shared<SoakOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "soak",
+      "Soak test: start hapticsimd and the simulated device together in a private network "
+      "namespace, run for --duration, sample the daemon's memory and CPU, inject bad input, and "
+      "check: no non-finite force, no lost or duplicated answer on shared memory, LCM loss "
+      "within budget, memory flat after the warm-up, still answering after bad input, a clean "
+      "stop. Writes soak.json and soak.html. Exit status 4 when a check fails.");
+  app->add_option("--duration", options->duration_s, "Seconds to run")->capture_default_str();
+  app->add_option("--warm-up", options->warm_up_s,
+                  "Seconds before memory must stay flat (default: a tenth of the run, ≥ 5 s)");
+  app->add_option("--daemon", options->daemon,
+                  "hapticsimd to run (default: the one built next to "
+                  "this hapticsim)");
+  app->add_option("--error-map", options->error_map, "Error map for the daemon (default: none)");
+  app->add_option("--report", options->report_dir,
+                  "Directory for soak.json, soak.html and the "
+                  "daemon's log")
+      ->capture_default_str();
+  app->add_option("--input", options->input, "Device input: walk, press or sine")
+      ->capture_default_str();
+  app->add_option("--seed", options->seed, "Random walk seed")->capture_default_str();
+  app->add_option("--max-lcm-loss-percent", options->max_lcm_loss_percent,
+                  "Budget for forces lost on LCM, %")
+      ->capture_default_str();
+  app->add_option("--max-rss-growth-kib", options->max_rss_growth_kib,
+                  "Tolerance for resident-memory growth after the warm-up, KiB")
+      ->capture_default_str();
+  app->add_flag("--json", options->json, "Print the summary as JSON");
+  return {app, [options, argc, argv] {
+            if (!std::getenv(kInNetnsVariable)) ReexecInPrivateNetns(argc, argv);
+            return RunSoak(*options);
+          }};
+}
+
+}  // namespace hapticsim::cli
