@@ -13,6 +13,7 @@ packages=(
   iproute2 util-linux systemd
   libopenmpi-dev openmpi-bin
   chromium
+  xvfb
 )
 
 missing=()
