@@ -43,6 +43,7 @@ std::string LineChartSvg(const std::string& title, const std::string& x_label,
       if (std::isfinite(v)) y_max = std::max(y_max, v), y_min = std::min(y_min, v);
     }
   }
+  if (x_min > 0 && x_min < 0.05 * (x_max - x_min)) x_min = 0;  // an axis from 0, not 0.0004
   if (!(x_max > x_min)) x_max = x_min + 1;
   if (!(y_max > y_min)) y_max = y_min + 1;
   y_max *= 1.05;

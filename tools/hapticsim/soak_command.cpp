@@ -218,9 +218,10 @@ int RunSoak(const SoakOptions& o) {
         ResourceSample s{
             std::chrono::duration<double>(now - start).count(), rss,
             last_ticks >= 0 && dt > 0 ? 100 * (ticks - last_ticks) / ticks_per_s / dt : 0};
+        const bool first = last_ticks < 0;  // no CPU share without a previous sample
         last_ticks = ticks, last_time = now;
         std::lock_guard lock(resources_mutex);
-        resources.push_back(s);
+        if (!first) resources.push_back(s);
       }
       std::this_thread::sleep_for(std::chrono::seconds(1));
     }
