@@ -54,6 +54,8 @@ class LcmLink final : public DeviceLink {
     if (listen_only_) return false;
     static const char kGarbage[] = "not an LCM message of any type";
     lcm_.publish(device_channel_, kGarbage, sizeof kGarbage);
+    const status_t wrong_type{};  // well-formed, but its fingerprint is not device_input_t's
+    lcm_.publish(device_channel_, &wrong_type);
     return true;
   }
   void Collect(std::vector<Answer>* out) override {

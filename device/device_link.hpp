@@ -29,7 +29,8 @@ class DeviceLink {
   /** One device input. */
   virtual void Send(std::int64_t seq, std::int64_t utime_us,
                     const std::array<double, 3>& position_m) = 0;
-  /** A message that is not a device input at all (bad-input tests); false where unsupported. */
+  /** Messages that are no device input (bad-input tests): bytes of no type and a message of
+   * another type. False where unsupported. */
   virtual bool SendGarbage() { return false; }
   /** Appends the answers received since the last call, oldest first. Never blocks. */
   virtual void Collect(std::vector<Answer>* out) = 0;

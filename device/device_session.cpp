@@ -72,6 +72,8 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
   const double period_ns = 1e9 / settings.rate_hz;
   const std::int64_t periods = std::llround(settings.duration_s * settings.rate_hz);
   constexpr int kBurstPeriods = 8;
+  // Then silence longer than the daemon's stale_after (0.05 s by default): stale input.
+  constexpr int kSilentPeriods = 100;
   std::vector<std::int64_t> burst_starts;
   for (double t : settings.bad_input_bursts_s)
     burst_starts.push_back(std::llround(t * settings.rate_hz));
@@ -139,7 +141,13 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     const auto burst = std::find_if(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
       return n >= b && n < b + kBurstPeriods;
     });
-    if (burst != burst_starts.end()) {
+    const bool silent = std::any_of(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
+      return n >= b + kBurstPeriods && n < b + kBurstPeriods + kSilentPeriods;
+    });
+    if (silent) {
+      bad[seq] = 1;  // nothing sent: nothing to answer
+      ++report.silent_periods;
+    } else if (burst != burst_starts.end()) {
       // Bad input, one kind after the other; the daemon must refuse it and keep the last good.
       bad[seq] = 1;
       ++report.bad_inputs_sent;
@@ -160,8 +168,8 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
           break;
       }
       link.Send(sent_seq, release / 1000, tip);
-      if (link.SendGarbage()) ++report.bad_inputs_sent;
-      if (monitor && monitor->SendGarbage()) ++report.bad_inputs_sent;
+      if (link.SendGarbage()) report.bad_inputs_sent += 2;
+      if (monitor && monitor->SendGarbage()) report.bad_inputs_sent += 2;
       last_burst_end = seq;
     } else {
       last_good = tip;

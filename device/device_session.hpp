@@ -14,7 +14,8 @@ struct SessionSettings {
   double duration_s = 10;
   double rate_hz = 1000;
   /// Bursts of bad input (NaN, far outside, a jump no hand makes, an old seq, and on LCM a
-  /// message that is no device input) starting at these times, s; each lasts 8 periods.
+  /// message that is no device input and one of another type) starting at these times, s; each
+  /// lasts 8 periods and is followed by 0.1 s of silence (stale input).
   std::vector<double> bad_input_bursts_s;
 };
 
@@ -41,6 +42,7 @@ struct StreamSummary {
 struct SessionReport {
   std::int64_t inputs_sent = 0;  ///< good inputs (bad ones are counted apart)
   std::int64_t bad_inputs_sent = 0;
+  std::int64_t silent_periods = 0;       ///< periods nothing was sent (stale input on purpose)
   std::int64_t unanswered_inputs = 0;    ///< good inputs no force ever answered
   std::int64_t late_answers = 0;         ///< first answer more than one period after sending
   StreamSummary stream;                  ///< on the device's own link

@@ -134,7 +134,8 @@ Command AddDeviceCommand(CLI::App& parent) {
   app->add_option("--duration", options->duration_s, "Seconds to run")->capture_default_str();
   app->add_option("--bad-input-at", options->bad_input_at_s,
                   "Inject a burst of bad input at these times, s (NaN, far outside, a jump, an "
-                  "old seq; on LCM also a message of no type)")
+                  "old seq; on LCM also a message of no type and one of another type), then "
+                  "0.1 s of silence (stale input)")
       ->delimiter(',');
   app->add_flag("--json", options->json, "Print the summary as JSON");
   app->add_option("--max-p99-us", options->limits.p99_us, "Limit: p99 round trip, µs");

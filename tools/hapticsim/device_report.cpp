@@ -63,6 +63,7 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
   nlohmann::json out = {{"duration_s", r.duration_s},
                         {"inputs_sent", r.inputs_sent},
                         {"bad_inputs_sent", r.bad_inputs_sent},
+                        {"silent_periods", r.silent_periods},
                         {"unanswered_inputs", r.unanswered_inputs},
                         {"late_answers", r.late_answers},
                         {"answers", r.stream.answers},
@@ -119,8 +120,9 @@ std::string ReportText(const device::SessionReport& r) {
     std::snprintf(line, sizeof line, format, values...);
     text << line << "\n";
   };
-  add("  inputs sent                %lld (+ %lld bad, injected)",
-      static_cast<long long>(r.inputs_sent), static_cast<long long>(r.bad_inputs_sent));
+  add("  inputs sent                %lld (+ %lld bad and %lld periods of silence, injected)",
+      static_cast<long long>(r.inputs_sent), static_cast<long long>(r.bad_inputs_sent),
+      static_cast<long long>(r.silent_periods));
   add("  unanswered inputs          %lld", static_cast<long long>(r.unanswered_inputs));
   add("  late answers (> 1 period)  %lld", static_cast<long long>(r.late_answers));
   add("  answers                    %lld (lost %lld, duplicated %lld)",
