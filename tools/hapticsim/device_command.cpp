@@ -38,11 +38,17 @@ int Run(DeviceOptions o) {
   HAPTICSIM_THROW_UNLESS(o.duration_s > 0, "--duration must be positive, s");
   device::DeviceMotion motion(o.motion);
   if (o.motion.kind == "replay" && o.duration_s <= 0) o.duration_s = motion.replay_periods() / 1e3;
-  std::unique_ptr<device::DeviceLink> link;
+  std::unique_ptr<device::DeviceLink> link, status_link;
   if (o.transport == "lcm") {
     link = device::MakeLcmLink(o.lcm_url, o.device_channel, o.force_channel, o.status_channel);
   } else if (o.transport == "shm") {
     link = device::MakeShmLink(o.shm_name);
+    // The daemon's status (deadlines, configuration) comes over LCM; listen when LCM is there.
+    try {
+      status_link = device::MakeLcmLink(o.lcm_url, o.device_channel, o.force_channel,
+                                        o.status_channel, /*listen_only=*/true);
+    } catch (const Error&) {
+    }
   } else {
     throw Error("--transport " + o.transport + ": use lcm or shm");
   }
@@ -50,8 +56,8 @@ int Run(DeviceOptions o) {
   settings.duration_s = o.duration_s;
   settings.bad_input_bursts_s = o.bad_input_at_s;
   const bool terminal = isatty(STDERR_FILENO);
-  const device::SessionReport report =
-      device::RunSession(motion, *link, nullptr, settings, [&](const device::SessionReport& r) {
+  const device::SessionReport report = device::RunSession(
+      motion, *link, status_link.get(), settings, [&](const device::SessionReport& r) {
         if (!terminal) return;
         const device::SecondSummary& s = r.seconds.back();
         std::fprintf(
