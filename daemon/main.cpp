@@ -252,6 +252,9 @@ int Serve(const Arguments& args) {
   };
   OverloadWatch overload;  // a region missing deadlines second after second
   std::int64_t last_overload_line_ns = 0;
+  // The cost of a configuration the map has nothing cheaper than: not asked again.
+  double cheapest_cost_us_per_ms = -1;
+  bool choice_for_overload = false;
   std::optional<LatticeIndex> hover_node;  // the node the tool hovers over, and since when
   std::int64_t hover_since_ns = 0;
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
@@ -396,10 +399,12 @@ int Serve(const Arguments& args) {
         }
         loop.SetErrorState(decision.error_percent, active_flags());
       } catch (const Error& e) {
+        if (choice_for_overload) cheapest_cost_us_per_ms = decision.cost_us_per_ms;
         spdlog::error("{} failed: {}; keeping the active configuration",
                       choice_pin ? "pinning a configuration" : "choosing a configuration",
                       e.what());
       }
+      choice_for_overload = false;
     }
     // Moving the regions — to the pending configuration, or onto the node the tool touches or
     // hovers over. A new configuration only out of contact, after the object has settled: the
@@ -458,13 +463,15 @@ int Serve(const Arguments& args) {
     }
     if (const int region = overload.Check(now, rates_hz); region >= 0) {
       const std::string name = loop.regions().partition().RegionName(region);
-      if (decision.have_map && !pinned && !choice.valid()) {
+      const bool nothing_cheaper = decision.cost_us_per_ms == cheapest_cost_us_per_ms;
+      if (decision.have_map && !pinned && !choice.valid() && !nothing_cheaper) {
         spdlog::error(
             "{} thread missed {} of its {} periods in the last second, and more than 5 % in "
             "each of the 3 before: choosing a configuration cheaper than {} µs per simulated "
             "ms (deadlines before accuracy)",
             name, overload.last_misses(), rates_hz[region], decision.cost_us_per_ms);
         choice_pin.reset();
+        choice_for_overload = true;
         choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target,
                                                  ceiling = decision.cost_us_per_ms] {
           return ChooseConfiguration(scene, m.get(), target, std::nullopt, ceiling);
@@ -477,6 +484,7 @@ int Serve(const Arguments& args) {
             "its own (realtime.cpus, realtime.fifo_priority) or pin a cheaper one",
             name, overload.last_misses(),
             pinned              ? "a configuration is pinned"
+            : nothing_cheaper   ? "the map has nothing cheaper"
             : decision.have_map ? "a choice is being made"
                                 : "no error map");
       }
