@@ -1,28 +1,14 @@
 #include "core/realtime_schedule.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <thread>
 
+#include "core/monotonic_clock.hpp"
+
 namespace hapticsim {
 namespace {
-
-std::int64_t NowNs() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void SleepUntilNs(std::int64_t wake_ns) {
-  timespec ts{};
-  ts.tv_sec = wake_ns / 1'000'000'000;
-  ts.tv_nsec = wake_ns % 1'000'000'000;
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
 
 // Per-thread record of one periodic loop, preallocated before the loop starts.
 struct LoopRecord {
@@ -80,7 +66,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   }
 
   // Wall-clock origin of simulation time 0, far enough ahead for the outer regions' leads.
-  const std::int64_t origin_ns = NowNs() + 20'000'000 + lead_ns.back();
+  const std::int64_t origin_ns = MonotonicNowNs() + 20'000'000 + lead_ns.back();
   std::atomic<bool> primary_done{false};
 
   std::vector<std::thread> threads;
@@ -94,10 +80,10 @@ TrialResult RealTimeSchedule::RunTrial() {
         const std::int64_t state = regions_.state_ticks(a);
         if (state >= end_ticks + period) break;
         const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns[a];
-        SleepUntilNs(release);
-        const std::int64_t woke = NowNs();
+        SleepUntilMonotonicNs(release);
+        const std::int64_t woke = MonotonicNowNs();
         for (int q = 0; q < substeps; ++q) regions_.StepRegion(a);
-        const std::int64_t done = NowNs();
+        const std::int64_t done = MonotonicNowNs();
         record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
         if (woke - release > period_ns || done > release + period_ns) ++record.misses;
         if (record.execution_s.size() < record.execution_s.capacity()) {
@@ -112,8 +98,8 @@ TrialResult RealTimeSchedule::RunTrial() {
   for (long n = 0; n <= steps; ++n) {
     const std::int64_t release =
         origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
-    SleepUntilNs(release);
-    const std::int64_t woke = NowNs();
+    SleepUntilMonotonicNs(release);
+    const std::int64_t woke = MonotonicNowNs();
     const double t = n * dt;
     std::array<double, 3> r{};
     for (int q = 1; q <= primary_substeps; ++q) {
@@ -121,7 +107,7 @@ TrialResult RealTimeSchedule::RunTrial() {
           regions_.StepPrimary(trajectory.DisplacementAt(t + q * dt / primary_substeps));
       if (q == 1) r = rq;
     }
-    const std::int64_t done = NowNs();
+    const std::int64_t done = MonotonicNowNs();
     record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
     if (woke - release > period_ns || done > release + period_ns) ++record.misses;
     record.execution_s.push_back((done - woke) * 1e-9);

@@ -1,25 +1,18 @@
 #include "device/device_link.hpp"
 
-#include <time.h>
-
 #include <atomic>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/monotonic_clock.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "ipc/shm_device_client.hpp"
 
 namespace hapticsim::device {
 namespace {
-
-std::int64_t NowNs() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 class LcmLink final : public DeviceLink {
  public:
@@ -72,8 +65,13 @@ class LcmLink final : public DeviceLink {
 
  private:
   void OnForce(const lcm::ReceiveBuffer*, const std::string&, const force_feedback_t* f) {
-    Answer a{f->period,        f->seq,  f->utime, NowNs(), {f->force[0], f->force[1], f->force[2]},
-             f->error_percent, f->flags};
+    Answer a{f->period,
+             f->seq,
+             f->utime,
+             MonotonicNowNs(),
+             {f->force[0], f->force[1], f->force[2]},
+             f->error_percent,
+             f->flags};
     std::lock_guard lock(mutex_);
     pending_.push_back(a);
   }
@@ -101,7 +99,7 @@ class ShmLink final : public DeviceLink {
     client_.WriteInput(seq, utime_us, position_m);
   }
   void Collect(std::vector<Answer>* out) override {
-    const std::int64_t now = NowNs();
+    const std::int64_t now = MonotonicNowNs();
     last_period_ = client_.ReadForcesSince(last_period_, [&](const shm::ShmForceOutput& f) {
       if (f.seq < 0) return;  // before the first input: nothing answered
       out->push_back(Answer{f.period,

@@ -1,28 +1,14 @@
 #include "device/device_session.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/monotonic_clock.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 
 namespace hapticsim::device {
 namespace {
-
-std::int64_t NowNs() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void SleepUntilNs(std::int64_t wake_ns) {
-  timespec ts{static_cast<time_t>(wake_ns / 1'000'000'000),
-              static_cast<long>(wake_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
 
 double Percentile(const std::vector<double>& sorted, double q) {
   if (sorted.empty()) return 0;
@@ -131,11 +117,11 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     }
   };
 
-  const std::int64_t start = NowNs() + 2'000'000;
+  const std::int64_t start = MonotonicNowNs() + 2'000'000;
   std::int64_t next_second = 1;
   for (std::int64_t n = 0; n < periods; ++n) {
     const std::int64_t release = start + std::llround(n * period_ns);
-    SleepUntilNs(release);
+    SleepUntilMonotonicNs(release);
     const std::int64_t seq = n + 1;
     std::array<double, 3> tip = motion.Next();
     const auto burst = std::find_if(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
@@ -176,13 +162,13 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
       link.Send(seq, release / 1000, tip);
       ++report.inputs_sent;
     }
-    sent_ns[seq] = NowNs();
+    sent_ns[seq] = MonotonicNowNs();
     const std::int64_t next_release = start + std::llround((n + 1) * period_ns);
     if (link.needs_polling()) {
       // Shared memory: look for the answer every 50 µs until just before the next period.
-      while (NowNs() < next_release - 60'000) {
+      while (MonotonicNowNs() < next_release - 60'000) {
         collect();
-        SleepUntilNs(NowNs() + 50'000);
+        SleepUntilMonotonicNs(MonotonicNowNs() + 50'000);
       }
     }
     collect();
@@ -203,10 +189,10 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     }
   }
   // The last answers: a few periods to arrive.
-  const std::int64_t end = NowNs() + 50'000'000;
-  while (NowNs() < end) {
+  const std::int64_t end = MonotonicNowNs() + 50'000'000;
+  while (MonotonicNowNs() < end) {
     collect();
-    SleepUntilNs(NowNs() + 200'000);
+    SleepUntilMonotonicNs(MonotonicNowNs() + 200'000);
   }
   for (std::int64_t seq = 1; seq <= periods; ++seq) {
     if (!bad[seq] && !answered[seq]) ++report.unanswered_inputs;
