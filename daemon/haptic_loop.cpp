@@ -2,31 +2,16 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <time.h>
 
 #include <cmath>
 #include <cstring>
 
 #include "core/error.hpp"
+#include "core/monotonic_clock.hpp"
 
 namespace hapticsim {
-namespace {
 
-void SleepUntilNs(std::int64_t wake_ns) noexcept {
-  timespec ts{};
-  ts.tv_sec = wake_ns / 1'000'000'000;
-  ts.tv_nsec = wake_ns % 1'000'000'000;
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
-
-}  // namespace
-
-std::int64_t HapticLoop::NowNs() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+std::int64_t HapticLoop::NowNs() noexcept { return MonotonicNowNs(); }
 
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene),
@@ -89,14 +74,13 @@ void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
   // The primary acknowledges at its next release; after that it does not touch the regions.
   const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
   while (!paused_.load(std::memory_order_acquire)) {
-    if (NowNs() > give_up_ns) {  // a hung primary thread: replace everything the slow way
-      Stop();
-      Install(scene, std::move(regions));
-      Start();  // restarts from rest whatever `restart` asked
-      return;
+    if (NowNs() > give_up_ns) {
+      // A primary thread that does not come round in a second is hung: joining it would hang the
+      // supervisor too. Leave everything as it is; the watchdog stops getting pings.
+      pause_requested_.store(false, std::memory_order_release);
+      throw Error("the primary thread did not answer within 1 s: regions not replaced");
     }
-    const timespec short_wait{0, 100'000};
-    nanosleep(&short_wait, nullptr);
+    SleepUntilMonotonicNs(NowNs() + 100'000);
   }
   StopSecondaries();
   Install(scene, std::move(regions));
@@ -172,8 +156,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   const ContactTracker::Contact contact = have && !stale
                                               ? contact_.Update(PredictedTip(), now_ns, centre)
                                               : contact_.Hold(now_ns, centre);
-  in_contact_ = contact.engaged && usable;
-  displacement_ = contact.displacement_m;
+  const bool in_contact = contact.engaged && usable;
   if (contact.waiting) flags |= force_flags::kReconfiguring;
   contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
@@ -186,7 +169,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     const int substeps = regions_->schedule(kPrimaryRegion).substeps;
     for (int q = 1; q <= substeps; ++q) {
       // The device gives one position per period: every substep holds it.
-      const std::array<double, 3> r = regions_->StepPrimary(displacement_);
+      const std::array<double, 3> r = regions_->StepPrimary(contact.displacement_m);
       if (q == 1) reaction = r;
     }
   }
@@ -197,7 +180,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   out.seq = last_input_.seq;
   out.utime_us = now_ns / 1000;
   out.error_percent = error_percent_.load(std::memory_order_relaxed);
-  const bool render = in_contact_ && !(stale && options_.zero_force_when_stale);
+  const bool render = in_contact && !(stale && options_.zero_force_when_stale);
   if (render) {
     for (int c = 0; c < 3; ++c) out.force_n[c] = -reaction[c];
     const double magnitude = std::hypot(out.force_n[0], out.force_n[1], out.force_n[2]);
@@ -207,7 +190,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       force_faults_.fetch_add(1, std::memory_order_relaxed);
     }
   }
-  if (in_contact_) {
+  if (in_contact) {
     flags |= force_flags::kInContact;
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);
   }
@@ -244,7 +227,7 @@ void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
   for (std::int64_t k = 0; !stop_.load(std::memory_order_acquire); ++k) {
     const std::int64_t release =
         origin_ns + std::llround(static_cast<double>(k) * primary_period_ns_);
-    SleepUntilNs(release);
+    SleepUntilMonotonicNs(release);
     const std::int64_t woke = NowNs();
     PrimaryPeriod(release, woke);
     monitor.Record(release, woke, NowNs());
@@ -258,7 +241,7 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
     const std::int64_t release =
         origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
         lead_ns_[region];
-    SleepUntilNs(release);
+    SleepUntilMonotonicNs(release);
     const std::int64_t woke = NowNs();
     for (int q = 0; q < substeps; ++q) regions_->StepRegion(region);
     monitor.Record(release, woke, NowNs());

@@ -106,8 +106,8 @@ class HapticLoop {
    * flagged, every input answered) and resumes on the new ones. `keep_contact`: a touching tip
    * engages again with its force ramped in (re-centring on it); otherwise it must lift off first
    * (a reset). Supervisor thread only.
-   * @throws Error for an invalid scene or another primary rate (the running loop is left as it
-   *         was).
+   * @throws Error for an invalid scene, another primary rate, or a primary thread that does not
+   *         answer within a second (the running loop is left as it was).
    */
   void Reconfigure(const Scene& scene, bool keep_contact = false);
   /** The node the tool wants the regions centred on (see ContactTracker::wanted_node). */
@@ -203,8 +203,6 @@ class HapticLoop {
   DeviceSample previous_input_;   // the accepted input before last_input_
   std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
   int periods_since_input_ = 0;
-  std::array<double, 3> displacement_{};
-  bool in_contact_ = false;
   DeviceSample last_input_;
 };
 
