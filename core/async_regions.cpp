@@ -81,10 +81,11 @@ double AsyncRegions::compute_seconds(RegionIndex region) const {
   return regions_[region]->compute_s;
 }
 
-AsyncRegions::AsyncRegions(const Scene& scene)
+AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety)
     : partition_(scene),
       coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement
                                                        : Coupling::kForce) {
+  if (!(substep_safety > 0)) throw Error("substep safety must be positive");
   const RegionPartition& p = partition_;
   const int n = p.mesh().num_dofs();
   const int count = p.num_regions();
@@ -107,7 +108,7 @@ AsyncRegions::AsyncRegions(const Scene& scene)
     schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, p.dofs(a).owned));
     schedule.substeps =
         std::max(1, static_cast<int>(std::ceil(1.0 / schedule.rate_hz /
-                                               (kSubstepSafety * schedule.alone.critical_dt_s))));
+                                               (substep_safety * schedule.alone.critical_dt_s))));
     ticks_per_second_ = std::lcm(ticks_per_second_, rates[a] * schedule.substeps);
   }
   common_period_ticks_ = 1;
@@ -350,9 +351,18 @@ RegionIndex AsyncRegions::LargestStateRegion() const {
 }
 
 TrialResult AsyncRegions::RunTrial(const InputSettings& input) {
+  Reset();
+  return RunTrialFromCurrentState(input);
+}
+
+TrialResult AsyncRegions::RunTrialFromRandomState(const InputSettings& input, unsigned seed) {
+  SetRandomState(seed);
+  return RunTrialFromCurrentState(input);
+}
+
+TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input) {
   TrialResult result;
   result.stability = regions_[kPrimaryRegion]->schedule.alone;
-  Reset();
   const Scene& scene = partition_.scene();
   const ContactTrajectory trajectory(input, InwardNormal(scene.mesh, ContactNode(scene)));
   const std::array<double, 3>& normal = trajectory.inward_normal();

@@ -70,8 +70,13 @@ class AsyncRegions {
   /** What an inner region sends the outer one for Γ. */
   enum class Coupling { kForce, kDisplacement };
 
-  /** @throws Error for invalid adaptivity settings. */
-  explicit AsyncRegions(const Scene& scene);
+  /**
+   * substep_safety: each region takes the fewest substeps that keep its step at most this
+   * fraction of its own critical step. Above 1 a region may run past its limit: only the stability
+   * stress test asks for that, to watch divergence being detected.
+   * @throws Error for invalid adaptivity settings or a substep_safety that is not positive.
+   */
+  explicit AsyncRegions(const Scene& scene, double substep_safety = kSubstepSafety);
   ~AsyncRegions();
 
   const RegionPartition& partition() const { return partition_; }
@@ -114,6 +119,11 @@ class AsyncRegions {
   TrialResult RunTrial();
   /** A trial of another input on the same regions (the sweep reuses one set per configuration). */
   TrialResult RunTrial(const InputSettings& input);
+  /**
+   * The same trial from SetRandomState(seed) instead of rest, so every mode starts excited (the
+   * stability stress test: an unstable mode cannot hide behind a smooth input).
+   */
+  TrialResult RunTrialFromRandomState(const InputSettings& input, unsigned seed);
 
   /** The region whose state is largest (or non-finite): where a divergence grew. */
   RegionIndex LargestStateRegion() const;
@@ -134,6 +144,7 @@ class AsyncRegions {
  private:
   struct Region;
   void PublishInitialSnapshots();
+  TrialResult RunTrialFromCurrentState(const InputSettings& input);
   void PublishInward(RegionIndex region) noexcept;
   void PublishOutward(RegionIndex region) noexcept;
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,

@@ -22,7 +22,8 @@ TEST(HapticsimCli, HelpListsTheSubcommands) {
   const CommandResult result = Hapticsim({"--help"});
   EXPECT_EQ(result.exit_status, 0);
   for (const char* sub :
-       {"simulate", "static", "stability", "scene", "sweep", "map", "lookup", "analyze"}) {
+       {"simulate", "static", "stability", "scene", "sweep", "map", "lookup", "analyze", "device",
+        "soak", "log", "stress"}) {
     EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
   }
 }

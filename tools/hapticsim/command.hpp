@@ -30,6 +30,7 @@ Command AddLookupCommand(CLI::App& parent);
 Command AddAnalyzeCommand(CLI::App& parent);
 Command AddDeviceCommand(CLI::App& parent);
 Command AddLogCommand(CLI::App& parent);
+Command AddStressCommand(CLI::App& parent);
 /** argc/argv: soak runs itself again inside a private network namespace. */
 Command AddSoakCommand(CLI::App& parent, int argc, char** argv);
 

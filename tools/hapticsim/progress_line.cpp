@@ -21,8 +21,9 @@ std::string ShortDuration(double seconds) {
   return buffer;
 }
 
-ProgressLine::ProgressLine(std::string what, double plain_interval_s)
+ProgressLine::ProgressLine(std::string what, double plain_interval_s, std::string unit)
     : what_(std::move(what)),
+      unit_(std::move(unit)),
       terminal_(isatty(STDERR_FILENO)),
       plain_interval_s_(plain_interval_s) {}
 
@@ -36,13 +37,13 @@ void ProgressLine::Update(std::size_t done, std::size_t total, std::size_t fresh
     const int filled = static_cast<int>(fraction * kWidth);
     std::string bar(filled, '#');
     bar.resize(kWidth, '.');
-    std::fprintf(stderr, "\r%s [%s] %zu/%zu samples  %.1f/s  ETA %s   ", what_.c_str(), bar.c_str(),
-                 done, total, rate, ShortDuration(eta).c_str());
+    std::fprintf(stderr, "\r%s [%s] %zu/%zu %s  %.1f/s  ETA %s   ", what_.c_str(), bar.c_str(),
+                 done, total, unit_.c_str(), rate, ShortDuration(eta).c_str());
     drawn_ = true;
   } else if (elapsed_s - last_plain_s_ >= plain_interval_s_ || done == total) {
-    std::fprintf(stderr, "%s: %zu/%zu samples (%.0f %%), %.1f samples/s, %s elapsed, ETA %s\n",
-                 what_.c_str(), done, total, 100 * fraction, rate, ShortDuration(elapsed_s).c_str(),
-                 ShortDuration(eta).c_str());
+    std::fprintf(stderr, "%s: %zu/%zu %s (%.0f %%), %.1f %s/s, %s elapsed, ETA %s\n", what_.c_str(),
+                 done, total, unit_.c_str(), 100 * fraction, rate, unit_.c_str(),
+                 ShortDuration(elapsed_s).c_str(), ShortDuration(eta).c_str());
     last_plain_s_ = elapsed_s;
   }
   std::fflush(stderr);

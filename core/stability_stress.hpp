@@ -1,0 +1,92 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/reference_trial.hpp"
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/**
+ * The numerical-stability stress test: random scenes and region configurations, each predicted
+ * (every region's step against its own limit, then the coupled spectral radius) and then run,
+ * to check the prediction against what the run does.
+ *
+ *  - predicted stable    → must stay bounded over a long run from a random state under an
+ *                          extreme input (the divergence detector of every trial must stay quiet);
+ *  - predicted unstable  → run anyway; divergence must be detected within the number of steps
+ *                          its predicted growth needs (DetectionBoundPeriods), and the region
+ *                          reported for it recorded.
+ *
+ * One case is a pure function of (seed, index): results never depend on the job count.
+ */
+struct StressRanges {
+  int min_nodes = 5;  ///< nodes per axis, drawn from the odd counts in [min_nodes, max_nodes]
+  int max_nodes = 9;
+  double stable_run_s = 2.0;  ///< simulated time of a predicted-stable run, s
+  double max_run_s = 30.0;    ///< a predicted-unstable run never goes on longer than this, s
+};
+
+/** One drawn case: a valid adaptive scene and the substep safety its regions were built with. */
+struct StressCase {
+  int index = 0;
+  Scene scene;
+  /**
+   * Each region's step as a fraction of its own limit that its substeps aim for: the production
+   * 0.95, or (two cases in five) so large that every region takes one step per period, with the
+   * stiffness scaled to put one region's step between 0.8 and 1.3 of its own limit.
+   */
+  double substep_safety = 0.95;
+  unsigned state_seed = 0;  ///< the random start state
+};
+
+/** Draws case `index` of the run `seed` (deterministic; retries until the scene is valid). */
+StressCase DrawStressCase(std::uint64_t seed, int index, const StressRanges& ranges);
+
+/** The prediction and what the run did. */
+struct StressOutcome {
+  StressCase stress_case;
+  int regions = 0;
+  /** Each region's step over its own critical step (≥ 1: that region alone is past its limit). */
+  std::vector<double> step_over_limit;
+  double spectral_radius = 0;  ///< coupled, per common period
+  double common_period_s = 0;
+  bool past_limit = false;              ///< some region's step is at or past its own limit
+  bool coupling_only_unstable = false;  ///< every region stable alone, the coupling not
+  bool predicted_stable = false;        ///< no region past its limit and the coupling stable
+  long bound_periods = 0;               ///< predicted unstable: primary periods detection may take
+  bool marginal = false;  ///< predicted unstable but growing too slowly to detect by max_run_s
+
+  TrialOutcome outcome = TrialOutcome::kCompleted;
+  long periods_run = 0;      ///< primary periods simulated
+  int diverged_region = -1;  ///< the region whose state was largest when divergence was seen
+  double peak_force_n = 0;   ///< over the run, N
+  double seconds = 0;        ///< wall time of the case (prediction and run), s
+
+  bool diverged() const {
+    return outcome == TrialOutcome::kDivergedEnergy || outcome == TrialOutcome::kDivergedNonFinite;
+  }
+  /** A predicted-stable case that diverged: the prediction failed. */
+  bool stable_but_diverged() const { return predicted_stable && diverged(); }
+  /** A predicted-unstable, non-marginal case whose divergence was not seen within its bound. */
+  bool divergence_undetected() const { return !predicted_stable && !marginal && !diverged(); }
+};
+
+/**
+ * Primary periods within which a configuration growing by `spectral_radius` per common period
+ * must trip the divergence detector from a random start: the unstable mode has to grow from
+ * 10⁻²⁰ of the energy the detector compares with (the start's energy plus the input's work, which
+ * an extreme input makes many orders larger than a random start's) to the detector's factor above
+ * it, plus 100 common periods for the transient.
+ */
+long DetectionBoundPeriods(double spectral_radius, double common_period_s, double primary_dt_s);
+
+/** Predicts and runs one case. */
+StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& ranges);
+
+/** One line describing a case's scene and configuration, for reports. */
+std::string DescribeStressCase(const StressCase& stress_case);
+
+}  // namespace hapticsim

@@ -1,0 +1,333 @@
+// hapticsim stress: the numerical-stability stress test. Random scenes and configurations are
+// predicted and then run (core/stability_stress.hpp); the supervisor is asked to choose for each
+// scene, also from an error map that calls every configuration fine, and what it chose is
+// verified again on its own.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <random>
+#include <thread>
+#include <tuple>
+
+#include "core/async_regions.hpp"
+#include "core/error.hpp"
+#include "core/error_map.hpp"
+#include "core/stability_stress.hpp"
+#include "daemon/supervisor.hpp"
+#include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/progress_line.hpp"
+
+namespace hapticsim::cli {
+namespace {
+
+using Json = nlohmann::json;
+
+struct StressOptions {
+  int count = 1000;
+  std::uint64_t seed = 1;
+  int jobs = 0;
+  int only_case = -1;
+  int supervisor_every = 1;
+  StressRanges ranges;
+  bool json = false;
+};
+
+// What the supervisor did for one case's scene.
+struct SupervisorCheck {
+  int choices = 0;                // decisions made (without a map, from a lying map, pinned)
+  int chose_unstable = 0;         // a chosen configuration that is not predicted stable on its own
+  int stable_pinned_refused = 0;  // a stable pinned configuration it refused
+  std::string problem;
+  double seconds = 0;  // wall time of the checks
+};
+
+bool IndependentlyStable(const Scene& scene) {
+  try {
+    AsyncRegions regions(scene);
+    return regions.EstimateCoupledStability().stable;
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+// An error map for this scene's material and input that calls four configurations fine (two
+// primary sizes × two secondary rates at the scene's spacing factor): the supervisor must still
+// verify stability itself. Four, not the paper's 60, keeps a case's checks to a few estimates.
+ErrorMap LyingMap(const Scene& scene, std::mt19937_64& rng) {
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  const MapPoint at = PointOfScene(scene);
+  for (int a = 0; a < 6; ++a) axes[a] = {at[a]};
+  axes[static_cast<int>(MapAxis::kSecondaryLod)] = {
+      static_cast<double>(scene.adaptivity.secondary_lod)};
+  const int size = std::uniform_int_distribution<int>(1, 3)(rng);
+  axes[static_cast<int>(MapAxis::kPrimarySize)] = {static_cast<double>(size),
+                                                   static_cast<double>(size + 1)};
+  const double primary = std::round(1.0 / scene.solver.dt_s);
+  const int percent = std::uniform_int_distribution<int>(5, 9)(rng) * 10;
+  axes[static_cast<int>(MapAxis::kSecondaryRate)] = {primary * percent / 100, primary};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  std::uniform_real_distribution<double> error(0, 10), cost(10, 500);
+  for (MapSample& sample : map.samples) {
+    sample.status = SampleStatus::kOk;
+    sample.l2_percent = sample.max_magnitude_percent = error(rng);
+    sample.max_direction_deg = 1;
+    sample.reference_peak_n = 1;
+    sample.cost_us_per_ms[0] = cost(rng);
+  }
+  return map;
+}
+
+SupervisorCheck CheckSupervisor(const StressOutcome& outcome) {
+  const auto start = std::chrono::steady_clock::now();
+  SupervisorCheck check;
+  const Scene& scene = outcome.stress_case.scene;
+  std::mt19937_64 rng(outcome.stress_case.state_seed);
+  const ErrorMap lying = LyingMap(scene, rng);
+  // Independent verdicts, each estimated once per configuration.
+  std::map<std::tuple<int, int, double>, bool> verdicts;
+  auto stable = [&](const RegionConfiguration& c) {
+    const auto key = std::make_tuple(c.primary_size, c.secondary_lod, c.secondary_rate_hz);
+    const auto found = verdicts.find(key);
+    if (found != verdicts.end()) return found->second;
+    return verdicts[key] = IndependentlyStable(SceneWith(scene, c));
+  };
+  auto verify = [&](const char* how, const ErrorMap* map,
+                    const std::optional<RegionConfiguration>& pinned) {
+    ++check.choices;
+    try {
+      const SupervisorDecision decision = ChooseConfiguration(scene, map, 5.0, pinned);
+      if (!stable(decision.configuration)) {
+        ++check.chose_unstable;
+        check.problem = std::string(how) + " chose an unstable configuration: " + decision.reason;
+      }
+    } catch (const Error&) {
+      // Refusing when nothing is stable is a correct answer; refusing a stable pinned one is not.
+      if (pinned && stable(*pinned)) {
+        ++check.stable_pinned_refused;
+        check.problem = std::string(how) + " refused a stable pinned configuration";
+      }
+    }
+  };
+  const RegionConfiguration own{scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
+                                scene.adaptivity.secondary_rate_hz};
+  verify("pinned to the scene's own configuration", nullptr, own);
+  verify("without a map", nullptr, std::nullopt);
+  verify("from a map calling four configurations fine", &lying, std::nullopt);
+  check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return check;
+}
+
+Json CaseJson(const StressOutcome& o) {
+  return {
+      {"index", o.stress_case.index},
+      {"description", DescribeStressCase(o.stress_case)},
+      {"step_over_limit", o.step_over_limit},
+      {"spectral_radius", std::isfinite(o.spectral_radius) ? Json(o.spectral_radius) : Json("inf")},
+      {"predicted_stable", o.predicted_stable},
+      {"bound_periods", o.bound_periods},
+      {"outcome", std::string(TrialOutcomeName(o.outcome))},
+      {"periods_run", o.periods_run},
+      {"diverged_region", o.diverged_region}};
+}
+
+int Run(const StressOptions& o) {
+  HAPTICSIM_THROW_UNLESS(o.count >= 1, "--count must be at least 1");
+  HAPTICSIM_THROW_UNLESS(o.ranges.min_nodes >= 3 && o.ranges.max_nodes >= o.ranges.min_nodes,
+                         "--nodes MIN MAX: need 3 <= MIN <= MAX");
+  const int first = o.only_case >= 0 ? o.only_case : 0;
+  const int count = o.only_case >= 0 ? 1 : o.count;
+  const int jobs =
+      std::max(1, std::min(count, o.jobs > 0 ? o.jobs
+                                             : static_cast<int>(std::max(
+                                                   1u, std::thread::hardware_concurrency()))));
+  std::vector<StressOutcome> outcomes(static_cast<size_t>(count));
+  std::vector<SupervisorCheck> checks(static_cast<size_t>(count));
+  std::atomic<int> next{0}, done{0};
+  std::mutex error_mutex;
+  std::string first_error;
+  const auto start = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (int i; (i = next++) < count;) {
+      try {
+        const StressCase c = DrawStressCase(o.seed, first + i, o.ranges);
+        outcomes[i] = RunStressCase(c, o.ranges);
+        if ((first + i) % o.supervisor_every == 0) checks[i] = CheckSupervisor(outcomes[i]);
+      } catch (const std::exception& e) {
+        std::lock_guard lock(error_mutex);
+        if (first_error.empty())
+          first_error = "case " + std::to_string(first + i) + ": " + e.what();
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
+  ProgressLine progress("stress", 10.0, "cases");
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  while (done < count) {
+    progress.Update(static_cast<size_t>(done.load()), static_cast<size_t>(count),
+                    static_cast<size_t>(done.load()), elapsed());
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  for (auto& thread : threads) thread.join();
+  progress.Update(static_cast<size_t>(count), static_cast<size_t>(count),
+                  static_cast<size_t>(count), elapsed());
+  progress.Finish();
+  HAPTICSIM_THROW_UNLESS(first_error.empty(), first_error);
+
+  long predicted_stable = 0, stable_diverged = 0, past_limit = 0, coupling_only = 0, unstable = 0,
+       detected = 0, undetected = 0, marginal = 0, marginal_detected = 0, region_is_past_limit = 0,
+       past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0;
+  double worst_detection_fraction = 0, slowest_case_s = 0, cases_s = 0, supervisor_s = 0;
+  Json failures = Json::array();
+  for (int i = 0; i < count; ++i) {
+    const StressOutcome& out = outcomes[i];
+    const SupervisorCheck& check = checks[i];
+    slowest_case_s = std::max(slowest_case_s, out.seconds + check.seconds);
+    cases_s += out.seconds;
+    supervisor_s += check.seconds;
+    choices += check.choices;
+    chose_unstable += check.chose_unstable;
+    pinned_refused += check.stable_pinned_refused;
+    if (out.predicted_stable) {
+      ++predicted_stable;
+      if (out.diverged()) ++stable_diverged;
+    } else {
+      ++unstable;
+      if (out.past_limit) ++past_limit;
+      if (out.coupling_only_unstable) ++coupling_only;
+      if (out.marginal) {
+        ++marginal;
+        if (out.diverged()) ++marginal_detected;
+      } else if (out.diverged()) {
+        ++detected;
+        worst_detection_fraction = std::max(
+            worst_detection_fraction, static_cast<double>(out.periods_run) / out.bound_periods);
+      } else {
+        ++undetected;
+      }
+      if (out.past_limit && out.diverged()) {
+        ++past_limit_diverged;
+        if (out.step_over_limit[static_cast<size_t>(out.diverged_region)] >= 1) {
+          ++region_is_past_limit;
+        }
+      }
+    }
+    if (out.stable_but_diverged() || out.divergence_undetected() || check.chose_unstable ||
+        check.stable_pinned_refused) {
+      Json entry = CaseJson(out);
+      if (!check.problem.empty()) entry["supervisor"] = check.problem;
+      failures.push_back(entry);
+    }
+  }
+  const bool passed =
+      stable_diverged == 0 && undetected == 0 && chose_unstable == 0 && pinned_refused == 0;
+  const double seconds = elapsed();
+  if (o.json) {
+    Json out = {{"count", count},
+                {"seed", o.seed},
+                {"predicted_stable", predicted_stable},
+                {"predicted_stable_diverged", stable_diverged},
+                {"predicted_unstable", unstable},
+                {"run_past_limit", past_limit},
+                {"coupling_only_unstable", coupling_only},
+                {"divergence_detected", detected},
+                {"divergence_undetected", undetected},
+                {"marginal", marginal},
+                {"marginal_detected", marginal_detected},
+                {"worst_detection_fraction_of_bound", worst_detection_fraction},
+                {"past_limit_diverged", past_limit_diverged},
+                {"diverged_region_past_its_limit", region_is_past_limit},
+                {"supervisor_choices", choices},
+                {"supervisor_chose_unstable", chose_unstable},
+                {"supervisor_refused_stable_pinned", pinned_refused},
+                {"seconds", seconds},
+                {"slowest_case_s", slowest_case_s},
+                {"prediction_and_run_s", cases_s},
+                {"supervisor_checks_s", supervisor_s},
+                {"passed", passed},
+                {"failures", failures}};
+    if (o.only_case >= 0) out["case"] = CaseJson(outcomes[0]);
+    std::cout << out.dump(2) << "\n";
+  } else {
+    if (o.only_case >= 0) {
+      const StressOutcome& out = outcomes[0];
+      std::cout << DescribeStressCase(out.stress_case) << "\n  step / own limit per region:";
+      for (double r : out.step_over_limit) std::cout << " " << r;
+      std::cout << "\n  coupled spectral radius " << out.spectral_radius << " per "
+                << out.common_period_s * 1e3 << " ms; predicted "
+                << (out.predicted_stable ? "stable" : "unstable")
+                << "\n  run: " << TrialOutcomeName(out.outcome) << " after " << out.periods_run
+                << " periods"
+                << (out.diverged() ? " (region " + std::to_string(out.diverged_region) + ")" : "")
+                << (out.predicted_stable ? "" : ", bound " + std::to_string(out.bound_periods))
+                << "\n";
+    }
+    std::cout << "stress: " << count << " cases (seed " << o.seed << ") in " << seconds
+              << " s (CPU: predictions and runs " << cases_s << " s, supervisor checks "
+              << supervisor_s << " s; slowest case " << slowest_case_s << " s)\n"
+              << "  predicted stable            " << predicted_stable << ", of which diverged "
+              << stable_diverged << "\n"
+              << "  predicted unstable          " << unstable << " (a region past its own limit "
+              << past_limit << ", only the coupling " << coupling_only << ")\n"
+              << "    divergence detected       " << detected << " (at most "
+              << worst_detection_fraction * 100 << " % of the predicted bound)\n"
+              << "    divergence undetected     " << undetected << "\n"
+              << "    too slow to detect        " << marginal << " (detected anyway "
+              << marginal_detected << ")\n"
+              << "    region reported is past its limit: " << region_is_past_limit << " of "
+              << past_limit_diverged << "\n"
+              << "  supervisor decisions        " << choices << ", unstable chosen "
+              << chose_unstable << ", stable pinned refused " << pinned_refused << "\n";
+    for (const Json& failure : failures) std::cout << "FAILED " << failure.dump() << "\n";
+    std::cout << (passed ? "passed\n" : "FAILED\n");
+  }
+  return passed ? kExitOk : kExitLimitsExceeded;
+}
+
+}  // namespace
+
+Command AddStressCommand(CLI::App& parent) {
+  auto options = std::make_shared<StressOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "stress",
+      "Numerical-stability stress test: random scenes and configurations (materials beyond the "
+      "paper's ranges, meshes, primary sizes, spacing factors, rates, coupling, steps around each "
+      "region's own limit, extreme inputs) predicted, then run from a random state; checks that "
+      "every predicted-stable one stays bounded, every unstable one is detected within its "
+      "predicted bound, and the supervisor never chooses an unstable one. Exit 4 when a check "
+      "fails.");
+  app->add_option("--count", options->count, "Number of random cases")->capture_default_str();
+  app->add_option("--seed", options->seed, "Seed of the draw (case i is the same for any --jobs)")
+      ->capture_default_str();
+  app->add_option("--jobs", options->jobs, "Worker threads (0: one per core)")
+      ->capture_default_str();
+  app->add_option("--case", options->only_case,
+                  "Run only case I of the seed and describe it (to reproduce a failure)");
+  app->add_option("--min-nodes", options->ranges.min_nodes, "Smallest mesh, nodes per axis")
+      ->capture_default_str();
+  app->add_option("--max-nodes", options->ranges.max_nodes, "Largest mesh, nodes per axis")
+      ->capture_default_str();
+  app->add_option("--stable-run", options->ranges.stable_run_s,
+                  "Simulated time of a predicted-stable run, s")
+      ->capture_default_str();
+  app->add_option("--max-run", options->ranges.max_run_s,
+                  "Longest simulated time of a predicted-unstable run, s")
+      ->capture_default_str();
+  app->add_option("--supervisor-every", options->supervisor_every,
+                  "Ask the supervisor to choose for every Nth case only (its checks cost several "
+                  "stability estimates each)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app->add_flag("--json", options->json, "One JSON object on stdout");
+  return {app, [options] { return Run(*options); }};
+}
+
+}  // namespace hapticsim::cli
