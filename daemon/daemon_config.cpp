@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -138,10 +139,13 @@ DaemonConfig DefaultDaemonConfig() {
   return config;
 }
 
-DaemonConfig LoadDaemonConfig(const std::string& path) {
+namespace {
+
+DaemonConfig ParseDaemonConfig(const std::string& path, const std::optional<std::string>& text,
+                               bool read_scene_file) {
   toml::table document;
   try {
-    document = toml::parse_file(path);
+    document = text ? toml::parse(*text, path) : toml::parse_file(path);
   } catch (const toml::parse_error& e) {
     if (e.source().begin.line == 0) {
       throw Error("cannot read config file " + path + ": " + std::string(e.description()));
@@ -168,6 +172,9 @@ DaemonConfig LoadDaemonConfig(const std::string& path) {
       setter->second(&config, value, at);
     }
   }
+  if (!config.scene_file.empty() && !read_scene_file) {
+    throw Error("config file " + path + ": scene.file is not read here");
+  }
   config.scene = config.scene_file.empty() ? Scene{} : LoadSceneFile(config.scene_file);
   DefaultAdaptivity(&config.scene);
   try {
@@ -176,6 +183,15 @@ DaemonConfig LoadDaemonConfig(const std::string& path) {
     throw Error("config file " + path + ": " + e.what());
   }
   return config;
+}
+
+}  // namespace
+
+DaemonConfig LoadDaemonConfig(const std::string& path) { return ParseDaemonConfig(path, {}, true); }
+
+DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& origin,
+                                   bool read_scene_file) {
+  return ParseDaemonConfig(origin, text, read_scene_file);
 }
 
 std::string FormatDaemonConfig(const DaemonConfig& c) {

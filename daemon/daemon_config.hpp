@@ -52,6 +52,14 @@ struct DaemonConfig {
  */
 DaemonConfig LoadDaemonConfig(const std::string& path);
 
+/**
+ * The same from a config file's text; `origin` names it in messages. Without read_scene_file a
+ * config naming a scene file is refused instead of reading it (the fuzz target: fuzzed text must
+ * not open arbitrary files).
+ */
+DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& origin,
+                                   bool read_scene_file = true);
+
 /** The defaults, as with an empty config file. */
 DaemonConfig DefaultDaemonConfig();
 

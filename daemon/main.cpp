@@ -31,6 +31,7 @@
 #include "core/error_map_file.hpp"
 #include "core/error_sweep.hpp"
 #include "daemon/black_box.hpp"
+#include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
@@ -330,15 +331,10 @@ int Serve(const Arguments& args) {
     }
     if (bridge) {
       while (std::optional<command_t> command = bridge->PopCommand()) {
-        switch (command->command) {
-          case command_t::SET_ERROR_TARGET:
-            if (!(std::isfinite(command->error_target_percent) &&
-                  command->error_target_percent > 0 && command->error_target_percent <= 100)) {
-              spdlog::warn("command SET_ERROR_TARGET {} refused: the target must be in (0, 100] %",
-                           command->error_target_percent);
-              break;
-            }
-            target = command->error_target_percent;
+        const CheckedCommand checked = CheckCommand(*command, PrimaryRateHz(config.scene));
+        switch (checked.kind) {
+          case CheckedCommand::Kind::kSetErrorTarget:
+            target = checked.error_target_percent;
             decision.target_met = decision.have_map && decision.error_percent <= target;
             loop.SetErrorState(decision.error_percent, active_flags());
             spdlog::info(
@@ -347,38 +343,25 @@ int Serve(const Arguments& args) {
                 target, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
             choose_again(pinned);
             break;
-          case command_t::PIN_CONFIGURATION: {
-            const RegionConfiguration pin{command->primary_size, command->secondary_lod,
-                                          command->secondary_rate_hz};
-            if (!(pin.primary_size >= 1 && pin.secondary_lod >= 1 &&
-                  std::isfinite(pin.secondary_rate_hz) && pin.secondary_rate_hz > 0 &&
-                  pin.secondary_rate_hz <= PrimaryRateHz(config.scene))) {
-              spdlog::warn(
-                  "command PIN_CONFIGURATION refused: primary_size {} and secondary_lod {} must "
-                  "be at least 1 and secondary_rate_hz {} in (0, {}] Hz",
-                  pin.primary_size, pin.secondary_lod, pin.secondary_rate_hz,
-                  PrimaryRateHz(config.scene));
-              break;
-            }
+          case CheckedCommand::Kind::kPinConfiguration:
             spdlog::info(
                 "command PIN_CONFIGURATION: verifying primary_size {}, secondary_lod {}, "
                 "secondary_rate {} Hz",
-                pin.primary_size, pin.secondary_lod, pin.secondary_rate_hz);
-            choose_again(pin);
+                checked.pin.primary_size, checked.pin.secondary_lod, checked.pin.secondary_rate_hz);
+            choose_again(checked.pin);
             break;
-          }
-          case command_t::RELEASE_CONFIGURATION:
+          case CheckedCommand::Kind::kReleaseConfiguration:
             spdlog::info("command RELEASE_CONFIGURATION: choosing freely again");
             pinned.reset();
             choose_again(std::nullopt);
             break;
-          case command_t::RESET:
+          case CheckedCommand::Kind::kReset:
             spdlog::info("command RESET: the simulation restarts from rest");
             restart_from_rest("RESET");
             break;
-          default:
-            spdlog::warn("command {} refused: unknown or not supported by this version",
-                         command->command);
+          case CheckedCommand::Kind::kRefused:
+            spdlog::warn("command {}", checked.refusal);
+            break;
         }
       }
     }

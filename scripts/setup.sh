@@ -14,6 +14,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   chromium
   xvfb
+  clang libclang-rt-14-dev
 )
 
 missing=()

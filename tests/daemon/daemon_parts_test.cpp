@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <tuple>
 
 #include "core/error.hpp"
+#include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
@@ -242,6 +244,57 @@ TEST(OverloadWatch, ARegionMissingDeadlinesForThreeSecondsIsReportedAndABurstIsN
   // No window closes before its second is over.
   watch.Count(0, 1000);
   EXPECT_EQ(watch.Check(9 * kS + kS / 2, rates), -1);
+}
+
+}  // namespace
+}  // namespace hapticsim
+
+namespace hapticsim {
+namespace {
+
+// Commands are input like any other: out-of-range fields and unknown commands are refused with the
+// reason, and nothing refused reaches the supervisor.
+TEST(CheckCommand, AcceptsWellFormedCommandsAndRefusesTheRestWithTheReason) {
+  command_t c{};
+  c.command = command_t::SET_ERROR_TARGET;
+  c.error_target_percent = 5;
+  EXPECT_EQ(CheckCommand(c, 1000).kind, CheckedCommand::Kind::kSetErrorTarget);
+  for (double bad : {0.0, -3.0, 100.5, double{NAN}, double{INFINITY}}) {
+    c.error_target_percent = bad;
+    const CheckedCommand checked = CheckCommand(c, 1000);
+    EXPECT_EQ(checked.kind, CheckedCommand::Kind::kRefused) << bad;
+    EXPECT_NE(checked.refusal.find("(0, 100] %"), std::string::npos) << checked.refusal;
+  }
+
+  c = command_t{};
+  c.command = command_t::PIN_CONFIGURATION;
+  c.primary_size = 3, c.secondary_lod = 2, c.secondary_rate_hz = 800;
+  const CheckedCommand pin = CheckCommand(c, 1000);
+  ASSERT_EQ(pin.kind, CheckedCommand::Kind::kPinConfiguration);
+  EXPECT_EQ(pin.pin, (RegionConfiguration{3, 2, 800}));
+  for (auto [size, lod, rate] : {std::tuple{0, 2, 800.0}, {3, 0, 800.0}, {3, 2, 1500.0},
+                                 {3, 2, 0.0}, {3, 2, double{NAN}}, {3, 2, 800.5}, {5000, 2, 800.0}}) {
+    c.primary_size = size, c.secondary_lod = lod, c.secondary_rate_hz = rate;
+    const CheckedCommand checked = CheckCommand(c, 1000);
+    EXPECT_EQ(checked.kind, CheckedCommand::Kind::kRefused) << size << " " << lod << " " << rate;
+    EXPECT_NE(checked.refusal.find("PIN_CONFIGURATION refused"), std::string::npos);
+  }
+
+  c = command_t{};
+  c.command = command_t::RELEASE_CONFIGURATION;
+  EXPECT_EQ(CheckCommand(c, 1000).kind, CheckedCommand::Kind::kReleaseConfiguration);
+  c.command = command_t::RESET;
+  EXPECT_EQ(CheckCommand(c, 1000).kind, CheckedCommand::Kind::kReset);
+  c.command = 99;
+  const CheckedCommand unknown = CheckCommand(c, 1000);
+  EXPECT_EQ(unknown.kind, CheckedCommand::Kind::kRefused);
+  EXPECT_NE(unknown.refusal.find("99 refused: unknown"), std::string::npos) << unknown.refusal;
+}
+
+TEST(DaemonConfig, TextFromFuzzingNamingASceneFileIsRefusedNotRead) {
+  EXPECT_THROW(ParseDaemonConfigText("[scene]\nfile = \"/dev/zero\"\n", "fuzz.toml", false),
+               Error);
+  EXPECT_NO_THROW(ParseDaemonConfigText("[scene]\nfile = \"\"\n", "fuzz.toml", false));
 }
 
 }  // namespace
