@@ -202,6 +202,7 @@ void AsyncRegions::Reset() {
     region->state_ticks = 0;
     region->compute_s = 0;
   }
+  primary_boundary_age_s_.store(0, std::memory_order_relaxed);
   PublishInitialSnapshots();
 }
 
@@ -240,6 +241,9 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     (void)region.inward->TryReadLatestTwo(&region.outer_newer, &region.outer_older);
     // The outer region is ahead: interpolate. If it is late, hold its newest state.
     const double t = std::min(t0 + h, region.outer_newer.time_s);
+    if (a == kPrimaryRegion) {
+      primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
+    }
     for (size_t i = 0; i < outer_gamma.size(); ++i) {
       region.prescribed_values[region.outer_offset + i] =
           OnLine(region.outer_older, region.outer_newer, static_cast<int>(i), t);
@@ -289,6 +293,19 @@ std::array<double, 3> AsyncRegions::StepPrimary(
 
 void AsyncRegions::StepRegion(RegionIndex region) noexcept {
   StepRegionAt(region, nullptr, nullptr);
+}
+
+void AsyncRegions::SkipRegion(RegionIndex a, std::int64_t steps) noexcept {
+  if (a == kPrimaryRegion || steps <= 0) return;
+  Region& region = *regions_[a];
+  // Published twice, one step apart, with the same values: a flat line, so a neighbour reading
+  // between them holds the state instead of interpolating towards the time before the stall.
+  region.state_ticks += (steps - 1) * region.period_ticks;
+  for (int twice = 0; twice < 2; ++twice) {
+    PublishInward(a);
+    if (region.inward) PublishOutward(a);
+    if (twice == 0) region.state_ticks += region.period_ticks;
+  }
 }
 
 void AsyncRegions::AdvanceRegionTo(RegionIndex a, std::int64_t ticks) noexcept {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -105,6 +106,21 @@ class AsyncRegions {
   /** A secondary region's thread: one step of region `region` ≥ 1. */
   void StepRegion(RegionIndex region) noexcept;
   /**
+   * A secondary region's thread, after a stall: moves the region's clock on by `steps` steps
+   * without stepping (its state is held, as its neighbours held its boundary meanwhile) and
+   * publishes its boundary at the new time. Stepping the missed steps late instead would couple it
+   * to its neighbours' present state with the stall's delay — a lag the stability estimate did
+   * not assume, and one that diverges (docs/reliability.md).
+   */
+  void SkipRegion(RegionIndex region, std::int64_t steps) noexcept;
+  /**
+   * How far the primary's newest boundary from region 1 was behind the primary's step time at
+   * its last step, s (0 with no secondary region). Any thread (relaxed atomic).
+   */
+  double primary_boundary_age_s() const noexcept {
+    return primary_boundary_age_s_.load(std::memory_order_relaxed);
+  }
+  /**
    * Virtual time: steps the secondary regions (outermost first, recursively) until region 1 can
    * supply Γ at `ticks`, as the primary's next step needs.
    */
@@ -158,6 +174,7 @@ class AsyncRegions {
   Coupling coupling_;
   std::vector<std::unique_ptr<Region>> regions_;
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
+  std::atomic<double> primary_boundary_age_s_{0};
 };
 
 }  // namespace hapticsim

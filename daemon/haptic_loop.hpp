@@ -138,6 +138,20 @@ class HapticLoop {
   /** Primary periods run on stale input, and force faults (non-finite or above max_force_n). */
   std::int64_t stale_periods() const { return stale_periods_.load(std::memory_order_relaxed); }
   std::int64_t force_faults() const { return force_faults_.load(std::memory_order_relaxed); }
+  /**
+   * A secondary region's stalls (woke more than kSkipAfterLatePeriods of its periods late) and the
+   * periods it skipped holding its state, since the loop was made. Any thread.
+   */
+  std::int64_t stalls(RegionIndex region) const {
+    return stalls_[region].load(std::memory_order_relaxed);
+  }
+  std::int64_t skipped_periods(RegionIndex region) const {
+    return skipped_periods_[region].load(std::memory_order_relaxed);
+  }
+  /** A secondary region woken more periods late than this skips them instead of stepping them. */
+  static constexpr int kSkipAfterLatePeriods = 3;
+  /** Regions a loop keeps counters for (a scene has at most 1 + 8). */
+  static constexpr int kMaxRegions = 16;
 
   /**
    * One primary period released at `release_ns`, run at `now_ns` (what the primary thread runs;
@@ -172,6 +186,7 @@ class HapticLoop {
   std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0},
       paused_periods_{0};
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
+  std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;
   std::vector<std::thread> secondary_threads_;
   std::vector<std::int64_t> lead_ns_;

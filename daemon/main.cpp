@@ -251,6 +251,11 @@ int Serve(const Arguments& args) {
     }
   };
   OverloadWatch overload;  // a region missing deadlines second after second
+  // Per region, as last logged.
+  std::array<std::int64_t, HapticLoop::kMaxRegions> stalls_seen{}, skipped_seen{};
+  // A boundary older than this means a secondary thread is not running at all.
+  constexpr double kStaleBoundary_s = 0.5;
+  bool boundary_stale = false;
   std::int64_t last_overload_line_ns = 0;
   // The cost of a configuration the map has nothing cheaper than: not asked again.
   double cheapest_cost_us_per_ms = -1;
@@ -304,6 +309,31 @@ int Serve(const Arguments& args) {
       break;
     }
     black_box.Drain(loop);
+    // A secondary region that stalled held its state over the periods it missed (HapticLoop).
+    for (int r = 1; r < loop.regions().num_regions(); ++r) {
+      if (loop.stalls(r) == stalls_seen[r]) continue;
+      spdlog::warn(
+          "{} region stalled: it held its state over {} of its periods instead of stepping them "
+          "late (the primary held its boundary meanwhile); {} stall(s) so far",
+          loop.regions().partition().RegionName(r), loop.skipped_periods(r) - skipped_seen[r],
+          loop.stalls(r));
+      stalls_seen[r] = loop.stalls(r);
+      skipped_seen[r] = loop.skipped_periods(r);
+    }
+    // A secondary thread that does not run at all: the primary renders on its held boundary.
+    const double boundary_age_s = loop.regions().primary_boundary_age_s();
+    if (boundary_age_s > kStaleBoundary_s && !boundary_stale) {
+      spdlog::error(
+          "the primary's boundary from the secondary region is {:.2f} s old: its thread is not "
+          "running; the primary renders on the held boundary (the primary region alone, stable "
+          "by its own limit)",
+          boundary_age_s);
+      boundary_stale = true;
+    } else if (boundary_age_s < kStaleBoundary_s && boundary_stale) {
+      spdlog::info("the secondary region runs again (its boundary is {:.1f} ms old)",
+                   boundary_age_s * 1e3);
+      boundary_stale = false;
+    }
     for (int r = 0; r < loop.regions().num_regions(); ++r) {
       DeadlineEvent event;
       int misses = 0;
