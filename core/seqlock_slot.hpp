@@ -30,7 +30,10 @@ class SeqlockSlot {
   void Write(const T& value) noexcept {
     std::array<std::uint64_t, kWords> words{};
     std::memcpy(words.data(), &value, sizeof(T));
-    const std::uint64_t seq = sequence_.load(std::memory_order_relaxed);
+    std::uint64_t seq = sequence_.load(std::memory_order_relaxed);
+    // Odd here: the previous writer (another process, over shared memory) died mid-write. Start
+    // from the next even value, or every write from now on would read as torn.
+    if (seq & 1) ++seq;
     sequence_.store(seq + 1, std::memory_order_relaxed);  // odd: writing
     std::atomic_thread_fence(std::memory_order_release);
     for (size_t i = 0; i < kWords; ++i) words_[i].store(words[i], std::memory_order_relaxed);

@@ -29,6 +29,7 @@
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "ipc/shm_device_client.hpp"
 #include "tests/support/run_command.hpp"
 
 namespace hapticsim {
@@ -443,6 +444,56 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
   const auto after = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name});
   EXPECT_EQ(after.exit_status, 2);
   EXPECT_NE(after.err.find("cannot open shared memory"), std::string::npos) << after.err;
+}
+
+// A driver that dies mid-write leaves the input slot's sequence odd ("being written") for good:
+// the daemon reads nothing more from it, flags the input stale and renders no force; a restarted
+// driver is served again.
+TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestartedOneIsServed) {
+  const std::string name = "/hapticsim-e2e-dead-" + std::to_string(getpid());
+  const std::string config = Temp("shm_dead.toml");
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+                        << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm_dead.log"));
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
+    ASSERT_TRUE(daemon.running()) << daemon.Log();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // Above the front face's middle, then 5 mm in, one input per millisecond; the newest answer.
+  auto press = [&](shm::ShmDeviceClient& driver) {
+    for (int n = 0; n < 600; ++n) {
+      const double z = n < 50 ? -0.002 : std::min(0.005, 1e-5 * (n - 50));
+      driver.WriteInput(n, 0, {0.125, 0.125, z});
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    shm::ShmForceOutput answer;
+    EXPECT_TRUE(driver.ReadForce(&answer));
+    return answer;
+  };
+  shm::ShmDeviceClient first(name);
+  const shm::ShmForceOutput pressed = press(first);
+  EXPECT_TRUE(pressed.flags & force_feedback_t::FLAG_IN_CONTACT) << pressed.flags;
+  EXPECT_LT(pressed.force_n[2], -0.5);
+
+  // It dies between the two sequence stores of a write. (The slot's sequence is its first word,
+  // core/seqlock_slot.hpp: this store leaves it exactly as such a death does.)
+  shm::MappedSegment view = shm::MappedSegment::Open(name);
+  auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(&view.segment().input);
+  sequence.store(sequence.load() + 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // > stale_after_s, > a session
+  shm::ShmForceOutput expired;
+  ASSERT_TRUE(first.ReadForce(&expired));
+  EXPECT_TRUE(expired.flags & force_feedback_t::FLAG_INPUT_STALE) << expired.flags;
+  EXPECT_EQ(expired.force_n[2], 0.0);
+
+  shm::ShmDeviceClient restarted(name);
+  const shm::ShmForceOutput again = press(restarted);
+  EXPECT_FALSE(again.flags & force_feedback_t::FLAG_INPUT_STALE) << again.flags;
+  EXPECT_TRUE(again.flags & force_feedback_t::FLAG_IN_CONTACT) << again.flags;
+  EXPECT_LT(again.force_n[2], -0.3);  // pushes back (the object had not settled: not equal)
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
 TEST(HapticsimdSharedMemory, AClientRefusesASegmentThatIsNotHapticsimds) {

@@ -46,6 +46,28 @@ TEST(SeqlockSlot, ReadersNeverSeeATornValue) {
   EXPECT_GE(reads.load(), kReadsWanted);
 }
 
+// Over shared memory the writer is another process, which can die between the two sequence
+// stores: the slot is left odd ("being written") for good. Readers must read nothing from it,
+// and the next writer (a restarted driver) must be read again.
+TEST(SeqlockSlot, AWriterThatDiedMidWriteLeavesNothingReadableAndTheNextWriterIsRead) {
+  SeqlockSlot<Checked> slot;
+  slot.Write({1, 2, 3});
+  // The sequence is the slot's first member (core/seqlock_slot.hpp): a death mid-write leaves it
+  // odd, exactly as this store does.
+  auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(&slot);
+  ASSERT_EQ(sequence.load() % 2, 0u);
+  sequence.store(sequence.load() + 1);
+  Checked value;
+  EXPECT_FALSE(slot.Read(&value)) << "a half-written value was read";
+  slot.Write({4, 8, 12});  // the restarted writer
+  ASSERT_TRUE(slot.Read(&value));
+  EXPECT_EQ(value.a, 4);
+  EXPECT_EQ(value.c, 12);
+  slot.Write({5, 10, 15});
+  ASSERT_TRUE(slot.Read(&value));
+  EXPECT_EQ(value.a, 5);
+}
+
 TEST(SpscRing, DeliversInOrderAndCountsWhatAFullRingDrops) {
   SpscRing<Checked, 1024> ring;
   std::atomic<bool> done{false};
