@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/mman.h>
+#include <sys/ptrace.h>
+#include <sys/wait.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -509,7 +511,19 @@ TEST(HapticsimdSharedMemory, AClientRefusesASegmentThatIsNotHapticsimds) {
 }
 
 // The systemd protocol without systemd: the test is the notify socket.
-TEST(HapticsimdSystemd, ReportsReadyPingsTheWatchdogWhileServingAndSaysWhenStopping) {
+// The kernel thread id of process `pid`'s thread named `name` (-1: none).
+pid_t ThreadOf(int pid, const std::string& name) {
+  const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
+  for (const auto& task : std::filesystem::directory_iterator(tasks)) {
+    std::ifstream comm(task.path() / "comm");
+    std::string comm_name;
+    std::getline(comm, comm_name);
+    if (comm_name == name) return static_cast<pid_t>(std::stol(task.path().filename().string()));
+  }
+  return -1;
+}
+
+TEST(HapticsimdSystemd, PingsTheWatchdogWhileServingNotWhileThePrimaryHangsAndSaysWhenStopping) {
   const std::string socket_path = Temp("notify.sock");
   std::filesystem::remove(socket_path);
   const int fd = socket(AF_UNIX, SOCK_DGRAM, 0);
@@ -544,6 +558,24 @@ TEST(HapticsimdSystemd, ReportsReadyPingsTheWatchdogWhileServingAndSaysWhenStopp
   EXPECT_EQ(messages.front().rfind("READY=1", 0), 0u) << messages.front();
   const auto pings = std::count(messages.begin(), messages.end(), "WATCHDOG=1");
   EXPECT_GE(pings, 10) << daemon.Log();
+
+  // A hung primary loop: its thread alone stopped (ptrace stops one thread, not the process).
+  // The pings stop while it hangs, so systemd would restart the daemon; they resume with it.
+  const pid_t primary = ThreadOf(daemon.pid(), "hsim-primary");
+  ASSERT_GT(primary, 0) << "no thread named hsim-primary in the daemon";
+  ASSERT_EQ(ptrace(PTRACE_SEIZE, primary, nullptr, nullptr), 0) << std::strerror(errno);
+  ASSERT_EQ(ptrace(PTRACE_INTERRUPT, primary, nullptr, nullptr), 0) << std::strerror(errno);
+  int stop_status = 0;
+  ASSERT_EQ(waitpid(primary, &stop_status, __WALL), primary);
+  receive_for(0.2);  // a ping already on its way, or due before the loop looks, may still come
+  messages.clear();
+  receive_for(1.0);
+  const auto hung_pings = std::count(messages.begin(), messages.end(), "WATCHDOG=1");
+  ptrace(PTRACE_DETACH, primary, nullptr, nullptr);
+  EXPECT_EQ(hung_pings, 0) << "the watchdog was pinged while the primary loop hung";
+  messages.clear();
+  receive_for(1.0);
+  EXPECT_GE(std::count(messages.begin(), messages.end(), "WATCHDOG=1"), 5) << daemon.Log();
   daemon.Signal(SIGTERM);
   receive_for(1);
   EXPECT_EQ(daemon.Wait(5), 0);

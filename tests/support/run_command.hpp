@@ -25,6 +25,7 @@ class BackgroundProcess {
   int Wait(double timeout_s);
   bool running();
   std::string Log() const;
+  int pid() const { return pid_; }
 
  private:
   int pid_ = -1;
