@@ -199,6 +199,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       force_faults_.fetch_add(1, std::memory_order_relaxed);
     }
   }
+  if (regions_->primary_boundary_age_s() > kStaleBoundary_s) flags |= force_flags::kBoundaryStale;
   if (in_contact) {
     flags |= force_flags::kInContact;
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);

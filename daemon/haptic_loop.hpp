@@ -55,6 +55,7 @@ inline constexpr std::int32_t kInputStale = 8;
 inline constexpr std::int32_t kReconfiguring = 16;
 inline constexpr std::int32_t kNoErrorMap = 32;
 inline constexpr std::int32_t kInputRejected = 64;
+inline constexpr std::int32_t kBoundaryStale = 128;
 }  // namespace force_flags
 
 /**
@@ -150,6 +151,11 @@ class HapticLoop {
   }
   /** A secondary region woken more periods late than this skips them instead of stepping them. */
   static constexpr int kSkipAfterLatePeriods = 3;
+  /**
+   * The primary's boundary from region 1 older than this means the secondary thread is not
+   * running: every answer is flagged kBoundaryStale (the supervisor logs it too).
+   */
+  static constexpr double kStaleBoundary_s = 0.1;
   /** Regions a loop keeps counters for (a scene has at most 1 + 8). */
   static constexpr int kMaxRegions = 16;
 

@@ -253,9 +253,7 @@ int Serve(const Arguments& args) {
   OverloadWatch overload;  // a region missing deadlines second after second
   // Per region, as last logged.
   std::array<std::int64_t, HapticLoop::kMaxRegions> stalls_seen{}, skipped_seen{};
-  // A boundary older than this means a secondary thread is not running at all.
-  constexpr double kStaleBoundary_s = 0.5;
-  bool boundary_stale = false;
+  bool boundary_stale = false;  // the secondary region has not run for kStaleBoundary_s
   std::int64_t last_overload_line_ns = 0;
   // The cost of a configuration the map has nothing cheaper than: not asked again.
   double cheapest_cost_us_per_ms = -1;
@@ -322,14 +320,14 @@ int Serve(const Arguments& args) {
     }
     // A secondary thread that does not run at all: the primary renders on its held boundary.
     const double boundary_age_s = loop.regions().primary_boundary_age_s();
-    if (boundary_age_s > kStaleBoundary_s && !boundary_stale) {
+    if (boundary_age_s > HapticLoop::kStaleBoundary_s && !boundary_stale) {
       spdlog::error(
           "the primary's boundary from the secondary region is {:.2f} s old: its thread is not "
           "running; the primary renders on the held boundary (the primary region alone, stable "
-          "by its own limit)",
+          "by its own limit), its forces flagged boundary stale",
           boundary_age_s);
       boundary_stale = true;
-    } else if (boundary_age_s < kStaleBoundary_s && boundary_stale) {
+    } else if (boundary_age_s < HapticLoop::kStaleBoundary_s && boundary_stale) {
       spdlog::info("the secondary region runs again (its boundary is {:.1f} ms old)",
                    boundary_age_s * 1e3);
       boundary_stale = false;

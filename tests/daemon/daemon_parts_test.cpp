@@ -73,6 +73,7 @@ TEST(LcmTypes, TheDaemonsForceFlagsAreTheMessageConstants) {
   EXPECT_EQ(force_flags::kReconfiguring, force_feedback_t::FLAG_RECONFIGURING);
   EXPECT_EQ(force_flags::kNoErrorMap, force_feedback_t::FLAG_NO_ERROR_MAP);
   EXPECT_EQ(force_flags::kInputRejected, force_feedback_t::FLAG_INPUT_REJECTED);
+  EXPECT_EQ(force_flags::kBoundaryStale, force_feedback_t::FLAG_BOUNDARY_STALE);
 }
 
 std::string ConfigError(const std::string& text) {

@@ -59,6 +59,7 @@ struct StallRun {
   std::vector<ForceRecord> forces;
   double largest_jump_n = 0, final_force_n = 0, oldest_boundary_s = 0;
   std::int64_t stalls = 0, skipped = 0;
+  int flagged_stale = 0;  // answers flagged kBoundaryStale
 };
 
 // Above the front face's middle node for 0.1 s, in at 10 mm/s for 0.3 s, then held for 1.1 s;
@@ -105,6 +106,7 @@ StallRun Press(Stall stall) {
   run.skipped = loop.skipped_periods(1);
   double previous = 0;
   for (const ForceRecord& f : run.forces) {
+    if (f.flags & force_flags::kBoundaryStale) ++run.flagged_stale;
     if (!std::isfinite(f.force_n[2])) continue;
     run.largest_jump_n = std::max(run.largest_jump_n, std::abs(f.force_n[2] - previous));
     previous = f.force_n[2];
@@ -127,23 +129,30 @@ TEST(SecondaryStall, ThePrimaryAnswersOnTheHeldBoundaryAndTheRegionCarriesOnFrom
       stalled.final_force_n, stalled.oldest_boundary_s * 1e3,
       static_cast<long long>(stalled.stalls), static_cast<long long>(stalled.skipped));
 
-  // Seen: the primary's boundary aged through the stall, and the region counted it.
+  for (const StallRun* run : {&calm, &stalled, &lagging}) {
+    for (const ForceRecord& f : run->forces) {
+      ASSERT_TRUE(std::isfinite(f.force_n[0] + f.force_n[1] + f.force_n[2]));
+    }
+  }
+  // Under a sanitizer every step is many times slower than its period and signals wait for the
+  // sanitizer's safe points: the run checks the threads' hand-over (what the sanitizer is for),
+  // not the timing. (Measured under TSan: the primary answered 716 of 1,500 periods and the
+  // secondary was more than 3 periods late 68 times without any stall injected.)
+  if (kSanitized) return;
+  // Seen: the primary's boundary aged through the stall, the region counted it, the answers
+  // from 0.1 s into the stall until the region ran again were flagged.
   EXPECT_GT(stalled.oldest_boundary_s, 0.2);
   EXPECT_GE(stalled.stalls, 1);
   EXPECT_GT(stalled.skipped, 0.2 * 600);  // most of 0.3 s at 600 Hz
+  EXPECT_GT(stalled.flagged_stale, 150);
+  EXPECT_LT(stalled.flagged_stale, 250);
+  EXPECT_GE(lagging.stalls, 10);
   // Every period answered: one answer per release across the stall.
   ASSERT_GT(stalled.forces.size(), 1000u);
   const double span = (stalled.forces.back().utime_us - stalled.forces.front().utime_us) / 1000.0;
   EXPECT_NEAR(static_cast<double>(stalled.forces.size()) - 1, span, std::max(2.0, 0.005 * span));
-  for (const ForceRecord& f : stalled.forces) {
-    ASSERT_TRUE(std::isfinite(f.force_n[0] + f.force_n[1] + f.force_n[2]));
-  }
-  EXPECT_GE(lagging.stalls, 10);
-  for (const ForceRecord& f : lagging.forces) {
-    ASSERT_TRUE(std::isfinite(f.force_n[0] + f.force_n[1] + f.force_n[2]));
-  }
-  if (kSanitized) return;
   EXPECT_EQ(calm.stalls, 0);
+  EXPECT_EQ(calm.flagged_stale, 0);
   // Bounded through a stall: measured here 0.045 N (as the calm press) in four runs of five and
   // 0.17 N in one, against 0.30 and 0.56 N with the missed periods stepped late (kept in
   // docs/reliability.md; too close to timing to assert more than a safe bound). Afterwards the

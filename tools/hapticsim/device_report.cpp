@@ -16,6 +16,7 @@ constexpr std::pair<std::int32_t, const char*> kFlagNames[] = {
     {force_feedback_t::FLAG_RECONFIGURING, "reconfiguring"},
     {force_feedback_t::FLAG_NO_ERROR_MAP, "no error map"},
     {force_feedback_t::FLAG_INPUT_REJECTED, "input rejected"},
+    {force_feedback_t::FLAG_BOUNDARY_STALE, "boundary stale"},
 };
 
 nlohmann::json LatencyJson(const device::LatencySummary& l) {
