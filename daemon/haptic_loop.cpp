@@ -181,6 +181,10 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       const std::array<double, 3> r = regions_->StepPrimary(contact.displacement_m);
       if (q == 1) reaction = r;
     }
+    // Only here: while paused for a reconfiguration the regions are not the primary's to read.
+    if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
+      flags |= force_flags::kBoundaryStale;
+    }
   }
   ForceRecord out;
   out.period = periods_run_++;
@@ -199,7 +203,6 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       force_faults_.fetch_add(1, std::memory_order_relaxed);
     }
   }
-  if (regions_->primary_boundary_age_s() > kStaleBoundary_s) flags |= force_flags::kBoundaryStale;
   if (in_contact) {
     flags |= force_flags::kInContact;
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);
