@@ -44,6 +44,15 @@ std::string Temp(const std::string& name) {
   return ::testing::TempDir() + "hapticsimd_e2e_" + name;
 }
 
+// Waits until the daemon logs that it serves (startup estimates stability first), at most 30 s.
+void WaitUntilServing(testing::BackgroundProcess& daemon) {
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
+    ASSERT_TRUE(daemon.running()) << daemon.Log();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 // A two-configuration map for the default scene, made by the real sweep (a few seconds): the
 // primary sizes 1 (cheaper, about 2.7 % error) and 3 (about 0.4 %).
 const std::string& SmallMap() {
@@ -412,11 +421,7 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
   std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
                         << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm.log"));
-  const auto deadline = Clock::now() + std::chrono::seconds(30);
-  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
-    ASSERT_TRUE(daemon.running()) << daemon.Log();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   struct stat info {};
   ASSERT_EQ(stat(("/dev/shm" + name).c_str(), &info), 0);
   EXPECT_EQ(info.st_mode & 0777, 0660u) << "owner and group only";
@@ -457,11 +462,7 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
   std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
                         << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm_dead.log"));
-  const auto deadline = Clock::now() + std::chrono::seconds(30);
-  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
-    ASSERT_TRUE(daemon.running()) << daemon.Log();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   // Above the front face's middle, then 5 mm in, one input per millisecond; the newest answer.
   auto press = [&](shm::ShmDeviceClient& driver) {
     for (int n = 0; n < 600; ++n) {
@@ -596,11 +597,7 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
   const std::string config = Temp("device.toml");
   std::ofstream(config) << "[shm]\nenabled = true\nname = \"" << name << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("device.log"));
-  const auto deadline = Clock::now() + std::chrono::seconds(30);
-  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
-    ASSERT_TRUE(daemon.running()) << daemon.Log();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   // Record the LCM session while the device presses over LCM.
   const std::string log = Temp("session.lcmlog");
   std::filesystem::remove(log);
