@@ -28,6 +28,8 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
       nodes_(scene.mesh.nodes),
       contact_(scene.mesh, options.engage_ramp_s) {
   Install(scene, std::make_unique<AsyncRegions>(scene));
+  tip_ =
+      InputResampler(primary_period_ns_ * 1e-9, kMaxPredictedPeriods * primary_period_ns_ * 1e-9);
 }
 
 HapticLoop::~HapticLoop() { Stop(); }
@@ -118,13 +120,9 @@ void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcep
 void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
   DeviceSample sample;
   if (input_.Read(&sample)) {
-    if (sample.seq != last_input_.seq) {
-      if (last_input_.seq >= 0) previous_input_ = last_input_;
-      periods_since_input_ = 0;
-    }
+    if (sample.seq != last_input_.seq) tip_.Add(sample.seq, sample.received_ns, sample.position_m);
     last_input_ = sample;
   }
-  if (periods_since_input_ < kMaxPredictedPeriods + 1) ++periods_since_input_;
   const bool have = last_input_.seq >= 0;
   const bool stale =
       !have || static_cast<double>(now_ns - last_input_.received_ns) > options_.stale_after_s * 1e9;
@@ -159,12 +157,14 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     flags |= force_flags::kReconfiguring;
   }
 
-  // Stale input holds the contact where it was; fresh input moves it.
+  // Stale input holds the contact where it was; fresh input moves it. Both on the release grid,
+  // not on when this thread woke: a period woken late must not hurry the tip or the engage ramp
+  // (the driven node's inertia turns an uneven step into a force spike).
   const std::optional<LatticeIndex> centre =
       usable ? std::optional<LatticeIndex>(centre_) : std::nullopt;
-  const ContactTracker::Contact contact = have && !stale
-                                              ? contact_.Update(PredictedTip(), now_ns, centre)
-                                              : contact_.Hold(now_ns, centre);
+  const ContactTracker::Contact contact =
+      have && !stale ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
+                     : contact_.Hold(release_ns, centre);
   const bool in_contact = contact.engaged && usable;
   if (contact.waiting) flags |= force_flags::kReconfiguring;
   contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
@@ -216,23 +216,6 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   box.error_percent = out.error_percent;
   box.flags = flags;
   black_box_.Push(box);
-}
-
-std::array<double, 3> HapticLoop::PredictedTip() const noexcept {
-  // periods_since_input_ is 1 in the period a new input arrived.
-  const int ahead = periods_since_input_ - 1;
-  const std::int64_t device_periods = last_input_.seq - previous_input_.seq;
-  if (ahead < 1 || ahead > kMaxPredictedPeriods || previous_input_.seq < 0 || device_periods < 1 ||
-      device_periods > kMaxPredictedPeriods) {
-    return last_input_.position_m;
-  }
-  std::array<double, 3> tip = last_input_.position_m;
-  for (int c = 0; c < 3; ++c) {
-    const double per_period =
-        (last_input_.position_m[c] - previous_input_.position_m[c]) / device_periods;
-    tip[c] += per_period * ahead;
-  }
-  return tip;
 }
 
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {

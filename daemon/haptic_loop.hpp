@@ -13,6 +13,7 @@
 #include "core/seqlock_slot.hpp"
 #include "daemon/contact_tracker.hpp"
 #include "daemon/deadline_monitor.hpp"
+#include "daemon/input_resampler.hpp"
 #include "daemon/spsc_ring.hpp"
 
 namespace hapticsim {
@@ -212,18 +213,15 @@ class HapticLoop {
   std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none
   std::atomic<bool> contact_waiting_{false};
 
-  // Input that arrives late by a period or two (a network or a scheduler's jitter) would hold the
-  // tip still for a period and then jump: the node's inertia turns that into force chatter. A
-  // period without new input continues the tip at its last velocity (per device period, one seq
-  // per primary period) for at most this many periods, then holds it.
+  // Input arrives with jitter: the tip the primary drives is the device's, resampled at each
+  // release on the device's own timeline (one seq per primary period), continued for at most
+  // this many periods past the newest input and then held.
   static constexpr int kMaxPredictedPeriods = 3;
-  std::array<double, 3> PredictedTip() const noexcept;
 
   // Primary thread state.
   ContactTracker contact_;
-  DeviceSample previous_input_;   // the accepted input before last_input_
+  InputResampler tip_{1e-3, kMaxPredictedPeriods * 1e-3};  // re-made for the primary's period
   std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
-  int periods_since_input_ = 0;
   DeviceSample last_input_;
 };
 

@@ -1,0 +1,62 @@
+#include "daemon/input_resampler.hpp"
+
+#include <algorithm>
+
+namespace hapticsim {
+
+InputResampler::InputResampler(double device_period_s, double max_ahead_s) noexcept
+    : period_ns_(device_period_s * 1e9), max_ahead_ns_(max_ahead_s * 1e9) {}
+
+void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
+                         const std::array<double, 3>& position_m) noexcept {
+  if (count_ > 0 && seq <= newest_seq_) Reset();  // a restarted driver: its own new timeline
+  const double device_ns = static_cast<double>(seq) * period_ns_;
+  const double latency_ns = static_cast<double>(received_ns) - device_ns;
+  if (count_ > 0 && latency_ns > latency_floor_ns_ + kRelock_ns) Reset();
+  if (count_ > 0) before_ = newest_;
+  latencies_ns_[next_latency_] = latency_ns;
+  next_latency_ = (next_latency_ + 1) % kLatencyWindow;
+  latencies_ = std::min(latencies_ + 1, kLatencyWindow);
+  latency_floor_ns_ = LatencyFloor();
+  newest_ = {device_ns, position_m};
+  newest_seq_ = seq;
+  count_ = std::min(count_ + 1, 2);
+}
+
+double InputResampler::LatencyFloor() const noexcept {
+  // The ring in order, oldest first; the latencies are one seq apart only if no input was lost,
+  // which is close enough for a trend (a lost input makes the trend look a little steeper).
+  auto at = [this](int i) {
+    return latencies_ns_[(next_latency_ - latencies_ + i + kLatencyWindow) % kLatencyWindow];
+  };
+  // How much later each seq arrives than the one before, from the quickest of each half.
+  double trend_ns = 0;
+  const int half = latencies_ / 2;
+  if (half >= 2) {
+    double older = at(0), newer = at(half);
+    for (int i = 1; i < half; ++i) older = std::min(older, at(i));
+    for (int i = half + 1; i < 2 * half; ++i) newer = std::min(newer, at(i));
+    trend_ns = std::max(0.0, (newer - older) / half);
+  }
+  double floor_ns = at(latencies_ - 1);
+  for (int i = 0; i < latencies_; ++i) {
+    floor_ns = std::min(floor_ns, at(i) + trend_ns * (latencies_ - 1 - i));
+  }
+  return floor_ns;
+}
+
+std::array<double, 3> InputResampler::TipAt(std::int64_t at_ns) const noexcept {
+  if (count_ < 2) return newest_.position_m;
+  // On the device's timeline, one device period back; never before the older input, never
+  // further past the newest than the prediction may go.
+  const double t = std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
+                              before_.device_ns, newest_.device_ns + max_ahead_ns_);
+  const double u = (t - before_.device_ns) / (newest_.device_ns - before_.device_ns);
+  std::array<double, 3> tip{};
+  for (int c = 0; c < 3; ++c) {
+    tip[c] = before_.position_m[c] + u * (newest_.position_m[c] - before_.position_m[c]);
+  }
+  return tip;
+}
+
+}  // namespace hapticsim
