@@ -6,10 +6,10 @@
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/ptrace.h>
-#include <sys/wait.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +32,7 @@
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
 #include "ipc/shm_device_client.hpp"
+#include "tests/support/late_wakes.hpp"
 #include "tests/support/run_command.hpp"
 
 namespace hapticsim {
@@ -293,9 +294,14 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
   EXPECT_GE(status->reconfigurations, 1);
   EXPECT_NE(daemon_->Log().find("regions centred on contact node (2, 3, 0)"), std::string::npos)
       << daemon_->Log();
-  int waited = 0, pushing_back = 0;
+  int waited = 0, pushing_back = 0, near_late = 0;
   double previous = 0, largest_jump = 0;
-  for (const force_feedback_t& f : client.Forces()) {
+  const std::vector<force_feedback_t> forces = client.Forces();
+  std::vector<Wake> wakes;
+  for (const force_feedback_t& f : forces) wakes.push_back({f.period, f.utime});
+  const std::vector<bool> near_late_wake = NearALateWake(wakes);
+  for (size_t i = 0; i < forces.size(); ++i) {
+    const force_feedback_t& f = forces[i];
     ASSERT_TRUE(std::isfinite(f.force[2]));
     if (!(f.flags & force_feedback_t::FLAG_IN_CONTACT)) {
       EXPECT_EQ(f.force[2], 0.0) << "force without contact at seq " << f.seq;
@@ -306,12 +312,18 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
       if (f.seq > 1300 && f.force[2] < -0.3) ++pushing_back;
     }
     if (f.flags & force_feedback_t::FLAG_INPUT_STALE) continue;  // zeroed once the device stops
-    largest_jump = std::max(largest_jump, std::abs(f.force[2] - previous));
+    if (near_late_wake[i]) {
+      ++near_late;  // the machine's hiccup, not the re-centring's (tests/support/late_wakes.hpp)
+    } else {
+      largest_jump = std::max(largest_jump, std::abs(f.force[2] - previous));
+    }
     previous = f.force[2];
   }
   EXPECT_GT(waited, 10) << "the touch should wait for its regions";
   EXPECT_GT(pushing_back, 100) << daemon_->Log();
   EXPECT_LT(largest_jump, 0.1) << "a force step across the re-centring";
+  EXPECT_LT(near_late, static_cast<int>(forces.size()) / 4)
+      << "answers from periods woken late, of " << forces.size();
   daemon_->Signal(SIGTERM);
   EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
 }

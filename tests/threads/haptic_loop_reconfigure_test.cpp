@@ -12,6 +12,7 @@
 
 #include "daemon/haptic_loop.hpp"
 #include "daemon/supervisor.hpp"
+#include "tests/support/late_wakes.hpp"
 
 namespace hapticsim {
 namespace {
@@ -91,7 +92,8 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
 
 struct PressResult {
   std::vector<ForceRecord> forces;
-  double largest_jump_n = 0;  // largest force change between consecutive periods
+  double largest_jump_n = 0;  // largest force change between periods woken on time
+  int near_late_wakes = 0;    // answers from a period woken late or just after one
   double final_force_n = 0;
   bool moved = false;
 };
@@ -123,10 +125,18 @@ PressResult PressAt(const LatticeIndex& node, const LatticeIndex& centre) {
   supervisor.join();
   loop.Stop();
   EXPECT_EQ(loop.centre_node(), node);
+  std::vector<Wake> wakes;
+  for (const ForceRecord& f : result.forces) wakes.push_back({f.period, f.utime_us});
+  const std::vector<bool> near_late = NearALateWake(wakes);
   double previous = 0;
-  for (const ForceRecord& f : result.forces) {
-    result.largest_jump_n = std::max(result.largest_jump_n, std::abs(f.force_n[2] - previous));
-    previous = f.force_n[2];
+  for (size_t i = 0; i < result.forces.size(); ++i) {
+    const double force = result.forces[i].force_n[2];
+    if (near_late[i]) {
+      ++result.near_late_wakes;
+    } else {
+      result.largest_jump_n = std::max(result.largest_jump_n, std::abs(force - previous));
+    }
+    previous = force;
   }
   result.final_force_n = previous;
   result.moved = moved;
@@ -162,8 +172,14 @@ TEST(HapticLoopReconfigure, ATouchOnAnotherNodeIsAnsweredAfterRecentringWithoutA
   const double step_if_not_ramped = std::abs(moved.final_force_n) * 0.002 / 0.006;
   std::printf(
       "largest force change between periods: %.4f N re-centred, %.4f N centred from the "
-      "start; unramped the waiting depth would step by %.3f N\n",
-      moved.largest_jump_n, centred.largest_jump_n, step_if_not_ramped);
+      "start; unramped the waiting depth would step by %.3f N (answers near a late wake, left "
+      "out: %d and %d of %zu)\n",
+      moved.largest_jump_n, centred.largest_jump_n, step_if_not_ramped, moved.near_late_wakes,
+      centred.near_late_wakes, moved.forces.size());
+  // Left out: under one per cent on this machine idle, 1 to 14 % with two busy loops beside it.
+  // A quarter, and what is left says nothing about smoothness.
+  EXPECT_LT(moved.near_late_wakes, moved.forces.size() / 4);
+  EXPECT_LT(centred.near_late_wakes, centred.forces.size() / 4);
   EXPECT_LT(moved.largest_jump_n, 1.25 * centred.largest_jump_n);
   EXPECT_LT(moved.largest_jump_n, 0.5 * step_if_not_ramped);
 }
