@@ -23,7 +23,7 @@ TEST(HapticsimCli, HelpListsTheSubcommands) {
   EXPECT_EQ(result.exit_status, 0);
   for (const char* sub :
        {"simulate", "static", "stability", "scene", "sweep", "map", "lookup", "analyze", "device",
-        "soak", "log", "stress"}) {
+        "soak", "log", "stress", "bench"}) {
     EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
   }
 }

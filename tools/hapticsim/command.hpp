@@ -31,6 +31,7 @@ Command AddAnalyzeCommand(CLI::App& parent);
 Command AddDeviceCommand(CLI::App& parent);
 Command AddLogCommand(CLI::App& parent);
 Command AddStressCommand(CLI::App& parent);
+Command AddBenchCommand(CLI::App& parent);
 /** argc/argv: soak runs itself again inside a private network namespace. */
 Command AddSoakCommand(CLI::App& parent, int argc, char** argv);
 

@@ -5,31 +5,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "tools/hapticsim/svg_text.hpp"
+
 namespace hapticsim::cli {
-namespace {
-
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4g", v);
-  return text;
-}
-
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else
-      out += c;
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string LineChartSvg(const std::string& title, const std::string& x_label,
                          const std::string& y_label, const std::vector<double>& x,
@@ -54,24 +32,20 @@ std::string LineChartSvg(const std::string& title, const std::string& x_label,
     return kHeight - kBottom - (v - y_min) / (y_max - y_min) * (kHeight - kTop - kBottom);
   };
   std::ostringstream svg;
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidth << "' height='" << kHeight
-      << "' font-family='sans-serif' font-size='12'>\n"
-      << "<text x='" << kLeft << "' y='18' font-size='14'>" << Escape(title) << "</text>\n"
-      << "<rect x='" << kLeft << "' y='" << kTop << "' width='" << kWidth - kLeft - kRight
-      << "' height='" << kHeight - kTop - kBottom << "' fill='none' stroke='#888'/>\n";
+  svg << SvgChartOpening(kWidth, kHeight, kLeft, kRight, kTop, kBottom, title);
   for (int tick = 0; tick <= 4; ++tick) {
     const double yv = y_min + (y_max - y_min) * tick / 4, xv = x_min + (x_max - x_min) * tick / 4;
-    svg << "<text x='" << kLeft - 6 << "' y='" << py(yv) + 4 << "' text-anchor='end'>" << Number(yv)
-        << "</text>\n"
+    svg << "<text x='" << kLeft - 6 << "' y='" << py(yv) + 4 << "' text-anchor='end'>"
+        << SvgNumber(yv) << "</text>\n"
         << "<line x1='" << kLeft << "' x2='" << kWidth - kRight << "' y1='" << py(yv) << "' y2='"
         << py(yv) << "' stroke='#eee'/>\n"
         << "<text x='" << px(xv) << "' y='" << kHeight - kBottom + 16 << "' text-anchor='middle'>"
-        << Number(xv) << "</text>\n";
+        << SvgNumber(xv) << "</text>\n";
   }
   svg << "<text x='" << (kLeft + kWidth - kRight) / 2 << "' y='" << kHeight - 8
-      << "' text-anchor='middle'>" << Escape(x_label) << "</text>\n"
+      << "' text-anchor='middle'>" << SvgEscape(x_label) << "</text>\n"
       << "<text transform='translate(16," << (kTop + kHeight - kBottom) / 2
-      << ") rotate(-90)' text-anchor='middle'>" << Escape(y_label) << "</text>\n";
+      << ") rotate(-90)' text-anchor='middle'>" << SvgEscape(y_label) << "</text>\n";
   for (std::size_t k = 0; k < series.size(); ++k) {
     const char* colour = colours[k % 5];
     svg << "<polyline fill='none' stroke='" << colour << "' stroke-width='1.5' points='";
@@ -79,7 +53,7 @@ std::string LineChartSvg(const std::string& title, const std::string& x_label,
       if (std::isfinite(series[k].y[i])) svg << px(x[i]) << "," << py(series[k].y[i]) << " ";
     }
     svg << "'/>\n<text x='" << kWidth - kRight - 150 << "' y='" << kTop + 16 + 16 * k << "' fill='"
-        << colour << "'>" << Escape(series[k].name) << "</text>\n";
+        << colour << "'>" << SvgEscape(series[k].name) << "</text>\n";
   }
   svg << "</svg>\n";
   return svg.str();

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
                                       AddSweepCommand(app),     AddMapCommand(app),
                                       AddLookupCommand(app),    AddAnalyzeCommand(app),
                                       AddDeviceCommand(app),    AddSoakCommand(app, argc, argv),
-                                      AddLogCommand(app),       AddStressCommand(app)};
+                                      AddLogCommand(app),       AddStressCommand(app),
+                                      AddBenchCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;
