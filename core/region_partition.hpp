@@ -47,7 +47,8 @@ class RegionPartition {
   const HybridMesh& mesh() const { return *mesh_; }
   const Eigen::VectorXd& dof_mass() const { return dof_mass_; }
   int num_regions() const { return static_cast<int>(stiffness_.size()); }
-  const ElementSetStiffness& stiffness(RegionIndex region) const { return *stiffness_[region]; }
+  /** K of the region's elements: by the stencil where they form a box (BoxStiffness). */
+  const StiffnessOperator& stiffness(RegionIndex region) const { return *stiffness_[region]; }
   const RegionDofs& dofs(RegionIndex region) const { return dofs_[region]; }
   /** Elements of `region` that touch its outer interface (the band whose forces cross it). */
   const std::vector<int>& outer_band_elements(RegionIndex region) const { return band_[region]; }
@@ -65,7 +66,7 @@ class RegionPartition {
   Scene scene_;
   std::unique_ptr<HybridMesh> mesh_;
   Eigen::VectorXd dof_mass_;
-  std::vector<std::unique_ptr<ElementSetStiffness>> stiffness_;
+  std::vector<std::unique_ptr<StiffnessOperator>> stiffness_;
   std::vector<RegionDofs> dofs_;
   std::vector<std::vector<int>> band_;
   std::array<int, 3> contact_dofs_{};

@@ -9,7 +9,8 @@ namespace hapticsim {
  * Implementations: StencilStiffness (matrix-free, the one the simulation runs) and
  * AssembledStiffness (Eigen sparse matrix, the test oracle and benchmark baseline).
  *
- * Thread-safety: Apply() is const and touches no shared mutable state; any thread may call it.
+ * Thread-safety: Apply() is const and touches no shared mutable state; any thread may call it —
+ * except BoxStiffness, which keeps scratch vectors: one thread at a time (its region's).
  */
 class StiffnessOperator {
  public:

@@ -1,0 +1,116 @@
+#include "core/box_stiffness.hpp"
+
+#include <algorithm>
+#include <climits>
+
+namespace hapticsim {
+namespace {
+
+// Corner offset of Hex8Element's local node: bx + 2·by + 4·bz.
+std::array<int, 3> Offset(int local) { return {local & 1, (local >> 1) & 1, (local >> 2) & 1}; }
+
+}  // namespace
+
+std::unique_ptr<BoxStiffness> BoxStiffness::TryMake(const HybridMesh& mesh,
+                                                    const Material& material,
+                                                    const std::vector<int>& element_ids) {
+  if (element_ids.empty()) return nullptr;
+  // Each element's lowest corner on the fine lattice, from one of its independent nodes (every
+  // fine element has one: a refined cell's centre, or a coarse vertex).
+  std::vector<std::array<int, 3>> origins;
+  origins.reserve(element_ids.size());
+  std::array<int, 3> low{INT_MAX, INT_MAX, INT_MAX}, high{INT_MIN, INT_MIN, INT_MIN};
+  for (int id : element_ids) {
+    const HybridElement& e = mesh.elements()[static_cast<size_t>(id)];
+    if (e.size_factor != 1) return nullptr;
+    bool found = false;
+    std::array<int, 3> origin{};
+    for (int local = 0; local < 8 && !found; ++local) {
+      const auto [begin, end] = mesh.Gather(e.nodes[local]);
+      if (end - begin != 1 || begin->weight != 1.0) continue;
+      const std::array<int, 3>& at = mesh.LatticeOf(begin->independent);
+      if (mesh.IndependentAt(at[0], at[1], at[2]) != begin->independent) continue;
+      for (int c = 0; c < 3; ++c) origin[c] = at[c] - Offset(local)[c];
+      found = true;
+    }
+    if (!found) return nullptr;
+    origins.push_back(origin);
+    for (int c = 0; c < 3; ++c) {
+      low[c] = std::min(low[c], origin[c]);
+      high[c] = std::max(high[c], origin[c]);
+    }
+  }
+  const std::array<int, 3> cells{high[0] - low[0] + 1, high[1] - low[1] + 1, high[2] - low[2] + 1};
+  if (static_cast<long>(cells[0]) * cells[1] * cells[2] != static_cast<long>(element_ids.size())) {
+    return nullptr;  // not a full box (or an element twice)
+  }
+  const std::array<int, 3> nodes{cells[0] + 1, cells[1] + 1, cells[2] + 1};
+  std::vector<int> box_mesh_nodes(static_cast<size_t>(nodes[0]) * nodes[1] * nodes[2], -1);
+  std::vector<char> seen(element_ids.size(), 0);
+  for (size_t i = 0; i < element_ids.size(); ++i) {
+    const std::array<int, 3> o{origins[i][0] - low[0], origins[i][1] - low[1],
+                               origins[i][2] - low[2]};
+    const size_t cell = static_cast<size_t>(o[0] + cells[0] * (o[1] + cells[1] * o[2]));
+    if (seen[cell]) return nullptr;
+    seen[cell] = 1;
+    const HybridElement& e = mesh.elements()[static_cast<size_t>(element_ids[i])];
+    for (int local = 0; local < 8; ++local) {
+      const std::array<int, 3> d = Offset(local);
+      const size_t node = static_cast<size_t>(
+          (o[0] + d[0]) + nodes[0] * ((o[1] + d[1]) + nodes[1] * (o[2] + d[2])));
+      if (box_mesh_nodes[node] >= 0 && box_mesh_nodes[node] != e.nodes[local]) return nullptr;
+      box_mesh_nodes[node] = e.nodes[local];
+    }
+  }
+  return std::unique_ptr<BoxStiffness>(
+      new BoxStiffness(mesh, material, element_ids, nodes, std::move(box_mesh_nodes)));
+}
+
+BoxStiffness::BoxStiffness(const HybridMesh& mesh, const Material& material,
+                           std::vector<int> element_ids, const std::array<int, 3>& box_nodes,
+                           std::vector<int> box_mesh_nodes)
+    : StiffnessOperator(mesh.num_dofs()),
+      mesh_(mesh),
+      elements_(mesh, material, std::move(element_ids)),
+      box_nodes_(box_nodes),
+      stencil_(HexGrid(box_nodes[0], box_nodes[1], box_nodes[2], mesh.options().spacing_m),
+               material) {
+  gather_start_.push_back(0);
+  for (int node : box_mesh_nodes) {
+    const auto [begin, end] = mesh.Gather(node);
+    gather_terms_.insert(gather_terms_.end(), begin, end);
+    gather_start_.push_back(static_cast<int>(gather_terms_.size()));
+  }
+  u_box_.setZero(3 * static_cast<Eigen::Index>(box_mesh_nodes.size()));
+  ku_box_.setZero(u_box_.size());
+}
+
+void BoxStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+                         Eigen::Ref<Eigen::VectorXd> ku) const {
+  const int nr = mesh_.num_independent();
+  const int nb = static_cast<int>(gather_start_.size()) - 1;
+  for (int b = 0; b < nb; ++b) {
+    double x = 0, y = 0, z = 0;
+    for (int t = gather_start_[b]; t < gather_start_[b + 1]; ++t) {
+      const GatherTerm& g = gather_terms_[static_cast<size_t>(t)];
+      x += g.weight * u[g.independent];
+      y += g.weight * u[nr + g.independent];
+      z += g.weight * u[2 * nr + g.independent];
+    }
+    u_box_[b] = x;
+    u_box_[nb + b] = y;
+    u_box_[2 * nb + b] = z;
+  }
+  stencil_.Apply(u_box_, ku_box_);
+  for (int dof : touched_dofs()) ku[dof] = 0.0;
+  for (int b = 0; b < nb; ++b) {
+    for (int t = gather_start_[b]; t < gather_start_[b + 1]; ++t) {
+      const GatherTerm& g = gather_terms_[static_cast<size_t>(t)];
+      ku[g.independent] += g.weight * ku_box_[b];
+      ku[nr + g.independent] += g.weight * ku_box_[nb + b];
+      ku[2 * nr + g.independent] += g.weight * ku_box_[2 * nb + b];
+    }
+  }
+}
+
+}  // namespace hapticsim
