@@ -23,7 +23,7 @@ double NiceStep(double max, int ticks) {
 
 std::string ParetoChartSvg(const std::string& title, const std::vector<ScatterPoint>& points,
                            double reference_cost, double threshold_percent) {
-  constexpr double kWidth = 760, kHeight = 420, kLeft = 70, kRight = 20, kTop = 30, kBottom = 45;
+  constexpr double kWidth = 760, kHeight = 440, kLeft = 70, kRight = 20, kTop = 48, kBottom = 45;
   double x_max = reference_cost, y_max = threshold_percent;
   for (const ScatterPoint& p : points) {
     if (std::isfinite(p.cost)) x_max = std::max(x_max, p.cost);
@@ -83,10 +83,9 @@ std::string ParetoChartSvg(const std::string& title, const std::vector<ScatterPo
         << SvgEscape(p.label) << ": " << SvgNumber(p.cost) << " µs/ms, " << SvgNumber(p.error)
         << " %</title></circle>\n";
   }
-  // Bottom left: cheap and accurate at once is the corner no configuration reaches.
-  svg << "<text x='" << kLeft + 10 << "' y='" << kHeight - kBottom - 10
-      << "' fill='#1f77b4'>● Pareto front</text><text x='" << kLeft + 110 << "' y='"
-      << kHeight - kBottom - 10 << "' fill='#888'>● other configurations</text>\n"
+  // The legend: its own row under the title.
+  svg << "<text x='" << kLeft << "' y='38' fill='#1f77b4'>● Pareto front (cheapest for its error)"
+      << "</text><text x='" << kLeft + 250 << "' y='38' fill='#888'>● other configurations</text>\n"
       << "</svg>\n";
   return svg.str();
 }
