@@ -13,7 +13,8 @@ std::array<int, 3> Offset(int local) { return {local & 1, (local >> 1) & 1, (loc
 
 std::unique_ptr<BoxStiffness> BoxStiffness::TryMake(const HybridMesh& mesh,
                                                     const Material& material,
-                                                    const std::vector<int>& element_ids) {
+                                                    const std::vector<int>& element_ids,
+                                                    int min_row_nodes) {
   if (element_ids.empty()) return nullptr;
   // Each element's lowest corner on the fine lattice, from one of its independent nodes (every
   // fine element has one: a refined cell's centre, or a coarse vertex).
@@ -45,6 +46,7 @@ std::unique_ptr<BoxStiffness> BoxStiffness::TryMake(const HybridMesh& mesh,
     return nullptr;  // not a full box (or an element twice)
   }
   const std::array<int, 3> nodes{cells[0] + 1, cells[1] + 1, cells[2] + 1};
+  if (nodes[0] < min_row_nodes || nodes[1] < min_row_nodes) return nullptr;
   std::vector<int> box_mesh_nodes(static_cast<size_t>(nodes[0]) * nodes[1] * nodes[2], -1);
   std::vector<char> seen(element_ids.size(), 0);
   for (size_t i = 0; i < element_ids.size(); ++i) {

@@ -26,10 +26,12 @@ class BoxStiffness final : public StiffnessOperator {
  public:
   /**
    * The operator for `element_ids` if they are exactly the fine elements of an axis-aligned box
-   * (every one of them, nothing else); nullptr otherwise.
+   * (every one of them, nothing else) whose rows along x and y have at least `min_row_nodes`
+   * nodes; nullptr otherwise (nothing built).
    */
   static std::unique_ptr<BoxStiffness> TryMake(const HybridMesh& mesh, const Material& material,
-                                               const std::vector<int>& element_ids);
+                                               const std::vector<int>& element_ids,
+                                               int min_row_nodes = 0);
 
   void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
              Eigen::Ref<Eigen::VectorXd> ku) const override;

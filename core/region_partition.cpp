@@ -56,8 +56,8 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
     // enough for the stencil's vector path: measured per K·u against the element loop, a 13×13×7
     // box 1.7× faster, 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar
     // path, are nearly all of a small box; docs/benchmarks.md).
-    auto box = BoxStiffness::TryMake(*mesh_, scene.material, elements[region]);
-    if (box && box->box_nodes()[0] >= kMinBoxRowNodes && box->box_nodes()[1] >= kMinBoxRowNodes) {
+    if (auto box =
+            BoxStiffness::TryMake(*mesh_, scene.material, elements[region], kMinBoxRowNodes)) {
       stiffness_.push_back(std::move(box));
     } else {
       stiffness_.push_back(

@@ -68,6 +68,9 @@ TEST(BoxStiffness, RefusesWhatIsNotAFullBoxOfFineElements) {
   const RegionPartition partition(scene);
   const HybridMesh& mesh = partition.mesh();
   std::vector<int> primary = ElementsOf(mesh, kPrimaryRegion);
+  // Rows shorter than asked for: the 9 × 9 × 5 box is refused when rows of 10 are the minimum.
+  ASSERT_NE(BoxStiffness::TryMake(mesh, scene.material, primary, 9), nullptr);
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, primary, 10), nullptr);
   primary.pop_back();  // a box with a corner missing
   EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, primary), nullptr);
   // The secondary region: coarse elements, and a box with a hole in it.
