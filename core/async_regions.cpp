@@ -206,6 +206,10 @@ void AsyncRegions::Reset() {
   PublishInitialSnapshots();
 }
 
+bool AsyncRegions::RegionAtRest(RegionIndex region, double tolerance_m) const noexcept {
+  return regions_[region]->integrator->OwnedStateMaxAbs() <= tolerance_m;
+}
+
 void AsyncRegions::SetRandomState(unsigned seed) {
   Reset();
   std::mt19937_64 rng(seed);

@@ -126,6 +126,13 @@ class AsyncRegions {
    */
   void AdvanceSecondariesTo(std::int64_t ticks) noexcept;
 
+  /**
+   * True when the region's state is within `tolerance_m` of rest (every owned displacement, now
+   * and one step ago): with no load, stepping it on would change nothing a user could feel. The
+   * thread stepping that region (or any thread while no steps run).
+   */
+  bool RegionAtRest(RegionIndex region, double tolerance_m) const noexcept;
+
   /** Positive-definite energy of the coupled state (all regions), J. */
   double Energy() noexcept;
   /** Its kinetic part, ½ Σ m v² over the owned DOFs (no K·u needed), J. */

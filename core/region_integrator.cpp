@@ -1,6 +1,8 @@
 #include "core/region_integrator.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <cmath>
 
 namespace hapticsim {
 
@@ -31,7 +33,6 @@ void RegionIntegrator::Reset() {
   ku_valid_ = false;
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
 }
-
 
 const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
   if (!ku_valid_) {
@@ -83,6 +84,17 @@ double RegionIntegrator::OwnedStateNormSquared() const {
   double sum = 0;
   for (int i : owned_) sum += (*u_)[i] * (*u_)[i] + (*u_previous_)[i] * (*u_previous_)[i];
   return sum;
+}
+
+double RegionIntegrator::OwnedStateMaxAbs() const noexcept {
+  double largest = 0;
+  for (int i : owned_) {
+    for (double value : {(*u_)[i], (*u_previous_)[i]}) {
+      // NaN compares false: a diverged region must never look like one at rest.
+      if (!(std::abs(value) <= largest)) largest = std::isnan(value) ? INFINITY : std::abs(value);
+    }
+  }
+  return largest;
 }
 
 }  // namespace hapticsim

@@ -68,6 +68,8 @@ class RegionIntegrator {
   void ScaleState(double factor);
   /** Σ over owned DOFs of u² + u⁻², for the period-map norm. */
   double OwnedStateNormSquared() const;
+  /** Largest |u| or |u⁻| over the owned DOFs, m: how far the region is from rest. */
+  double OwnedStateMaxAbs() const noexcept;
 
  private:
   const StiffnessOperator& stiffness_;

@@ -74,6 +74,7 @@ const std::map<std::string, Setter>& Setters() {
       }
     };
     flag("realtime.lock_memory", &DaemonConfig::lock_memory);
+    flag("realtime.sleep_at_rest", &DaemonConfig::sleep_at_rest);
     text("log.level", &DaemonConfig::log_level);
     real("log.max_lines_per_s", &DaemonConfig::max_log_lines_per_s);
     return s;
@@ -219,7 +220,9 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "max_force_n = " << real(c.max_force_n) << "\n\n"
       << "[realtime]\nfifo_priority = " << c.fifo_priority << "\ncpus = [";
   for (size_t i = 0; i < c.cpus.size(); ++i) out << (i ? ", " : "") << c.cpus[i];
-  out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n\n"
+  out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n"
+      << "sleep_at_rest = " << (c.sleep_at_rest ? "true" : "false")
+      << "  # untouched and at rest: regions not stepped, ~0 CPU\n\n"
       << "[log]\nlevel = " << quote(c.log_level) << "\n"
       << "max_lines_per_s = " << real(c.max_log_lines_per_s) << "\n";
   return out.str();

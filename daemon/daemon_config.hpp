@@ -38,9 +38,10 @@ struct DaemonConfig {
   double workspace_margin_m = 0.1;    ///< accepted positions: the object's box grown by this
   double max_force_n = 50.0;          ///< a larger force is a fault: zero force, reset
   // [realtime]
-  int fifo_priority = 0;     ///< SCHED_FIFO priority of the region threads (0: normal)
-  std::vector<int> cpus;     ///< CPUs the region threads are pinned to (empty: any)
-  bool lock_memory = false;  ///< mlockall(MCL_CURRENT | MCL_FUTURE)
+  int fifo_priority = 0;      ///< SCHED_FIFO priority of the region threads (0: normal)
+  std::vector<int> cpus;      ///< CPUs the region threads are pinned to (empty: any)
+  bool lock_memory = false;   ///< mlockall(MCL_CURRENT | MCL_FUTURE)
+  bool sleep_at_rest = true;  ///< regions at rest with nothing touching them are not stepped
   // [log]
   std::string log_level = "info";   ///< trace, debug, info, warn, error
   double max_log_lines_per_s = 10;  ///< rate limit of repeated warnings

@@ -1,10 +1,16 @@
 #include "daemon/haptic_loop.hpp"
 
+#include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <string>
 
 #include "core/error.hpp"
@@ -16,6 +22,22 @@ namespace {
 // Named threads show up as such in top -H, ps -L, perf and gdb (15 characters at most).
 void NameThisThread(const std::string& name) {
   pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
+}
+
+// The futex behind an atomic word: std::atomic::wait has no timeout, and an idle primary must
+// still come round now and then (stop, reconfiguration, the watchdog's sign of life).
+static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) &&
+              std::atomic<std::uint32_t>::is_always_lock_free);
+void FutexWait(std::atomic<std::uint32_t>* word, std::uint32_t expected, double timeout_s) {
+  const auto ns = static_cast<long>(timeout_s * 1e9);
+  const timespec timeout{ns / 1'000'000'000, ns % 1'000'000'000};
+  // Returns at once if *word != expected; spurious returns are harmless to the caller.
+  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAIT_PRIVATE, expected, &timeout,
+          nullptr, 0);
+}
+void FutexWakeAll(std::atomic<std::uint32_t>* word) {
+  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAKE_PRIVATE, INT_MAX, nullptr,
+          nullptr, 0);
 }
 
 }  // namespace
@@ -77,11 +99,13 @@ void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
   const RestartKind restart = keep_contact ? kRestartKeepingContact : kRestartFromRest;
   if (!running_.load()) {
     restart_kind_.store(restart);
+    ForgetSleep();
     Install(scene, std::move(regions));
     return;
   }
   paused_.store(false);
   pause_requested_.store(true, std::memory_order_release);
+  FutexWakeAll(&input_arrivals_);  // an idle primary waiting for input comes round now
   // The primary acknowledges at its next release; after that it does not touch the regions.
   const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
   while (!paused_.load(std::memory_order_acquire)) {
@@ -94,6 +118,7 @@ void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
     SleepUntilMonotonicNs(NowNs() + 100'000);
   }
   StopSecondaries();
+  ForgetSleep();
   Install(scene, std::move(regions));
   // The new regions start from rest on the primary's own release grid, late enough for the
   // secondaries to be released ahead of it.
@@ -117,7 +142,105 @@ void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcep
   error_flags_.store(flags, std::memory_order_relaxed);
 }
 
+void HapticLoop::OfferInput(const DeviceSample& sample) noexcept {
+  input_.Write(sample);
+  // Sequentially consistent with the primary's waiting flag: either it sees this arrival before
+  // it waits, or this sees it waiting and wakes it.
+  input_arrivals_.fetch_add(1);
+  if (primary_waiting_.load()) FutexWakeAll(&input_arrivals_);
+}
+
+std::int64_t HapticLoop::primary_alive_ns() const {
+  return std::max(monitors_[kPrimaryRegion]->last_done_ns(),
+                  alive_ns_.load(std::memory_order_relaxed));
+}
+
+void HapticLoop::ForgetSleep() {
+  park_secondaries_.store(false);
+  watch_rest_.store(false);
+  for (auto& parked : parked_) parked.store(false);
+  parked_count_.store(0);
+  wake_origin_ns_.store(-1);
+  sleep_state_ = kAwake;
+  asleep_.store(false);
+  idle_.store(false);
+}
+
+bool HapticLoop::SecondaryMayStep(RegionIndex region) noexcept {
+  if (park_secondaries_.load(std::memory_order_acquire)) {
+    if (!parked_[region].exchange(true, std::memory_order_acq_rel)) {
+      // Its last step's writes are published to the primary with the count.
+      parked_count_.fetch_add(1, std::memory_order_acq_rel);
+    }
+    return false;
+  }
+  if (watch_rest_.load(std::memory_order_acquire)) {
+    region_at_rest_[region].store(regions_->RegionAtRest(region, kRestTolerance_m),
+                                  std::memory_order_release);
+  }
+  return true;
+}
+
+void HapticLoop::WatchForRest(bool touched) noexcept {
+  const int secondaries = regions_->num_regions() - 1;
+  if (sleep_state_ == kAwake) {
+    if (touched) {
+      watch_rest_.store(false, std::memory_order_relaxed);
+      return;
+    }
+    if (!watch_rest_.load(std::memory_order_relaxed)) {
+      // A secondary's "at rest" from before the touch does not count: each must find it anew.
+      for (int a = 1; a <= secondaries; ++a) region_at_rest_[a].store(false);
+      watch_rest_.store(true, std::memory_order_release);
+      return;
+    }
+    if (!regions_->RegionAtRest(kPrimaryRegion, kRestTolerance_m)) return;
+    for (int a = 1; a <= secondaries; ++a) {
+      if (!region_at_rest_[a].load(std::memory_order_acquire)) return;
+    }
+    park_secondaries_.store(true, std::memory_order_release);
+    sleep_state_ = kParking;
+  }
+  if (sleep_state_ == kParking) {
+    if (parked_count_.load(std::memory_order_acquire) < secondaries) return;
+    watch_rest_.store(false, std::memory_order_relaxed);
+    if (touched) {
+      // Touched while the secondaries were parking: they carry on where they were (at rest).
+      WakeSecondaries(-1);
+      return;
+    }
+    // Nothing steps any region now: rest exactly, at time 0 of a schedule that starts on waking.
+    regions_->Reset();
+    sleep_state_ = kAsleep;
+    asleep_.store(true, std::memory_order_relaxed);
+    sleeps_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void HapticLoop::WakeSecondaries(std::int64_t origin_ns) noexcept {
+  wake_origin_ns_.store(origin_ns, std::memory_order_relaxed);
+  for (auto& parked : parked_) parked.store(false, std::memory_order_relaxed);
+  parked_count_.store(0, std::memory_order_relaxed);
+  park_secondaries_.store(false, std::memory_order_relaxed);
+  wake_generation_.fetch_add(1, std::memory_order_release);  // publishes the stores above
+  wake_generation_.notify_all();
+  sleep_state_ = kAwake;
+  asleep_.store(false, std::memory_order_relaxed);
+}
+
+void HapticLoop::WaitForInput() noexcept {
+  primary_waiting_.store(true);
+  // An input offered since the period read the slot, a reconfiguration or a stop: no wait.
+  if (input_arrivals_.load() == arrivals_seen_ && !stop_.load() &&
+      !pause_requested_.load(std::memory_order_acquire)) {
+    FutexWait(&input_arrivals_, arrivals_seen_, kIdleWait_s);
+  }
+  primary_waiting_.store(false);
+  alive_ns_.store(NowNs(), std::memory_order_relaxed);
+}
+
 void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
+  arrivals_seen_ = input_arrivals_.load();
   DeviceSample sample;
   if (input_.Read(&sample)) {
     if (sample.seq != last_input_.seq) tip_.Add(sample.seq, sample.received_ns, sample.position_m);
@@ -175,17 +298,24 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
 
   std::array<double, 3> reaction{};
   if (usable) {
-    const int substeps = regions_->schedule(kPrimaryRegion).substeps;
-    for (int q = 1; q <= substeps; ++q) {
-      // The device gives one position per period: every substep holds it.
-      const std::array<double, 3> r = regions_->StepPrimary(contact.displacement_m);
-      if (q == 1) reaction = r;
-    }
-    // Only here: while paused for a reconfiguration the regions are not the primary's to read.
-    if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
-      flags |= force_flags::kBoundaryStale;
+    // Asleep, the regions are exactly at rest at time 0: a touch steps on from there in this very
+    // period, with the secondaries restarted on this release.
+    if (sleep_state_ == kAsleep && contact.engaged) WakeSecondaries(release_ns);
+    if (sleep_state_ != kAsleep) {
+      const int substeps = regions_->schedule(kPrimaryRegion).substeps;
+      for (int q = 1; q <= substeps; ++q) {
+        // The device gives one position per period: every substep holds it.
+        const std::array<double, 3> r = regions_->StepPrimary(contact.displacement_m);
+        if (q == 1) reaction = r;
+      }
+      // Only here: while paused for a reconfiguration the regions are not the primary's to read.
+      if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
+        flags |= force_flags::kBoundaryStale;
+      }
+      if (options_.sleep_at_rest) WatchForRest(contact.engaged);
     }
   }
+  idle_.store(usable && sleep_state_ == kAsleep && stale, std::memory_order_relaxed);
   ForceRecord out;
   out.period = periods_run_++;
   BlackBoxRecord box;
@@ -228,6 +358,13 @@ void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
     const std::int64_t woke = NowNs();
     PrimaryPeriod(release, woke);
     monitor.Record(release, woke, NowNs());
+    if (idle_.load(std::memory_order_relaxed)) {
+      // Asleep and no device: nothing to answer until an input arrives. Then back on the release
+      // grid at its next release (the periods waited through had nothing to answer).
+      WaitForInput();
+      const double now_periods = static_cast<double>(NowNs() - origin_ns) / primary_period_ns_;
+      k = std::max(k, static_cast<std::int64_t>(std::ceil(now_periods)) - 1);
+    }
   }
 }
 
@@ -236,10 +373,34 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   DeadlineMonitor& monitor = *monitors_[region];
   const int substeps = regions_->schedule(region).substeps;
   const double period_ns = 1e9 / regions_->schedule(region).rate_hz;
+  bool catching_up = false;  // restarted on a new origin, and not yet ahead of its grid
   while (!stop_secondaries_.load(std::memory_order_acquire)) {
-    const std::int64_t release =
-        origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
-        lead_ns_[region];
+    const std::uint32_t generation = wake_generation_.load(std::memory_order_acquire);
+    if (!SecondaryMayStep(region)) {
+      while (wake_generation_.load(std::memory_order_acquire) == generation &&
+             !stop_secondaries_.load(std::memory_order_acquire)) {
+        wake_generation_.wait(generation, std::memory_order_acquire);
+      }
+      const std::int64_t wake_origin = wake_origin_ns_.load(std::memory_order_relaxed);
+      if (wake_origin >= 0) {
+        origin_ns = wake_origin;  // the regions restart from rest there
+        catching_up = true;
+      }
+      continue;
+    }
+    std::int64_t release = origin_ns +
+                           static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
+                           lead_ns_[region];
+    if (catching_up) {
+      // Restarted on the primary's present release, a region meant to run ahead of it (lead_ns_)
+      // starts behind: its steps until it is ahead again are released now, not missed.
+      const std::int64_t now = NowNs();
+      if (release < now) {
+        release = now;
+      } else {
+        catching_up = false;
+      }
+    }
     SleepUntilMonotonicNs(release);
     const std::int64_t woke = NowNs();
     // Stalled (preempted, a debugger, a page-fault storm): hold the state over the missed periods
@@ -266,6 +427,8 @@ void HapticLoop::StartSecondaries(std::int64_t origin_ns) {
 
 void HapticLoop::StopSecondaries() {
   stop_secondaries_ = true;
+  wake_generation_.fetch_add(1);  // parked ones come round and see the stop
+  wake_generation_.notify_all();
   for (std::thread& thread : secondary_threads_) {
     if (thread.joinable()) thread.join();
   }
@@ -275,6 +438,7 @@ void HapticLoop::StopSecondaries() {
 std::string HapticLoop::Start() {
   if (running_) return "";
   regions_->Reset();
+  ForgetSleep();
   restart_kind_ = kRestartFromRest;
   pause_requested_ = false;
   stop_ = false;
@@ -312,6 +476,7 @@ std::string HapticLoop::ApplyRealtimeSettings(std::thread& thread) const {
 
 void HapticLoop::Stop() {
   stop_ = true;
+  FutexWakeAll(&input_arrivals_);  // an idle primary waiting for input comes round now
   if (primary_thread_.joinable()) primary_thread_.join();
   StopSecondaries();
   running_ = false;

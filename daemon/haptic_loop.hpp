@@ -75,6 +75,13 @@ inline constexpr std::int32_t kBoundaryStale = 128;
  * restart from rest (Start, a reset, a fault) a tip already inside the object renders nothing
  * until it has left the object once.
  *
+ * Sleeping at rest: out of contact, once every region is within kRestTolerance_m of rest, the
+ * secondary threads park (blocked, no CPU), the regions are set exactly to rest and the primary
+ * stops stepping them; it still answers every input and tracks the tip, and the period the tip
+ * engages it wakes them and steps on from rest in that same period (the secondaries restart on
+ * its release grid). Asleep with no fresh input, the primary thread itself blocks until an input
+ * arrives (OfferInput wakes it) and rejoins its release grid. See docs/operations.md.
+ *
  * Reconfiguration is gapless: the primary thread never stops. It pauses the regions (answers
  * every period with zero force, flagged "reconfiguring") while the supervisor joins the old
  * secondary threads, installs the new regions and starts their threads, and resumes them on its
@@ -89,6 +96,7 @@ class HapticLoop {
     int fifo_priority = 0;       ///< SCHED_FIFO for the region threads (0: normal scheduling)
     std::vector<int> cpus;       ///< pin the region threads here (empty: no pinning)
     double engage_ramp_s = 0.1;  ///< a contact that engages late ramps its force in over this
+    bool sleep_at_rest = true;   ///< regions at rest and untouched stop stepping until a touch
   };
   using ForceRing = SpscRing<ForceRecord, 4096>;
   using BlackBoxRing = SpscRing<BlackBoxRecord, 4096>;
@@ -126,8 +134,22 @@ class HapticLoop {
   std::int64_t last_contact_ns() const { return last_contact_ns_.load(std::memory_order_relaxed); }
   bool running() const { return running_.load(); }
 
-  /** I/O thread: the newest accepted input. */
-  SeqlockSlot<DeviceSample>& input() { return input_; }
+  /** I/O thread: hands the newest accepted input to the primary (and wakes it if it waits). */
+  void OfferInput(const DeviceSample& sample) noexcept;
+  /** True while the regions sleep at rest (not stepped; the secondary threads parked). */
+  bool asleep() const { return asleep_.load(std::memory_order_relaxed); }
+  /**
+   * True while asleep with no fresh input: the primary thread waits for an input instead of
+   * running periods, and the I/O thread may wait longer between polls.
+   */
+  bool idle() const { return idle_.load(std::memory_order_relaxed); }
+  /** Times the regions went to sleep since the loop was made. */
+  std::int64_t sleeps() const { return sleeps_.load(std::memory_order_relaxed); }
+  /**
+   * CLOCK_MONOTONIC of the primary thread's last sign of life, ns: a period done, or a wait for
+   * input that came round (at least every kIdleWait_s). 0 before the first period.
+   */
+  std::int64_t primary_alive_ns() const;
   /** I/O thread: the forces, one per primary period. */
   ForceRing& forces() { return forces_; }
   /** Supervisor: every primary period's record, for the black box. */
@@ -159,12 +181,27 @@ class HapticLoop {
   static constexpr double kStaleBoundary_s = 0.1;
   /** Regions a loop keeps counters for (a scene has at most 1 + 8). */
   static constexpr int kMaxRegions = 16;
+  /**
+   * A region whose every owned displacement (now and a step ago) is within this of rest counts
+   * as at rest, m. Zeroing 0.1 µm changes the force by ~10⁻⁵ N on the paper's cube: far below
+   * any device's resolution.
+   */
+  static constexpr double kRestTolerance_m = 1e-7;
+  /** An idle primary thread comes round at least this often (stop, reconfiguration, watchdog). */
+  static constexpr double kIdleWait_s = 0.02;
 
   /**
    * One primary period released at `release_ns`, run at `now_ns` (what the primary thread runs;
    * public for the allocation test). Never allocates, locks or throws.
    */
   void PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept;
+  /**
+   * What a secondary region's thread asks before each step: false while it must stay parked (the
+   * regions are going to sleep, or asleep; the first such call counts it as parked). While the
+   * primary watches for rest, it also reports whether this region is at rest. Public, like
+   * PrimaryPeriod, so a test can play the secondaries on one thread. Never allocates or blocks.
+   */
+  bool SecondaryMayStep(RegionIndex region) noexcept;
 
   static std::int64_t NowNs() noexcept;
 
@@ -177,6 +214,12 @@ class HapticLoop {
   void Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions);
   // The first release on the primary grid at or after `not_before_ns`.
   std::int64_t NextPrimaryRelease(std::int64_t not_before_ns) const;
+  // Primary thread: sleeping at rest (see the class comment).
+  void WatchForRest(bool touched) noexcept;
+  void WakeSecondaries(std::int64_t origin_ns) noexcept;
+  void WaitForInput() noexcept;
+  // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
+  void ForgetSleep();
 
   Scene scene_;
   Options options_;
@@ -212,6 +255,20 @@ class HapticLoop {
   // Published by the primary thread for the supervisor.
   std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none
   std::atomic<bool> contact_waiting_{false};
+
+  // Sleeping at rest. Primary → secondaries: park before your next step; a new wake generation
+  // (notified) releases them, to restart on wake_origin_ns_ (−1: carry on on their own grid).
+  std::atomic<bool> park_secondaries_{false}, watch_rest_{false}, asleep_{false}, idle_{false};
+  std::array<std::atomic<bool>, kMaxRegions> parked_{}, region_at_rest_{};
+  std::atomic<int> parked_count_{0};
+  std::atomic<std::uint32_t> wake_generation_{0};
+  std::atomic<std::int64_t> wake_origin_ns_{-1}, sleeps_{0}, alive_ns_{0};
+  // I/O → primary: inputs offered (the futex an idle primary waits on) and whether it waits.
+  std::atomic<std::uint32_t> input_arrivals_{0};
+  std::atomic<bool> primary_waiting_{false};
+  enum SleepState : int { kAwake, kParking, kAsleep };
+  SleepState sleep_state_ = kAwake;  // primary thread (supervisor only while it is paused)
+  std::uint32_t arrivals_seen_ = 0;  // primary thread: input_arrivals_ at its last period
 
   // Input arrives with jitter: the tip the primary drives is the device's, resampled at each
   // release on the device's own timeline (one seq per primary period), continued for at most

@@ -12,7 +12,7 @@ void InputIntake::Offer(std::int64_t seq, const std::array<double, 3>& position_
     counters_.Reject(verdict);
     last_accepted_.latest_rejected = true;  // the primary flags it; the simulation keeps the last
   }
-  loop_.input().Write(last_accepted_);
+  loop_.OfferInput(last_accepted_);
 }
 
 }  // namespace hapticsim

@@ -146,6 +146,7 @@ int Serve(const Arguments& args) {
   options.max_force_n = config.max_force_n;
   options.fifo_priority = config.fifo_priority;
   options.cpus = config.cpus;
+  options.sleep_at_rest = config.sleep_at_rest;
   HapticLoop loop(SceneWith(config.scene, decision.configuration), options);
   loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
   spdlog::info("contact: the regions are centred on node ({}, {}, {}) and follow the tool",
@@ -172,15 +173,24 @@ int Serve(const Arguments& args) {
   const std::string refused = loop.Start();
   if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
   std::atomic<bool> stop_io{false};
-  // The I/O thread: everything that may block, at most 0.25 ms behind the primary thread.
+  // The I/O thread: everything that may block, at most 0.25 ms behind the primary thread. While
+  // the loop is idle (regions asleep, no device) nothing needs it that often: LCM input wakes the
+  // poll anyway, so it waits up to 20 ms; shared-memory input cannot wake it and is polled every
+  // millisecond.
   std::thread io([&] {
-    const timespec quarter_ms{0, 250'000};
+    const timespec quarter_ms{0, 250'000}, one_ms{0, 1'000'000}, idle_wait{0, 20'000'000};
     ForceRecord record;
+    std::int64_t inputs_seen = -1;
     while (!stop_io.load()) {
+      // An input just handed over: its answer comes within a period, whatever the loop said.
+      const std::int64_t inputs = counters.inputs_received.load();
+      const bool idle = loop.idle() && inputs == inputs_seen;
+      inputs_seen = inputs;
+      const timespec& wait = !idle ? quarter_ms : shm ? one_ms : idle_wait;
       if (bridge) {
-        bridge->Poll(quarter_ms);
+        bridge->Poll(wait);
       } else {
-        nanosleep(&quarter_ms, nullptr);
+        nanosleep(&wait, nullptr);
       }
       if (shm) shm->PollInput();
       while (loop.forces().Pop(&record)) {
@@ -529,7 +539,7 @@ int Serve(const Arguments& args) {
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {
       // Only while the primary loop is alive: a hung loop stops the pings and systemd restarts us.
-      const double since_primary = (now - loop.monitor(kPrimaryRegion).last_done_ns()) * 1e-9;
+      const double since_primary = (now - loop.primary_alive_ns()) * 1e-9;
       if (since_primary < std::max(0.1, 50 * primary_period_s)) {
         systemd.Notify("WATCHDOG=1");
         next_watchdog_ns = now + static_cast<std::int64_t>(systemd.watchdog_interval_s() * 0.5e9);

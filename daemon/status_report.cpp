@@ -26,6 +26,8 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
   for (int c = 0; c < 3; ++c) s.contact_node[c] = loop.centre_node()[c];
   s.reconfigurations = loop.reconfigurations();
   s.paused_periods = loop.paused_periods();
+  s.asleep = loop.asleep();
+  s.sleeps = loop.sleeps();
   const AsyncRegions& regions = loop.regions();
   s.num_regions = regions.num_regions();
   for (int r = 0; r < regions.num_regions(); ++r) {

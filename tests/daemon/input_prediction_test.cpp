@@ -30,7 +30,7 @@ double LargestForceChange(const std::function<int(int)>& arrivals) {
       // Sampled at the device's period `sent`, with no latency: an input that reaches a period
       // before its own is one the primary sees because it woke that much late.
       const std::int64_t received = std::max(now, origin + sent * 1'000'000);
-      loop.input().Write(DeviceSample{sent, received, {0.125, 0.125, z}, false});
+      loop.OfferInput(DeviceSample{sent, received, {0.125, 0.125, z}, false});
     }
     auto& regions = const_cast<AsyncRegions&>(loop.regions());
     regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +

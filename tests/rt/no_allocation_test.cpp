@@ -104,7 +104,8 @@ namespace hapticsim {
 namespace {
 
 // hapticsimd's primary period (input slot → contact → step → force ring) on the default
-// configuration, in and out of contact, with stale input: never touches the heap.
+// configuration, in and out of contact, asleep and woken, with stale input: never touches the
+// heap.
 TEST(DaemonPrimaryPeriod, NeverAllocates) {
   Scene scene;
   scene.adaptivity.primary_size = 3;
@@ -112,20 +113,27 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
   std::int64_t now = HapticLoop::NowNs();
   ForceRecord record;
   int forces = 0;
+  bool pushed_back = false;
   testing::ScopedAllocationCount count;
   for (int n = 0; n < 600; ++n, now += 1'000'000) {
     if (n < 400) {
       const double z = n < 100 ? -0.002 : 0.01 * (n - 100) / 300.0;
-      loop.input().Write(DeviceSample{n, now, {0.125, 0.125, z}, false});
+      loop.OfferInput(DeviceSample{n, now, {0.125, 0.125, z}, false});
     }  // then the input goes stale
     loop.PrimaryPeriod(now, now);
     for (int r = 1; r < loop.regions().num_regions(); ++r) {
-      const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+      if (loop.SecondaryMayStep(r)) const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
     }
-    while (loop.forces().Pop(&record)) ++forces;
+    while (loop.forces().Pop(&record)) {
+      ++forces;
+      pushed_back |= record.force_n[2] < -0.1;
+    }
   }
   EXPECT_EQ(count.count(), 0u);
   EXPECT_EQ(forces, 600);
+  EXPECT_EQ(loop.sleeps(), 1) << "asleep above the surface, woken by the touch (sleeping and "
+                                 "waking are covered too)";
+  EXPECT_TRUE(pushed_back);
   EXPECT_TRUE(record.flags & force_flags::kInputStale);
 }
 

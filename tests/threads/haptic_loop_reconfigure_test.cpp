@@ -13,6 +13,7 @@
 #include "daemon/haptic_loop.hpp"
 #include "daemon/supervisor.hpp"
 #include "tests/support/late_wakes.hpp"
+#include "tests/support/play_device.hpp"
 
 namespace hapticsim {
 namespace {
@@ -34,26 +35,6 @@ Scene AdaptiveScene() {
   return scene;
 }
 
-// Plays the device at 1 kHz on absolute sleeps: `tip(n)` for n = 0, 1, … for at least `periods`
-// periods and until `done()`; collects every force the loop hands over.
-std::vector<ForceRecord> Drive(
-    HapticLoop& loop, int periods, const std::function<std::array<double, 3>(int)>& tip,
-    const std::function<bool()>& done = [] { return true; }) {
-  std::vector<ForceRecord> forces;
-  forces.reserve(static_cast<size_t>(periods) + 100);
-  auto next = std::chrono::steady_clock::now();
-  ForceRecord record;
-  for (int n = 0; n < periods || !done(); ++n) {
-    loop.input().Write(DeviceSample{n, HapticLoop::NowNs(), tip(n), false});
-    while (loop.forces().Pop(&record)) forces.push_back(record);
-    next += std::chrono::milliseconds(1);
-    std::this_thread::sleep_until(next);
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  while (loop.forces().Pop(&record)) forces.push_back(record);
-  return forces;
-}
-
 TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplaced) {
   const Scene scene = AdaptiveScene();
   HapticLoop loop(scene, HapticLoop::Options{});
@@ -70,7 +51,7 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
       ++replaced;
     }
   });
-  const auto forces = Drive(
+  const auto forces = testing::PlayDevice(
       loop, 300,
       [](int) {
         return std::array<double, 3>{0.1, 0.1, -0.002};
@@ -117,7 +98,7 @@ PressResult PressAt(const LatticeIndex& node, const LatticeIndex& centre) {
     moved = true;
   });
   PressResult result;
-  result.forces = Drive(loop, 1100, [&](int n) {
+  result.forces = testing::PlayDevice(loop, 1100, [&](int n) {
     const double z = n < 100 ? -0.001 : 1e-5 * std::min(n - 100, 600);
     return std::array<double, 3>{node[0] * kH, node[1] * kH, z};
   });

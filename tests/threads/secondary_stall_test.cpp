@@ -82,7 +82,7 @@ StallRun Press(Stall stall) {
   constexpr double kH = 0.25 / 12;
   for (int n = 0; n < 1500; ++n) {
     const double z = n < 100 ? -0.001 : 1e-5 * std::min(n - 100, 300);
-    loop.input().Write(DeviceSample{n, HapticLoop::NowNs(), {6 * kH, 6 * kH, z}, false});
+    loop.OfferInput(DeviceSample{n, HapticLoop::NowNs(), {6 * kH, 6 * kH, z}, false});
     // Once: 0.3 s at 0.6 s. Repeatedly: 12 ms of every 16 ms from 0.6 s to 1.2 s, so the region
     // runs a quarter of the time and falls ever further behind.
     const bool once = stall == Stall::kOnce && n == 600;

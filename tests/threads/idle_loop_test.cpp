@@ -1,0 +1,107 @@
+// hapticsimd's loop on real threads and clocks with nothing touching the object: the secondary
+// thread parks (no steps at all), the primary answers every input but steps nothing, and with no
+// device it waits for input instead of running periods; an input wakes it at once and a touch
+// wakes the regions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <thread>
+#include <vector>
+
+#include "daemon/haptic_loop.hpp"
+#include "tests/support/play_device.hpp"
+
+namespace hapticsim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;  // every step several times slower: latencies are not checked
+#else
+constexpr bool kSanitized = false;
+#endif
+
+constexpr std::array<double, 3> kAbove{0.125, 0.125, -0.002};  // 2 mm off the front face
+
+std::int64_t Cycles(HapticLoop& loop, RegionIndex region) {
+  return loop.monitor(region).TakeSnapshot().cycles;
+}
+
+// Plays the device for `periods` periods from seq *seq on (and moves *seq past them).
+std::vector<ForceRecord> Drive(HapticLoop& loop, std::int64_t* seq, int periods,
+                               const std::function<std::array<double, 3>(int)>& tip) {
+  std::vector<ForceRecord> forces = testing::PlayDevice(
+      loop, periods, tip, [] { return true; }, *seq);
+  *seq += periods;
+  return forces;
+}
+
+TEST(IdleLoop, ParksTheSecondaryAnswersEveryInputAndWakesOnInputAndTouch) {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  HapticLoop loop(scene, HapticLoop::Options{});
+  ASSERT_GE(loop.regions().num_regions(), 2);
+  loop.Start();
+  std::int64_t seq = 0;
+  auto above = [](int) { return kAbove; };
+
+  // At rest from the start and untouched: asleep within a few periods.
+  Drive(loop, &seq, 200, above);
+  ASSERT_TRUE(loop.asleep());
+  EXPECT_EQ(loop.sleeps(), 1);
+
+  // Hovering: every input answered, the secondary region not stepped once.
+  const std::int64_t secondary_before = Cycles(loop, 1);
+  const std::vector<ForceRecord> hovering = Drive(loop, &seq, 300, above);
+  EXPECT_EQ(Cycles(loop, 1), secondary_before) << "a parked secondary stepped";
+  EXPECT_GE(hovering.size(), 295u);
+  for (const ForceRecord& f : hovering) EXPECT_EQ(f.force_n[2], 0.0);
+
+  // No device: once the input is stale the primary waits for input instead of running periods.
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  EXPECT_TRUE(loop.idle());
+  const std::int64_t primary_before = Cycles(loop, kPrimaryRegion);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // (Awake it would run 300 periods; idle, one per kIdleWait_s at most: 15.)
+  EXPECT_LE(Cycles(loop, kPrimaryRegion) - primary_before, 20);
+  EXPECT_GT(loop.primary_alive_ns(), HapticLoop::NowNs() - 100'000'000) << "no sign of life";
+
+  // An input after the silence is answered at once, not at the idle primary's next look round.
+  int prompt = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    while (!loop.idle()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ForceRecord record;
+    while (loop.forces().Pop(&record)) {
+    }
+    const std::int64_t sent = seq++;
+    const auto start = Clock::now();
+    loop.OfferInput(DeviceSample{sent, HapticLoop::NowNs(), kAbove, false});
+    bool answered = false;
+    while (!answered && Clock::now() - start < std::chrono::milliseconds(100)) {
+      while (loop.forces().Pop(&record)) answered |= record.seq == sent;
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+    EXPECT_TRUE(answered) << "trial " << trial;
+    if (answered && Clock::now() - start < std::chrono::milliseconds(5)) ++prompt;
+  }
+  // Unwoken, an answer would wait for the primary's next look round (kIdleWait_s = 20 ms): under
+  // 5 ms a quarter of the time.
+  if (!kSanitized) EXPECT_GE(prompt, 8) << "of 10 inputs after a silence answered within 5 ms";
+
+  // A press wakes the regions: the secondary steps again and the object pushes back.
+  const std::vector<ForceRecord> press = Drive(loop, &seq, 400, [](int n) {
+    return std::array<double, 3>{0.125, 0.125, -0.002 + 0.007 * std::min(1.0, n / 300.0)};
+  });
+  EXPECT_FALSE(loop.asleep());
+  EXPECT_GT(Cycles(loop, 1), secondary_before + 10) << "the secondary was not woken";
+  double deepest = 0;
+  for (const ForceRecord& f : press) deepest = std::min(deepest, f.force_n[2]);
+  EXPECT_LT(deepest, -0.3) << "a 5 mm press pushes back with ~0.7 N";
+  loop.Stop();
+}
+
+}  // namespace
+}  // namespace hapticsim
