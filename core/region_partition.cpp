@@ -52,10 +52,11 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
                        " empty: use fewer or thinner shells"));
   }
   for (int region = 0; region < regions; ++region) {
-    // A box of fine elements (the primary region) runs on the stencil where its rows are long
-    // enough for the stencil's vector path: measured per K·u against the element loop, a 13×13×7
-    // box 1.7× faster, 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar
-    // path, are nearly all of a small box; docs/benchmarks.md).
+    // Fine elements (the primary box; at spacing factor 1 the secondary shells too, boxes with a
+    // hole) run on node stencils where their bounding box's rows are long enough for the vector
+    // path: measured per K·u against the element loop, a 13×13×7 primary box 2.0× faster,
+    // 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar path, are nearly all
+    // of a small box); a 13³ secondary with a hole 1.5–3.0× faster (docs/benchmarks.md).
     if (auto box =
             BoxStiffness::TryMake(*mesh_, scene.material, elements[region], kMinBoxRowNodes)) {
       stiffness_.push_back(std::move(box));

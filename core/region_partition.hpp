@@ -47,7 +47,7 @@ class RegionPartition {
   const HybridMesh& mesh() const { return *mesh_; }
   const Eigen::VectorXd& dof_mass() const { return dof_mass_; }
   int num_regions() const { return static_cast<int>(stiffness_.size()); }
-  /** K of the region's elements: by the stencil where they form a box (BoxStiffness). */
+  /** K of the region's elements: by node stencils where they are all fine (BoxStiffness). */
   const StiffnessOperator& stiffness(RegionIndex region) const { return *stiffness_[region]; }
   const RegionDofs& dofs(RegionIndex region) const { return dofs_[region]; }
   /** Elements of `region` that touch its outer interface (the band whose forces cross it). */

@@ -6,18 +6,10 @@
 
 #include "core/hex_grid.hpp"
 #include "core/material.hpp"
+#include "core/stencil_kernels.hpp"
 #include "core/stiffness_operator.hpp"
 
 namespace hapticsim {
-
-/**
- * One coupling of a stencil: ku_a[i] += coefficient · u[i + offset], where offset already includes
- * the component block of the source (b·N) and the neighbour's node stride.
- */
-struct StencilTerm {
-  std::ptrdiff_t offset;
-  double coefficient;
-};
 
 /**
  * Matrix-free K·u on a structured grid of identical cube elements: a 27-point node stencil.
@@ -41,16 +33,13 @@ class StencilStiffness final : public StiffnessOperator {
   double FlopsPerApply() const;
 
  private:
-  // Terms of one node class, split by output component a.
-  using ClassStencil = std::array<std::vector<StencilTerm>, 3>;
-
   static int AxisClass(int index, int count) {
     return index == 0 ? 0 : (index == count - 1 ? 2 : 1);
   }
   void ApplyRow(const double* u, double* ku, int iy, int iz) const;
 
   HexGrid grid_;
-  std::array<ClassStencil, 27> stencils_;
+  std::array<NodeStencil, 27> stencils_;  // per node class
 };
 
 }  // namespace hapticsim

@@ -10,10 +10,12 @@
 #include <benchmark/benchmark.h>
 
 #include "core/assembled_stiffness.hpp"
+#include "core/box_stiffness.hpp"
 #include "core/central_difference_integrator.hpp"
 #include "core/cube_scene.hpp"
 #include "core/element_set_stiffness.hpp"
 #include "core/hybrid_mesh.hpp"
+#include "core/region_partition.hpp"
 #include "core/stencil_stiffness.hpp"
 
 namespace hapticsim {
@@ -73,6 +75,39 @@ void BM_ElementLoopApply(benchmark::State& state) {
   state.counters["nodes"] = mesh.num_independent();
 }
 
+// One region of the paper's 13³ cube (primary size, spacing factor, region as arguments): K·u by
+// the element loop (use_box 0) or by BoxStiffness, node stencils on the region's bounding box
+// with its nodes gathered and scattered (use_box 1), on the same mesh and field. Region 0 is the
+// primary (a box), region 1 at spacing 1 a box with the primary's box as its hole.
+void BM_RegionApply(benchmark::State& state) {
+  Scene scene;
+  scene.adaptivity.primary_size = static_cast<int>(state.range(0));
+  scene.adaptivity.secondary_lod = static_cast<int>(state.range(1));
+  const auto region = static_cast<RegionIndex>(state.range(2));
+  const RegionPartition partition(scene);
+  const HybridMesh& mesh = partition.mesh();
+  std::vector<int> ids;
+  for (int e = 0; e < static_cast<int>(mesh.elements().size()); ++e) {
+    if (mesh.elements()[static_cast<size_t>(e)].region == region) ids.push_back(e);
+  }
+  const ElementSetStiffness elements(mesh, scene.material, ids);
+  const auto box = BoxStiffness::TryMake(mesh, scene.material, ids);
+  if (!box) {
+    state.SkipWithError("the region's elements are not all fine");
+    return;
+  }
+  const StiffnessOperator& k =
+      state.range(3) ? static_cast<const StiffnessOperator&>(*box) : elements;
+  const Eigen::VectorXd u = Field(mesh.num_dofs());
+  Eigen::VectorXd ku(mesh.num_dofs());
+  for (auto _ : state) {
+    k.Apply(u, ku);
+    benchmark::DoNotOptimize(ku.data());
+  }
+  state.counters["elements"] = static_cast<double>(ids.size());
+  state.counters["direct_nodes"] = box->direct_nodes();
+}
+
 void BM_TimeStep(benchmark::State& state) {
   Scene scene;
   scene.mesh.nodes = static_cast<int>(state.range(0));
@@ -89,6 +124,12 @@ void BM_TimeStep(benchmark::State& state) {
 BENCHMARK(BM_StencilApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssembledApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ElementLoopApply)->Arg(13)->Arg(25)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RegionApply)
+    ->ArgNames({"primary_size", "spacing", "region", "use_box"})
+    ->ArgsProduct({{4}, {3}, {0}, {0, 1}})
+    ->ArgsProduct({{3}, {2}, {0}, {0, 1}})
+    ->ArgsProduct({{1, 2, 3, 4}, {1}, {1}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TimeStep)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
