@@ -30,7 +30,7 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
 void RegionIntegrator::Reset() {
   for (auto& b : buffers_) b.setZero();
   ku_.setZero();
-  ku_valid_ = false;
+  ku_valid_ = true;  // K·0 = 0: no product needed (a region put to sleep is reset in 1 kHz time)
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
 }
 

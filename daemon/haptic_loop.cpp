@@ -105,7 +105,10 @@ void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
   }
   paused_.store(false);
   pause_requested_.store(true, std::memory_order_release);
-  FutexWakeAll(&input_arrivals_);  // an idle primary waiting for input comes round now
+  // An idle primary waiting for input comes round now (the count moves, so a primary about to
+  // wait does not wait either).
+  input_arrivals_.fetch_add(1);
+  FutexWakeAll(&input_arrivals_);
   // The primary acknowledges at its next release; after that it does not touch the regions.
   const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
   while (!paused_.load(std::memory_order_acquire)) {
@@ -157,7 +160,7 @@ std::int64_t HapticLoop::primary_alive_ns() const {
 
 void HapticLoop::ForgetSleep() {
   park_secondaries_.store(false);
-  watch_rest_.store(false);
+  watch_.store(0);
   for (auto& parked : parked_) parked.store(false);
   parked_count_.store(0);
   wake_origin_ns_.store(-1);
@@ -174,9 +177,9 @@ bool HapticLoop::SecondaryMayStep(RegionIndex region) noexcept {
     }
     return false;
   }
-  if (watch_rest_.load(std::memory_order_acquire)) {
-    region_at_rest_[region].store(regions_->RegionAtRest(region, kRestTolerance_m),
-                                  std::memory_order_release);
+  const std::uint32_t watch = watch_.load(std::memory_order_acquire);
+  if (watch != 0 && regions_->RegionAtRest(region, kRestTolerance_m)) {
+    at_rest_in_watch_[region].store(watch, std::memory_order_release);
   }
   return true;
 }
@@ -185,28 +188,34 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
   const int secondaries = regions_->num_regions() - 1;
   if (sleep_state_ == kAwake) {
     if (touched) {
-      watch_rest_.store(false, std::memory_order_relaxed);
+      watch_.store(0, std::memory_order_relaxed);
       return;
     }
-    if (!watch_rest_.load(std::memory_order_relaxed)) {
-      // A secondary's "at rest" from before the touch does not count: each must find it anew.
-      for (int a = 1; a <= secondaries; ++a) region_at_rest_[a].store(false);
-      watch_rest_.store(true, std::memory_order_release);
+    const std::uint32_t watch = watch_.load(std::memory_order_relaxed);
+    if (watch == 0) {
+      watches_ = watches_ == UINT32_MAX ? 1 : watches_ + 1;
+      watch_.store(watches_, std::memory_order_release);
       return;
     }
     if (!regions_->RegionAtRest(kPrimaryRegion, kRestTolerance_m)) return;
     for (int a = 1; a <= secondaries; ++a) {
-      if (!region_at_rest_[a].load(std::memory_order_acquire)) return;
+      if (at_rest_in_watch_[a].load(std::memory_order_acquire) != watch) return;
     }
     park_secondaries_.store(true, std::memory_order_release);
     sleep_state_ = kParking;
   }
   if (sleep_state_ == kParking) {
     if (parked_count_.load(std::memory_order_acquire) < secondaries) return;
-    watch_rest_.store(false, std::memory_order_relaxed);
-    if (touched) {
-      // Touched while the secondaries were parking: they carry on where they were (at rest).
-      WakeSecondaries(-1);
+    watch_.store(0, std::memory_order_relaxed);
+    // Every region is parked, so their states can be read here: the tool may have touched and
+    // left while they were parking (the primary stepped on meanwhile), and that deformation must
+    // not be thrown away.
+    bool at_rest = !touched;
+    for (int a = 0; a <= secondaries && at_rest; ++a) {
+      at_rest = regions_->RegionAtRest(a, kRestTolerance_m);
+    }
+    if (!at_rest) {
+      WakeSecondaries(-1);  // they carry on where they were
       return;
     }
     // Nothing steps any region now: rest exactly, at time 0 of a schedule that starts on waking.
@@ -382,21 +391,20 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
         wake_generation_.wait(generation, std::memory_order_acquire);
       }
       const std::int64_t wake_origin = wake_origin_ns_.load(std::memory_order_relaxed);
-      if (wake_origin >= 0) {
-        origin_ns = wake_origin;  // the regions restart from rest there
-        catching_up = true;
-      }
+      if (wake_origin >= 0) origin_ns = wake_origin;  // the regions restart from rest there
+      catching_up = true;
       continue;
     }
     std::int64_t release = origin_ns +
                            static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
                            lead_ns_[region];
     if (catching_up) {
-      // Restarted on the primary's present release, a region meant to run ahead of it (lead_ns_)
-      // starts behind: its steps until it is ahead again are released now, not missed.
+      // Woken, a region meant to run ahead of the primary (lead_ns_) starts behind: until it is
+      // ahead again a step is released now, and late only once it is behind the primary itself
+      // (then, stalled, it skips as below).
       const std::int64_t now = NowNs();
       if (release < now) {
-        release = now;
+        release = std::min(now, release + lead_ns_[region]);
       } else {
         catching_up = false;
       }
@@ -476,7 +484,8 @@ std::string HapticLoop::ApplyRealtimeSettings(std::thread& thread) const {
 
 void HapticLoop::Stop() {
   stop_ = true;
-  FutexWakeAll(&input_arrivals_);  // an idle primary waiting for input comes round now
+  input_arrivals_.fetch_add(1);  // an idle primary waiting for input comes round now
+  FutexWakeAll(&input_arrivals_);
   if (primary_thread_.joinable()) primary_thread_.join();
   StopSecondaries();
   running_ = false;

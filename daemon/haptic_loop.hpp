@@ -258,8 +258,13 @@ class HapticLoop {
 
   // Sleeping at rest. Primary → secondaries: park before your next step; a new wake generation
   // (notified) releases them, to restart on wake_origin_ns_ (−1: carry on on their own grid).
-  std::atomic<bool> park_secondaries_{false}, watch_rest_{false}, asleep_{false}, idle_{false};
-  std::array<std::atomic<bool>, kMaxRegions> parked_{}, region_at_rest_{};
+  std::atomic<bool> park_secondaries_{false}, asleep_{false}, idle_{false};
+  std::array<std::atomic<bool>, kMaxRegions> parked_{};
+  // The primary watches for rest in numbered watches (0: not watching); a secondary found at rest
+  // stores the watch it was found in, so a finding from before a touch cannot count after it.
+  std::atomic<std::uint32_t> watch_{0};
+  std::array<std::atomic<std::uint32_t>, kMaxRegions> at_rest_in_watch_{};
+  std::uint32_t watches_ = 0;  // primary thread
   std::atomic<int> parked_count_{0};
   std::atomic<std::uint32_t> wake_generation_{0};
   std::atomic<std::int64_t> wake_origin_ns_{-1}, sleeps_{0}, alive_ns_{0};

@@ -180,12 +180,15 @@ int Serve(const Arguments& args) {
   std::thread io([&] {
     const timespec quarter_ms{0, 250'000}, one_ms{0, 1'000'000}, idle_wait{0, 20'000'000};
     ForceRecord record;
-    std::int64_t inputs_seen = -1;
+    std::int64_t inputs_seen = -1, last_input_ns = 0;
     while (!stop_io.load()) {
-      // An input just handed over: its answer comes within a period, whatever the loop said.
+      // An input handed over lately: its answer comes within a period or two (the primary may
+      // still say idle until its next period runs), so poll fast for a while whatever it says.
       const std::int64_t inputs = counters.inputs_received.load();
-      const bool idle = loop.idle() && inputs == inputs_seen;
+      const std::int64_t now = HapticLoop::NowNs();
+      if (inputs != inputs_seen) last_input_ns = now;
       inputs_seen = inputs;
+      const bool idle = loop.idle() && now - last_input_ns > 5'000'000;
       const timespec& wait = !idle ? quarter_ms : shm ? one_ms : idle_wait;
       if (bridge) {
         bridge->Poll(wait);

@@ -20,16 +20,21 @@ struct Played {
 
 // hapticsimd's threads played on this one: each period an input that arrived at its release,
 // the secondary regions stepped in virtual time as far as the primary's coming step needs
-// (unless they are parked), then the primary period.
-Played Play(HapticLoop& loop, const std::function<double(int)>& depth_m, int periods) {
+// (unless they are parked, or busy: `secondaries_run(n)` false, as if their thread were in the
+// middle of a long step), then the primary period.
+Played Play(
+    HapticLoop& loop, const std::function<double(int)>& depth_m, int periods,
+    const std::function<bool(int)>& secondaries_run = [](int) { return true; }) {
   auto& regions = const_cast<AsyncRegions&>(loop.regions());
   Played played;
   std::int64_t release = 1'000'000'000;
   ForceRecord record;
   for (int n = 0; n < periods; ++n, release += 1'000'000) {
     loop.OfferInput(DeviceSample{n, release, {0.125, 0.125, depth_m(n)}, false});
-    bool may_step = true;
-    for (int r = 1; r < regions.num_regions(); ++r) may_step &= loop.SecondaryMayStep(r);
+    bool may_step = secondaries_run(n);
+    for (int r = 1; r < regions.num_regions() && may_step; ++r) {
+      may_step &= loop.SecondaryMayStep(r);
+    }
     if (may_step) {
       regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
                                    regions.period_ticks(kPrimaryRegion));
@@ -122,6 +127,27 @@ TEST(SleepAtRest, APressFeelsTheSameWhetherTheRegionsSleptBeforeItOrNot) {
   RecordProperty("largest_difference_n", std::to_string(largest_difference));
   std::printf("largest force difference over both presses: %.3g N (peak %.3f N)\n",
               largest_difference, peak);
+}
+
+TEST(SleepAtRest, ATouchWhileTheSecondaryParksIsNotThrownAway) {
+  // At rest from the start: the primary starts watching in period 0, the secondary reports rest
+  // in period 1 and the primary asks it to park; then it is busy (not asking, not stepping) until
+  // period 50 while the primary waits for it; meanwhile the tool presses 1 mm and leaves. When
+  // the secondary finally parks, the primary region still rings: the regions must carry on, not
+  // be reset.
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  HapticLoop loop(scene, HapticLoop::Options{});
+  auto press = [](int n) {
+    if (n < 10 || n >= 40) return -0.002;
+    return n < 25 ? -0.002 + 0.003 * (n - 10) / 15.0 : 0.001 - 0.003 * (n - 25) / 15.0;
+  };
+  const Played played = Play(loop, press, 60, [](int n) { return n < 2 || n >= 50; });
+  bool pushed = false;
+  for (const ForceRecord& f : played.forces) pushed |= f.force_n[2] < -0.01;
+  EXPECT_TRUE(pushed) << "the press was rendered while the secondary was busy";
+  EXPECT_EQ(loop.sleeps(), 0) << "the press's deformation was reset away";
+  EXPECT_FALSE(played.asleep.back());
 }
 
 TEST(SleepAtRest, AnObjectThatNeverRingsDownNeverSleeps) {
