@@ -382,7 +382,7 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   DeadlineMonitor& monitor = *monitors_[region];
   const int substeps = regions_->schedule(region).substeps;
   const double period_ns = 1e9 / regions_->schedule(region).rate_hz;
-  bool catching_up = false;  // restarted on a new origin, and not yet ahead of its grid
+  std::int64_t woken_ns = 0;  // when it last came out of parking
   while (!stop_secondaries_.load(std::memory_order_acquire)) {
     const std::uint32_t generation = wake_generation_.load(std::memory_order_acquire);
     if (!SecondaryMayStep(region)) {
@@ -392,23 +392,16 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
       }
       const std::int64_t wake_origin = wake_origin_ns_.load(std::memory_order_relaxed);
       if (wake_origin >= 0) origin_ns = wake_origin;  // the regions restart from rest there
-      catching_up = true;
+      woken_ns = NowNs();
       continue;
     }
-    std::int64_t release = origin_ns +
-                           static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
-                           lead_ns_[region];
-    if (catching_up) {
-      // Woken, a region meant to run ahead of the primary (lead_ns_) starts behind: until it is
-      // ahead again a step is released now, and late only once it is behind the primary itself
-      // (then, stalled, it skips as below).
-      const std::int64_t now = NowNs();
-      if (release < now) {
-        release = std::min(now, release + lead_ns_[region]);
-      } else {
-        catching_up = false;
-      }
-    }
+    // Woken, a region meant to run ahead of the primary (lead_ns_) starts behind it (and behind
+    // by more if the primary woke it late): its steps until it is ahead again count as released
+    // when it woke, so they run at once and are not misses — unless this thread is held up after
+    // waking, which counts from then and skips as below.
+    const std::int64_t release = std::max(
+        woken_ns, origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
+                      lead_ns_[region]);
     SleepUntilMonotonicNs(release);
     const std::int64_t woke = NowNs();
     // Stalled (preempted, a debugger, a page-fault storm): hold the state over the missed periods

@@ -16,6 +16,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -322,6 +323,10 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
     }
     previous = f.force[2];
   }
+  std::printf(
+      "re-centring: largest force step %.4f N over periods woken on time; %d of %zu answers "
+      "near a late wake\n",
+      largest_jump, near_late, forces.size());
   EXPECT_GT(waited, 10) << "the touch should wait for its regions";
   EXPECT_GT(pushing_back, 100) << daemon_->Log();
   EXPECT_LT(largest_jump, 0.1) << "a force step across the re-centring";
