@@ -1,8 +1,6 @@
 #include "core/stencil_stiffness.hpp"
 
 #include <cassert>
-#include <cmath>
-#include <cstring>
 
 #include "core/hex8_element.hpp"
 

@@ -24,8 +24,9 @@ void NameThisThread(const std::string& name) {
   pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
 }
 
-// The futex behind an atomic word: std::atomic::wait has no timeout, and an idle primary must
-// still come round now and then (stop, reconfiguration, the watchdog's sign of life).
+// The futex behind an atomic word, for every wait of the loop's threads: std::atomic::wait has
+// no timeout (an idle primary must still come round now and then: stop, reconfiguration, the
+// watchdog's sign of life), and a wake is one system call, no lock, in the 1 kHz path too.
 static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) &&
               std::atomic<std::uint32_t>::is_always_lock_free);
 void FutexWait(std::atomic<std::uint32_t>* word, std::uint32_t expected, double timeout_s) {
@@ -162,7 +163,6 @@ void HapticLoop::ForgetSleep() {
   park_secondaries_.store(false);
   watch_.store(0);
   for (auto& parked : parked_) parked.store(false);
-  parked_count_.store(0);
   wake_origin_ns_.store(-1);
   sleep_state_ = kAwake;
   asleep_.store(false);
@@ -171,10 +171,7 @@ void HapticLoop::ForgetSleep() {
 
 bool HapticLoop::SecondaryMayStep(RegionIndex region) noexcept {
   if (park_secondaries_.load(std::memory_order_acquire)) {
-    if (!parked_[region].exchange(true, std::memory_order_acq_rel)) {
-      // Its last step's writes are published to the primary with the count.
-      parked_count_.fetch_add(1, std::memory_order_acq_rel);
-    }
+    parked_[region].store(true, std::memory_order_release);  // publishes its last step's writes
     return false;
   }
   const std::uint32_t watch = watch_.load(std::memory_order_acquire);
@@ -205,7 +202,9 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
     sleep_state_ = kParking;
   }
   if (sleep_state_ == kParking) {
-    if (parked_count_.load(std::memory_order_acquire) < secondaries) return;
+    for (int a = 1; a <= secondaries; ++a) {
+      if (!parked_[a].load(std::memory_order_acquire)) return;
+    }
     watch_.store(0, std::memory_order_relaxed);
     // Every region is parked, so their states can be read here: the tool may have touched and
     // left while they were parking (the primary stepped on meanwhile), and that deformation must
@@ -229,10 +228,9 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
 void HapticLoop::WakeSecondaries(std::int64_t origin_ns) noexcept {
   wake_origin_ns_.store(origin_ns, std::memory_order_relaxed);
   for (auto& parked : parked_) parked.store(false, std::memory_order_relaxed);
-  parked_count_.store(0, std::memory_order_relaxed);
   park_secondaries_.store(false, std::memory_order_relaxed);
   wake_generation_.fetch_add(1, std::memory_order_release);  // publishes the stores above
-  wake_generation_.notify_all();
+  FutexWakeAll(&wake_generation_);
   sleep_state_ = kAwake;
   asleep_.store(false, std::memory_order_relaxed);
 }
@@ -388,7 +386,7 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
     if (!SecondaryMayStep(region)) {
       while (wake_generation_.load(std::memory_order_acquire) == generation &&
              !stop_secondaries_.load(std::memory_order_acquire)) {
-        wake_generation_.wait(generation, std::memory_order_acquire);
+        FutexWait(&wake_generation_, generation, kIdleWait_s);
       }
       const std::int64_t wake_origin = wake_origin_ns_.load(std::memory_order_relaxed);
       if (wake_origin >= 0) origin_ns = wake_origin;  // the regions restart from rest there
@@ -429,7 +427,7 @@ void HapticLoop::StartSecondaries(std::int64_t origin_ns) {
 void HapticLoop::StopSecondaries() {
   stop_secondaries_ = true;
   wake_generation_.fetch_add(1);  // parked ones come round and see the stop
-  wake_generation_.notify_all();
+  FutexWakeAll(&wake_generation_);
   for (std::thread& thread : secondary_threads_) {
     if (thread.joinable()) thread.join();
   }

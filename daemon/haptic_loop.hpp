@@ -256,8 +256,9 @@ class HapticLoop {
   std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none
   std::atomic<bool> contact_waiting_{false};
 
-  // Sleeping at rest. Primary → secondaries: park before your next step; a new wake generation
-  // (notified) releases them, to restart on wake_origin_ns_ (−1: carry on on their own grid).
+  // Sleeping at rest. Primary → secondaries: park before your next step (each sets its parked_);
+  // a new wake generation (futex-woken) releases them, to restart on wake_origin_ns_ (−1: carry
+  // on on their own grid).
   std::atomic<bool> park_secondaries_{false}, asleep_{false}, idle_{false};
   std::array<std::atomic<bool>, kMaxRegions> parked_{};
   // The primary watches for rest in numbered watches (0: not watching); a secondary found at rest
@@ -265,7 +266,6 @@ class HapticLoop {
   std::atomic<std::uint32_t> watch_{0};
   std::array<std::atomic<std::uint32_t>, kMaxRegions> at_rest_in_watch_{};
   std::uint32_t watches_ = 0;  // primary thread
-  std::atomic<int> parked_count_{0};
   std::atomic<std::uint32_t> wake_generation_{0};
   std::atomic<std::int64_t> wake_origin_ns_{-1}, sleeps_{0}, alive_ns_{0};
   // I/O → primary: inputs offered (the futex an idle primary waits on) and whether it waits.

@@ -90,7 +90,9 @@ TEST(IdleLoop, ParksTheSecondaryAnswersEveryInputAndWakesOnInputAndTouch) {
   // Unwoken, an answer would wait for the primary's next look round (kIdleWait_s = 20 ms): under
   // 5 ms a quarter of the time, so 7 of 10 by chance 0.4 % of the time (3 slow ones are allowed
   // for a busy machine).
-  if (!kSanitized) EXPECT_GE(prompt, 7) << "of 10 inputs after a silence answered within 5 ms";
+  if (!kSanitized) {
+    EXPECT_GE(prompt, 7) << "of 10 inputs after a silence answered within 5 ms";
+  }
 
   // A press wakes the regions: the secondary steps again and the object pushes back.
   const std::vector<ForceRecord> press = Drive(loop, &seq, 400, [](int n) {
