@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "core/scene_toml.hpp"
@@ -19,7 +20,13 @@ using Setter = std::function<void(DaemonConfig*, const toml::node&, const std::s
 
 template <typename T>
 T Get(const toml::node& node, const std::string& key, const std::string& where, const char* type) {
-  const std::optional<T> value = node.value<T>();
+  // A flag must be true or false as written: toml++'s value<bool>() would take 3 or 0 as well.
+  std::optional<T> value;
+  if constexpr (std::is_same_v<T, bool>) {
+    value = node.value_exact<bool>();
+  } else {
+    value = node.value<T>();
+  }
   if (!value) throw Error(where + ": " + key + " must be " + type);
   return *value;
 }

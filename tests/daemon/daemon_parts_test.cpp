@@ -110,6 +110,10 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 120\n").find("realtime.fifo_priority"),
             std::string::npos);
+  EXPECT_NE(ConfigError("[realtime]\nsleep_at_rest = 3\n")
+                .find("realtime.sleep_at_rest must be true or false"),
+            std::string::npos)
+      << ConfigError("[realtime]\nsleep_at_rest = 3\n");
   EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find("hapticsimd_config_test.toml:1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
 }
@@ -273,8 +277,13 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndRefusesTheRestWithTheReason) {
   const CheckedCommand pin = CheckCommand(c, 1000);
   ASSERT_EQ(pin.kind, CheckedCommand::Kind::kPinConfiguration);
   EXPECT_EQ(pin.pin, (RegionConfiguration{3, 2, 800}));
-  for (auto [size, lod, rate] : {std::tuple{0, 2, 800.0}, {3, 0, 800.0}, {3, 2, 1500.0},
-                                 {3, 2, 0.0}, {3, 2, double{NAN}}, {3, 2, 800.5}, {5000, 2, 800.0}}) {
+  for (auto [size, lod, rate] : {std::tuple{0, 2, 800.0},
+                                 {3, 0, 800.0},
+                                 {3, 2, 1500.0},
+                                 {3, 2, 0.0},
+                                 {3, 2, double{NAN}},
+                                 {3, 2, 800.5},
+                                 {5000, 2, 800.0}}) {
     c.primary_size = size, c.secondary_lod = lod, c.secondary_rate_hz = rate;
     const CheckedCommand checked = CheckCommand(c, 1000);
     EXPECT_EQ(checked.kind, CheckedCommand::Kind::kRefused) << size << " " << lod << " " << rate;
@@ -293,8 +302,7 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndRefusesTheRestWithTheReason) {
 }
 
 TEST(DaemonConfig, TextFromFuzzingNamingASceneFileIsRefusedNotRead) {
-  EXPECT_THROW(ParseDaemonConfigText("[scene]\nfile = \"/dev/zero\"\n", "fuzz.toml", false),
-               Error);
+  EXPECT_THROW(ParseDaemonConfigText("[scene]\nfile = \"/dev/zero\"\n", "fuzz.toml", false), Error);
   EXPECT_NO_THROW(ParseDaemonConfigText("[scene]\nfile = \"\"\n", "fuzz.toml", false));
 }
 
