@@ -204,7 +204,8 @@ class MapFileReader {
     if (version != kErrorMapFormatVersion) {
       Refuse(path_, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
                         std::to_string(kErrorMapFormatVersion) +
-                        " (remake it with hapticsim sweep)");
+                        (version == 1 ? " (version 1 maps have no contact-node axes)" : "") +
+                        ": remake it with hapticsim sweep");
     }
     const auto count = Read<std::uint32_t>(header, 12);
     if (count > 64) Refuse(path_, "corrupted: " + std::to_string(count) + " sections");

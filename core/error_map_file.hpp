@@ -18,13 +18,16 @@ namespace hapticsim {
  *     "lookup.l2_percent", "lookup.max_magnitude_percent", "lookup.max_direction_deg"
  *                         f64 per sample: one lookup table each
  *     "status"            u8 status + i8 region per sample
- *     "details"           f64 per sample: the point (9), reference peak, spectral radius,
+ *     "details"           f64 per sample: the point (12), reference peak, spectral radius,
  *                         cost per region (4)
  *
  * Every section has its own checksum, so the daemon reads and checks only what it looks up.
  */
-/** File format version written by SaveErrorMap and the only one LoadErrorMap reads. */
-inline constexpr std::uint32_t kErrorMapFormatVersion = 1;
+/**
+ * File format version written by SaveErrorMap and the only one LoadErrorMap reads.
+ * 2: the contact node's three axes appended (version 1 maps have nine axes).
+ */
+inline constexpr std::uint32_t kErrorMapFormatVersion = 2;
 
 /** Writes the map atomically (a temporary file renamed over `path`). @throws Error on I/O. */
 void SaveErrorMap(const ErrorMap& map, const std::string& path);

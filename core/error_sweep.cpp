@@ -35,15 +35,18 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 int Axis(MapAxis axis) { return static_cast<int>(axis); }
 
-// The material and input a reference depends on.
-using ReferenceKey = std::array<double, 6>;
+// The material and input (with the contact node) a reference depends on.
+using ReferenceKey = std::array<double, 9>;
 ReferenceKey ReferenceKeyOf(const MapPoint& p) {
   return {p[Axis(MapAxis::kPoissonRatio)], p[Axis(MapAxis::kDensity)],
           p[Axis(MapAxis::kDamping)],      p[Axis(MapAxis::kYoungsModulus)],
-          p[Axis(MapAxis::kAmplitude)],    p[Axis(MapAxis::kFrequency)]};
+          p[Axis(MapAxis::kAmplitude)],    p[Axis(MapAxis::kFrequency)],
+          p[Axis(MapAxis::kContactNodeX)], p[Axis(MapAxis::kContactNodeY)],
+          p[Axis(MapAxis::kContactNodeZ)]};
 }
 
 struct Reference {
+  MapPoint point{};  // a run that needs it: its configuration axes are not used
   TrialResult trial;
   bool ok = false;
 };
@@ -83,24 +86,47 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
   const auto& ax = grid.axes;
   const ErrorMap layout = ErrorMap::MakeGrid(ax);
   const int lod_axis = Axis(MapAxis::kSecondaryLod), size_axis = Axis(MapAxis::kPrimarySize);
-  // Sizes that give the same regions, per spacing factor: run once, copied to the others.
-  std::vector<std::vector<std::vector<int>>> size_groups(ax[lod_axis].size());
-  for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
-    std::map<std::vector<int>, size_t> seen;
-    for (size_t s = 0; s < ax[size_axis].size(); ++s) {
-      MapPoint point = layout.samples.front().point;
-      point[lod_axis] = ax[lod_axis][l];
-      point[size_axis] = ax[size_axis][s];
-      std::vector<int> signature;
-      try {
-        signature = RegionSignature(SceneAtPoint(base, point));
-      } catch (const Error& e) {
-        throw Error("configuration secondary_lod = " + FormatReal(point[lod_axis]) +
-                    ", primary_size = " + FormatReal(point[size_axis]) + ": " + e.what());
+  constexpr std::array<int, 3> kContactAxes = {static_cast<int>(MapAxis::kContactNodeX),
+                                               static_cast<int>(MapAxis::kContactNodeY),
+                                               static_cast<int>(MapAxis::kContactNodeZ)};
+  std::size_t contacts = 1;
+  for (int a : kContactAxes) contacts *= ax[a].size();
+  // The contact node's axis indices, the last axis fastest.
+  auto contact_index = [&](std::size_t c, std::array<int, kNumMapAxes>* index) {
+    for (int k = 2; k >= 0; --k) {
+      const int a = kContactAxes[k];
+      (*index)[a] = static_cast<int>(c % ax[a].size());
+      c /= ax[a].size();
+    }
+  };
+  // Sizes that give the same regions, per contact node and spacing factor: run once, copied to
+  // the others. (Boxes near an edge of the object are cut by it, so this depends on the node.)
+  std::vector<std::vector<std::vector<std::vector<int>>>> size_groups(contacts);
+  for (std::size_t c = 0; c < contacts; ++c) {
+    size_groups[c].resize(ax[lod_axis].size());
+    std::array<int, kNumMapAxes> index{};
+    contact_index(c, &index);
+    for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
+      std::map<std::vector<int>, size_t> seen;
+      for (size_t s = 0; s < ax[size_axis].size(); ++s) {
+        MapPoint point = layout.samples.front().point;
+        for (int a : kContactAxes) point[a] = ax[a][index[a]];
+        point[lod_axis] = ax[lod_axis][l];
+        point[size_axis] = ax[size_axis][s];
+        std::vector<int> signature;
+        try {
+          signature = RegionSignature(SceneAtPoint(base, point));
+        } catch (const Error& e) {
+          throw Error("configuration secondary_lod = " + FormatReal(point[lod_axis]) +
+                      ", primary_size = " + FormatReal(point[size_axis]) + " at contact node (" +
+                      FormatReal(point[kContactAxes[0]]) + ", " +
+                      FormatReal(point[kContactAxes[1]]) + ", " +
+                      FormatReal(point[kContactAxes[2]]) + "): " + e.what());
+        }
+        const auto [it, inserted] = seen.emplace(signature, size_groups[c][l].size());
+        if (inserted) size_groups[c][l].emplace_back();
+        size_groups[c][l][it->second].push_back(static_cast<int>(s));
       }
-      const auto [it, inserted] = seen.emplace(signature, size_groups[l].size());
-      if (inserted) size_groups[l].emplace_back();
-      size_groups[l][it->second].push_back(static_cast<int>(s));
     }
   }
   const size_t amps = ax[Axis(MapAxis::kAmplitude)].size();
@@ -112,47 +138,50 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
     for (int a = 0; a < kNumMapAxes; ++a) p[a] = ax[a][i[a]];
     return p;
   };
-  // Materials outermost, then spacing factor, rate and region group: the order is the task
-  // numbering that shards and journals use.
+  // Materials outermost, then contact node, spacing factor, rate and region group: the order is
+  // the task numbering that shards and journals use.
   const size_t materials = ax[0].size() * ax[1].size() * ax[2].size() * ax[3].size();
   for (size_t m = 0; m < materials; ++m) {
     for (int a = 3, rest = static_cast<int>(m); a >= 0; --a) {  // material axes, last fastest
       index[a] = rest % static_cast<int>(ax[a].size());
       rest /= static_cast<int>(ax[a].size());
     }
-    for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
-      for (size_t r = 0; r < ax[Axis(MapAxis::kSecondaryRate)].size(); ++r) {
-        for (const std::vector<int>& group : size_groups[l]) {
-          Task task;
-          index[lod_axis] = static_cast<int>(l);
-          index[Axis(MapAxis::kSecondaryRate)] = static_cast<int>(r);
-          index[size_axis] = group.front();
-          for (size_t f = 0; f < freqs; ++f) {
-            index[Axis(MapAxis::kFrequency)] = static_cast<int>(f);
-            const size_t run_amps = linear ? 1 : amps;
-            for (size_t ra = 0; ra < run_amps; ++ra) {
-              Run run;
-              index[Axis(MapAxis::kAmplitude)] = static_cast<int>(ra);
-              index[size_axis] = group.front();
-              run.point = point_at(index);
-              const double amplitude = run.point[Axis(MapAxis::kAmplitude)];
-              for (int s : group) {
-                for (size_t a = 0; a < amps; ++a) {
-                  if (!linear && a != ra) continue;
-                  auto target_index = index;
-                  target_index[size_axis] = s;
-                  target_index[Axis(MapAxis::kAmplitude)] = static_cast<int>(a);
-                  run.targets.push_back({layout.GridIndex(target_index),
-                                         ax[Axis(MapAxis::kAmplitude)][a] / amplitude});
+    for (std::size_t c = 0; c < contacts; ++c) {
+      contact_index(c, &index);
+      for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
+        for (size_t r = 0; r < ax[Axis(MapAxis::kSecondaryRate)].size(); ++r) {
+          for (const std::vector<int>& group : size_groups[c][l]) {
+            Task task;
+            index[lod_axis] = static_cast<int>(l);
+            index[Axis(MapAxis::kSecondaryRate)] = static_cast<int>(r);
+            index[size_axis] = group.front();
+            for (size_t f = 0; f < freqs; ++f) {
+              index[Axis(MapAxis::kFrequency)] = static_cast<int>(f);
+              const size_t run_amps = linear ? 1 : amps;
+              for (size_t ra = 0; ra < run_amps; ++ra) {
+                Run run;
+                index[Axis(MapAxis::kAmplitude)] = static_cast<int>(ra);
+                index[size_axis] = group.front();
+                run.point = point_at(index);
+                const double amplitude = run.point[Axis(MapAxis::kAmplitude)];
+                for (int s : group) {
+                  for (size_t a = 0; a < amps; ++a) {
+                    if (!linear && a != ra) continue;
+                    auto target_index = index;
+                    target_index[size_axis] = s;
+                    target_index[Axis(MapAxis::kAmplitude)] = static_cast<int>(a);
+                    run.targets.push_back({layout.GridIndex(target_index),
+                                           ax[Axis(MapAxis::kAmplitude)][a] / amplitude});
+                  }
                 }
+                stats->saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
+                stats->saved_by_same_regions += group.size() - 1;
+                task.runs.push_back(std::move(run));
               }
-              stats->saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
-              stats->saved_by_same_regions += group.size() - 1;
-              task.runs.push_back(std::move(run));
             }
+            task.point = task.runs.front().point;
+            tasks.push_back(std::move(task));
           }
-          task.point = task.runs.front().point;
-          tasks.push_back(std::move(task));
         }
       }
     }
@@ -383,7 +412,8 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   // Phase 1: one reference per material and input that this shard's remaining tasks need.
   std::map<ReferenceKey, Reference> references;
   for (std::size_t t : todo) {
-    for (const Run& run : all_tasks[t].runs) references[ReferenceKeyOf(run.point)];
+    for (const Run& run : all_tasks[t].runs)
+      references[ReferenceKeyOf(run.point)].point = run.point;
   }
   std::size_t reference_uses = 0;
   for (std::size_t t : todo) reference_uses += all_tasks[t].runs.size();
@@ -397,15 +427,12 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   ParallelFor(
       reference_list.size(), options.jobs, options.stop,
       [&](std::size_t i) {
-        const ReferenceKey& key = reference_list[i]->first;
-        MapPoint point = all_tasks[todo.front()].point;
-        for (int a = 0; a < 6; ++a) point[a] = key[a];
-        Scene scene = SceneAtPoint(base, point);
+        Reference& reference = reference_list[i]->second;
+        Scene scene = SceneAtPoint(base, reference.point);
         scene.adaptivity.primary_size = 0;
         TrialOptions trial_options;
         trial_options.substep_to_stability = true;
         const auto t0 = Clock::now();
-        Reference& reference = reference_list[i]->second;
         reference.trial = RunReferenceTrial(CubeScene(scene), trial_options);
         reference.ok = reference.trial.outcome == TrialOutcome::kCompleted;
         std::lock_guard lock(stats_mutex);

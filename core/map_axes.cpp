@@ -17,6 +17,10 @@ constexpr std::array<MapAxisInfo, kNumMapAxes> kAxes{{
     {"adaptivity.secondary_lod", "secondary_lod", "", "lod", true, false},
     {"adaptivity.primary_size", "primary_size", "", "primary size", true, false},
     {"adaptivity.secondary_rate", "secondary_rate", "Hz", "secondary rate", false, false},
+    // Whole lattice indices in a sweep; a lookup interpolates between mapped nodes.
+    {"input.contact_node.x", "contact_node_x", "node", "contact x", true, false, 0},
+    {"input.contact_node.y", "contact_node_y", "node", "contact y", true, false, 1},
+    {"input.contact_node.z", "contact_node_z", "node", "contact z", true, false, 2},
 }};
 
 }  // namespace
@@ -25,25 +29,37 @@ const MapAxisInfo& AxisInfo(int axis) { return kAxes.at(static_cast<size_t>(axis
 
 MapPoint PointOfScene(const Scene& scene) {
   MapPoint point{};
+  const LatticeIndex node = ContactNode(scene);
   for (int a = 0; a < kNumMapAxes; ++a) {
-    point[a] = std::stod(GetSceneValue(scene, AxisInfo(a).scene_key));
+    const MapAxisInfo& info = AxisInfo(a);
+    point[a] = info.node_component >= 0 ? node[info.node_component]
+                                        : std::stod(GetSceneValue(scene, info.scene_key));
   }
   return point;
 }
 
 Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
   Scene scene = base;
+  LatticeIndex node{};
   for (int a = 0; a < kNumMapAxes; ++a) {
     const MapAxisInfo& info = AxisInfo(a);
     if (info.integer) {
       HAPTICSIM_THROW_UNLESS(
           point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
           std::string(info.scene_key) + " = " + FormatReal(point[a]) + " is not a whole number");
+      if (info.node_component >= 0) {
+        HAPTICSIM_THROW_UNLESS(point[a] >= 0, std::string(info.scene_key) + " = " +
+                                                  FormatReal(point[a]) +
+                                                  " is not a lattice index (0 or more)");
+        node[info.node_component] = static_cast<int>(point[a]);
+        continue;
+      }
       SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));
     } else {
       SetSceneValue(&scene, info.scene_key, FormatReal(point[a]));
     }
   }
+  scene.input.contact_node = node;
   return scene;
 }
 

@@ -9,8 +9,9 @@ namespace hapticsim {
 
 /**
  * The parameters an error map is made over, in the paper's order (Section V-B): material,
- * input, adaptivity. Each is a scene key, so a map point is a scene. The order is part of the
- * map file format: append, never reorder.
+ * input, adaptivity, then the contact node. Each is a scene key (the contact node's three lattice
+ * indices are the three parts of input.contact_node), so a map point is a scene. The order is
+ * part of the map file format: append, never reorder.
  */
 enum class MapAxis : int {
   kPoissonRatio,
@@ -22,8 +23,11 @@ enum class MapAxis : int {
   kSecondaryLod,
   kPrimarySize,
   kSecondaryRate,
+  kContactNodeX,  ///< lattice indices of the driven node (input.contact_node)
+  kContactNodeY,
+  kContactNodeZ,
 };
-inline constexpr int kNumMapAxes = 9;
+inline constexpr int kNumMapAxes = 12;
 
 struct MapAxisInfo {
   std::string_view scene_key;  ///< e.g. "material.poisson_ratio"
@@ -32,6 +36,9 @@ struct MapAxisInfo {
   std::string_view label;      ///< short column heading: "ν"
   bool integer;                ///< values are whole numbers (no interpolation between them)
   bool material;               ///< a material property (worst case over a neighbourhood)
+  /// For the contact-node axes, the index (0, 1, 2: x, y, z) of input.contact_node they set;
+  /// -1 for the others, which are scene keys of their own.
+  int node_component = -1;
 };
 
 const MapAxisInfo& AxisInfo(int axis);
@@ -40,11 +47,12 @@ inline const MapAxisInfo& AxisInfo(MapAxis axis) { return AxisInfo(static_cast<i
 /** A point in parameter space, indexed by MapAxis. */
 using MapPoint = std::array<double, kNumMapAxes>;
 
-/** The point of a scene (its values of the nine keys). */
+/** The point of a scene (its values of the map's keys; the contact node of the scene's own). */
 MapPoint PointOfScene(const Scene& scene);
 
 /**
- * `base` with the nine keys set to `point`, adaptivity switched on.
+ * `base` with the map's keys set to `point` (the contact node to the point's three indices),
+ * adaptivity switched on. Whether the node is on the surface is ValidateScene's check.
  * @throws Error naming the key when a value is outside the key's range.
  */
 Scene SceneAtPoint(const Scene& base, const MapPoint& point);

@@ -13,7 +13,18 @@ std::size_t SweepGrid::NumSamples() const {
   return n;
 }
 
-SweepGrid PaperGrid() {
+namespace {
+
+void SetContactAxes(const MapPoint& scene_point, SweepGrid* grid) {
+  for (MapAxis axis : {MapAxis::kContactNodeX, MapAxis::kContactNodeY, MapAxis::kContactNodeZ}) {
+    const int a = static_cast<int>(axis);
+    grid->axes[a] = {scene_point[a]};
+  }
+}
+
+}  // namespace
+
+SweepGrid PaperGrid(const MapPoint& scene_point) {
   SweepGrid grid;
   grid.name = "paper";
   grid.axes = {{
@@ -27,10 +38,11 @@ SweepGrid PaperGrid() {
       {1, 2, 3, 4},
       {600, 700, 800, 900, 1000},
   }};
+  SetContactAxes(scene_point, &grid);
   return grid;
 }
 
-SweepGrid QuickGrid() {
+SweepGrid QuickGrid(const MapPoint& scene_point) {
   SweepGrid grid;
   grid.name = "quick";
   grid.axes = {{
@@ -44,11 +56,16 @@ SweepGrid QuickGrid() {
       {1, 4},
       {600, 1000},
   }};
+  SetContactAxes(scene_point, &grid);
+  const int x = static_cast<int>(MapAxis::kContactNodeX);
+  const double node_x = scene_point[x];
+  grid.axes[x] = node_x > 0 ? std::vector<double>{node_x - 1, node_x}
+                            : std::vector<double>{node_x, node_x + 1};
   return grid;
 }
 
 SweepGrid SceneGrid(const MapPoint& scene_point) {
-  SweepGrid grid = PaperGrid();
+  SweepGrid grid = PaperGrid(scene_point);
   grid.name = "scene";
   for (MapAxis axis :
        {MapAxis::kPoissonRatio, MapAxis::kDensity, MapAxis::kDamping, MapAxis::kYoungsModulus}) {
@@ -58,9 +75,9 @@ SweepGrid SceneGrid(const MapPoint& scene_point) {
   return grid;
 }
 
-SweepGrid MonteCarloGrid(int count, std::uint64_t seed) {
+SweepGrid MonteCarloGrid(int count, std::uint64_t seed, const MapPoint& scene_point) {
   HAPTICSIM_THROW_UNLESS(count > 0, "--monte-carlo needs a positive sample count");
-  const SweepGrid paper = PaperGrid();
+  const SweepGrid paper = PaperGrid(scene_point);
   SweepGrid grid;
   grid.name = "monte-carlo " + std::to_string(count) + " seed " + std::to_string(seed);
   grid.scattered = true;
@@ -71,6 +88,10 @@ SweepGrid MonteCarloGrid(int count, std::uint64_t seed) {
   for (MapPoint& point : grid.points) {
     for (int a = 0; a < kNumMapAxes; ++a) {
       const std::vector<double>& v = paper.axes[a];
+      if (v.size() == 1) {  // no draw: the sequence of the other axes stays as it was
+        point[a] = v.front();
+        continue;
+      }
       // Rates from the paper's values too: the coupled schedule repeats after the common period
       // of the rates (10 ms for these, up to 1 s for arbitrary whole-Hz rates), and the stability
       // estimate runs hundreds of common periods.

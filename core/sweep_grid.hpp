@@ -23,12 +23,16 @@ struct SweepGrid {
  * The paper's grid (Section V-B): ν {0.40, 0.45, 0.49}, ρ {800, 1000, 1200} kg/m³,
  * d {10, 20, 30, 40} 1/s, E {5, 10, 15, 20} kPa, amplitude {0.005, 0.010, 0.015} m,
  * frequency {0.5, 1.0, 1.25} Hz, spacing factor {1, 2, 3}, primary size {1, 2, 3, 4},
- * secondary rate {1000, 900, 800, 700, 600} Hz: 77,760 samples.
+ * secondary rate {1000, 900, 800, 700, 600} Hz: 77,760 samples, all at the contact node of
+ * `scene_point` (the paper presses one node).
  */
-SweepGrid PaperGrid();
+SweepGrid PaperGrid(const MapPoint& scene_point);
 
-/** Two values on every axis of the paper's grid (the ends), four primary sizes: under a minute. */
-SweepGrid QuickGrid();
+/**
+ * Two values on every axis of the paper's grid (the ends), and two contact nodes: the scene's and
+ * its neighbour along x (−x, or +x from the x = 0 face). Under a minute.
+ */
+SweepGrid QuickGrid(const MapPoint& scene_point);
 
 /**
  * The map the daemon needs for one scene: its material, the paper's inputs and every adaptive
@@ -38,9 +42,10 @@ SweepGrid SceneGrid(const MapPoint& scene_point);
 
 /**
  * `count` points drawn uniformly from the paper's ranges: material and input continuous; spacing
- * factor, primary size and secondary rate from the paper's values. Reproducible from `seed`.
+ * factor, primary size and secondary rate from the paper's values; the contact node of
+ * `scene_point`. Reproducible from `seed`.
  */
-SweepGrid MonteCarloGrid(int count, std::uint64_t seed);
+SweepGrid MonteCarloGrid(int count, std::uint64_t seed, const MapPoint& scene_point);
 
 /**
  * Checks a grid: values ascending and within each key's range.

@@ -47,12 +47,13 @@ SweepGrid LoadGridFile(const std::string& path, const MapPoint& base) {
 
 SweepGrid ChooseSweepGrid(const std::string& name, int monte_carlo, std::uint64_t seed,
                           const Scene& scene) {
-  if (monte_carlo > 0) return MonteCarloGrid(monte_carlo, seed);
-  if (name == "paper") return PaperGrid();
-  if (name == "quick") return QuickGrid();
-  if (name == "scene") return SceneGrid(PointOfScene(scene));
+  const MapPoint at = PointOfScene(scene);
+  if (monte_carlo > 0) return MonteCarloGrid(monte_carlo, seed, at);
+  if (name == "paper") return PaperGrid(at);
+  if (name == "quick") return QuickGrid(at);
+  if (name == "scene") return SceneGrid(at);
   if (name.size() > 5 && name.substr(name.size() - 5) == ".toml") {
-    return LoadGridFile(name, PointOfScene(scene));
+    return LoadGridFile(name, at);
   }
   throw Error("--grid " + name + ": choose paper, quick, scene or a FILE.toml");
 }

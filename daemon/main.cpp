@@ -245,13 +245,21 @@ int Serve(const Arguments& args) {
   RegionConfiguration active = decision.configuration;
   double active_radius = decision.spectral_radius;
   RegionsMover mover(config.scene);
-  // The error map is looked up for the configured contact node; elsewhere the error is the
-  // nearest mapped one's, flagged as clamped (the map has no contact-node axis yet).
-  const LatticeIndex mapped_node = ContactNode(config.scene);
-  auto active_flags = [&] {
-    return DecisionFlags(decision) |
-           (loop.centre_node() == mapped_node ? 0 : force_flags::kLookupClamped) |
-           (pending ? force_flags::kReconfiguring : 0);
+  // The error the status reports: the decision's, looked up again for the configuration running
+  // and the node the regions are centred on — interpolated between mapped contact nodes, the
+  // nearest mapped one's beyond them (flagged clamped). Where the map has no finite error the
+  // status says -1 % and "target exceeded": accuracy unknown is not accuracy met.
+  auto report_error = [&] {
+    std::int32_t flags = DecisionFlags(decision) | (pending ? force_flags::kReconfiguring : 0);
+    double error = decision.error_percent;
+    if (decision.have_map && map.map) {
+      const NodeError here = LookupErrorAt(*map.map, config.scene, active, loop.centre_node());
+      error = here.error_percent;
+      flags &= ~(force_flags::kLookupClamped | force_flags::kErrorTargetExceeded);
+      if (here.clamped) flags |= force_flags::kLookupClamped;
+      if (!here.usable || error > target) flags |= force_flags::kErrorTargetExceeded;
+    }
+    loop.SetErrorState(error, flags);
   };
   // Restarts the regions from rest where they are: the tool must lift off before it feels force.
   auto restart_from_rest = [&](const char* why) {
@@ -377,7 +385,7 @@ int Serve(const Arguments& args) {
           case CheckedCommand::Kind::kSetErrorTarget:
             target = checked.error_target_percent;
             decision.target_met = decision.have_map && decision.error_percent <= target;
-            loop.SetErrorState(decision.error_percent, active_flags());
+            report_error();
             spdlog::info(
                 "error target set to {} %: the active configuration's {} % {}; choosing "
                 "again",
@@ -420,7 +428,7 @@ int Serve(const Arguments& args) {
               pinned ? "pinned" : "better", chosen.reason, kSettleBeforeReconfigure_s);
           pending = chosen;
         }
-        loop.SetErrorState(decision.error_percent, active_flags());
+        report_error();
       } catch (const Error& e) {
         if (choice_for_overload) cheapest_cost_us_per_ms = decision.cost_us_per_ms;
         spdlog::error("{} failed: {}; keeping the active configuration",
@@ -468,7 +476,7 @@ int Serve(const Arguments& args) {
                          : "");
         match_miss_loggers(now);
         overload.Reset(now);
-        loop.SetErrorState(decision.error_percent, active_flags());
+        report_error();
       }
     } catch (const Error& e) {
       spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
@@ -476,7 +484,7 @@ int Serve(const Arguments& args) {
           !mover.may_ask({pending->configuration, wanted.value_or(loop.centre_node()), true})) {
         pending.reset();  // refused around this node: not asked again
       }
-      loop.SetErrorState(decision.error_percent, active_flags());
+      report_error();
     }
     // Deadlines before accuracy: a region that keeps missing them gets a cheaper configuration
     // (the map's measured costs), switched like any other once the tool is away.

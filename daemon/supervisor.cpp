@@ -34,7 +34,35 @@ std::optional<double> CoupledRadius(const Scene& scene, const RegionConfiguratio
   }
 }
 
+// The query for one configuration's error at the scene's point: the input frequency and
+// amplitude unknown (their worst case over the map).
+LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
+                               const RegionConfiguration& c) {
+  LookupQuery query = LookupQuery::At(at);
+  query.lo[kLod] = query.hi[kLod] = c.secondary_lod;
+  query.lo[kSize] = query.hi[kSize] = c.primary_size;
+  query.lo[kRate] = query.hi[kRate] = c.secondary_rate_hz;
+  const int amplitude = static_cast<int>(MapAxis::kAmplitude);
+  query.lo[amplitude] = map.axes[amplitude].front();
+  query.hi[amplitude] = map.axes[amplitude].back();
+  query.frequency_known = false;
+  return query;
+}
+
 }  // namespace
+
+NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
+                        const RegionConfiguration& configuration, const LatticeIndex& node) {
+  NodeError out;
+  if (!map.grid) return out;
+  const ErrorLookup lookup(map, ErrorField::kMagnitude);
+  const LookupResult result = lookup.Lookup(
+      ConfigurationQuery(map, PointOfScene(SceneWith(scene, configuration, node)), configuration));
+  out.usable = result.usable();
+  out.error_percent = result.usable() ? result.error : -1;
+  out.clamped = result.clamped;
+  return out;
+}
 
 Scene SceneWith(const Scene& scene, const RegionConfiguration& c) {
   Scene out = scene;
@@ -94,15 +122,7 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
         for (double rate : map->axes[kRate]) {
           const RegionConfiguration c{static_cast<int>(size), static_cast<int>(lod), rate};
           if (pinned && !(c == *pinned)) continue;
-          LookupQuery query = LookupQuery::At(at);
-          query.lo[kLod] = query.hi[kLod] = lod;
-          query.lo[kSize] = query.hi[kSize] = size;
-          query.lo[kRate] = query.hi[kRate] = rate;
-          const int amplitude = static_cast<int>(MapAxis::kAmplitude);
-          query.lo[amplitude] = map->axes[amplitude].front();
-          query.hi[amplitude] = map->axes[amplitude].back();
-          query.frequency_known = false;
-          const LookupResult result = lookup.Lookup(query);
+          const LookupResult result = lookup.Lookup(ConfigurationQuery(*map, at, c));
           if (!result.usable()) continue;  // predicted unstable or diverged in the map
           const auto entry = cost.find({lod, size, rate});
           const double mean_cost =

@@ -46,6 +46,21 @@ SupervisorDecision ChooseConfiguration(
     const std::optional<RegionConfiguration>& pinned,
     double below_cost_us_per_ms = std::numeric_limits<double>::infinity());
 
+/** The map's error for a configuration running centred on one contact node. */
+struct NodeError {
+  bool usable = false;        ///< false: the map has no finite error there (unstable or missing)
+  double error_percent = -1;  ///< worst magnitude error, % (as ChooseConfiguration looks it up)
+  bool clamped = false;       ///< the node (or the material) is outside the map
+};
+
+/**
+ * Looks up `configuration`'s error with the regions centred on `node`, the input unknown as in
+ * ChooseConfiguration: between mapped contact nodes the error is interpolated, beyond them it is
+ * the nearest edge's, flagged clamped.
+ */
+NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
+                        const RegionConfiguration& configuration, const LatticeIndex& node);
+
 /** The scene with `configuration` as its adaptivity. */
 Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration);
 

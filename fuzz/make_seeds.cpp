@@ -58,7 +58,10 @@ int main(int argc, char** argv) {
                                                        {1.0},
                                                        {1, 2},
                                                        {2, 3},
-                                                       {600, 1000}};
+                                                       {600, 1000},
+                                                       {5, 6},
+                                                       {6},
+                                                       {0}};
   ErrorMap map = ErrorMap::MakeGrid(axes);
   for (size_t i = 0; i < map.samples.size(); ++i) {
     MapSample& s = map.samples[i];

@@ -80,6 +80,33 @@ TEST(ErrorLookup, OutsideTheMapClampsAndSaysSoNeverExtrapolates) {
   EXPECT_TRUE(lookup.Lookup(LookupQuery::At(p)).clamped);
 }
 
+// A contact node between mapped ones interpolates between them; one beyond them is the edge's
+// value, flagged with the contact axis.
+TEST(ErrorLookup, ContactNodesBetweenMappedOnesInterpolateAndOthersClamp) {
+  constexpr int kX = static_cast<int>(MapAxis::kContactNodeX);
+  constexpr int kY = static_cast<int>(MapAxis::kContactNodeY);
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  for (auto& axis : axes) axis = {1.0};
+  axes[kX] = {3, 6};
+  axes[kY] = {2, 6};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  for (MapSample& s : map.samples) {
+    s.status = SampleStatus::kOk;
+    s.max_magnitude_percent = 1 + s.point[kX] + 10 * s.point[kY];  // bilinear (here linear)
+  }
+  const ErrorLookup lookup(map, ErrorField::kMagnitude);
+  MapPoint p = map.samples.front().point;
+  p[kX] = 4, p[kY] = 5;  // a node no sweep ran
+  LookupResult r = lookup.Lookup(LookupQuery::At(p));
+  EXPECT_FALSE(r.clamped);
+  EXPECT_NEAR(r.error, 1 + 4 + 50, 1e-12);
+  p[kX] = 8;  // beyond the mapped nodes
+  r = lookup.Lookup(LookupQuery::At(p));
+  EXPECT_TRUE(r.clamped);
+  EXPECT_EQ(r.clamped_axis, kX);
+  EXPECT_NEAR(r.error, 1 + 6 + 50, 1e-12);
+}
+
 TEST(ErrorLookup, UnknownFrequencyTakesTheBoundOverTheFrequencyAxis) {
   const ErrorLookup lookup(SyntheticMap(), ErrorField::kL2);
   LookupQuery query = LookupQuery::At(Centre());

@@ -93,6 +93,10 @@ TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSaying
   version[8] = 7;
   WriteAll(path, version);
   EXPECT_NE(LoadError(path).find("wrong format version 7"), std::string::npos) << LoadError(path);
+  version[8] = 1;  // a map from before the contact-node axes
+  WriteAll(path, version);
+  EXPECT_NE(LoadError(path).find("version 1 maps have no contact-node axes"), std::string::npos)
+      << LoadError(path);
 
   WriteAll(path, "[mesh]\nnodes = 13\n# a scene file, not a map\n");
   EXPECT_NE(LoadError(path).find("not an error map"), std::string::npos) << LoadError(path);

@@ -172,12 +172,61 @@ TEST(ErrorSweep, AStopRequestEndsTheSweepWithoutComputingMore) {
   EXPECT_EQ(map.CountStatus(SampleStatus::kNotComputed), map.samples.size());
 }
 
+// The contact-node axes: every node is swept as a scene driven at that node. Checked against the
+// cube's mirror symmetry x → L − x (the supports, the four back corners, are invariant under it;
+// no code path knows about it): nodes mirrored about the middle must give the same errors and
+// peak force. And a node's samples must be those of a sweep whose scene is driven there.
+TEST(ErrorSweep, EachContactNodeIsSweptAsItsOwnSceneAndMirroredNodesAgree) {
+  constexpr int kX = static_cast<int>(MapAxis::kContactNodeX);
+  SweepGrid grid = SmallGrid();
+  grid.axes[kDamping] = {10};
+  grid.axes[kAmplitude] = {0.01};
+  grid.axes[kSize] = {1};
+  grid.axes[kX] = {2, 4, 6};  // the 9³ cube's middle is x = 4
+  SweepOptions options;
+  options.jobs = 2;
+  SweepStats stats;
+  const ErrorMap map = Sweep(grid, options, &stats);
+  EXPECT_EQ(stats.reference_trials, 3u);  // one per node: a node's force is its own
+  ASSERT_EQ(map.samples.size(), 6u);      // nodes × rates {600, 1000}
+  auto at = [&](double x, double rate) -> const MapSample& {
+    for (const MapSample& s : map.samples) {
+      if (s.point[kX] == x && s.point[kRate] == rate) return s;
+    }
+    throw Error("no sample");
+  };
+  for (double rate : {600.0, 1000.0}) {
+    const MapSample &left = at(2, rate), &middle = at(4, rate), &right = at(6, rate);
+    ASSERT_EQ(left.status, SampleStatus::kOk);
+    ASSERT_EQ(right.status, SampleStatus::kOk);
+    EXPECT_NEAR(left.reference_peak_n, right.reference_peak_n, 1e-9 * left.reference_peak_n);
+    EXPECT_NEAR(left.l2_percent, right.l2_percent, 1e-6 * (1 + left.l2_percent));
+    EXPECT_NEAR(left.max_magnitude_percent, right.max_magnitude_percent,
+                1e-6 * (1 + left.max_magnitude_percent));
+    EXPECT_NE(left.reference_peak_n, middle.reference_peak_n);  // the node changes the scene
+  }
+  // The node x = 2 alone, as the scene's own contact node: the same numbers.
+  Scene at_two = SmallScene();
+  at_two.input.contact_node = LatticeIndex{2, 4, 0};
+  SweepGrid single = grid;
+  single.axes[kX] = {2};
+  SweepStats single_stats;
+  const ErrorMap alone = RunSweep(at_two, single, options, &single_stats);
+  for (const MapSample& s : alone.samples) {
+    const MapSample& swept = at(2, s.point[kRate]);
+    EXPECT_EQ(s.status, swept.status);
+    EXPECT_EQ(s.reference_peak_n, swept.reference_peak_n);
+    EXPECT_EQ(s.l2_percent, swept.l2_percent);
+  }
+}
+
 TEST(ErrorSweep, MonteCarloPointsAreReproducibleAndInsideThePapersRanges) {
-  const SweepGrid a = MonteCarloGrid(200, 42), b = MonteCarloGrid(200, 42);
-  const SweepGrid c = MonteCarloGrid(200, 43);
+  const MapPoint at = PointOfScene(Scene{});
+  const SweepGrid a = MonteCarloGrid(200, 42, at), b = MonteCarloGrid(200, 42, at);
+  const SweepGrid c = MonteCarloGrid(200, 43, at);
   EXPECT_EQ(a.points, b.points);
   EXPECT_NE(a.points, c.points);
-  const SweepGrid paper = PaperGrid();
+  const SweepGrid paper = PaperGrid(at);
   for (const MapPoint& p : a.points) {
     for (int axis = 0; axis < kNumMapAxes; ++axis) {
       const auto& values = paper.axes[axis];
@@ -191,7 +240,7 @@ TEST(ErrorSweep, MonteCarloPointsAreReproducibleAndInsideThePapersRanges) {
 }
 
 TEST(ErrorSweep, AMonteCarloSweepMakesAScatteredMapThatCannotBeLookedUp) {
-  SweepGrid grid = MonteCarloGrid(3, 7);
+  SweepGrid grid = MonteCarloGrid(3, 7, PointOfScene(SmallScene()));
   for (MapPoint& p : grid.points) p[6] = 2, p[7] = 1;  // spacing factor 2: valid on the 9³ cube
   SweepOptions options;
   options.jobs = 2;

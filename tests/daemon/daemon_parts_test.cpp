@@ -218,6 +218,46 @@ TEST(Supervisor, ChoosesTheCheapestStableConfigurationMeetingTheTargetElseTheMos
   EXPECT_EQ(no_map.error_percent, -1);
 }
 
+// Where the tool moves the regions, the status's error is looked up for that node: between the
+// mapped contact nodes interpolated, beyond them the edge's and flagged, and none where the map
+// calls the configuration unstable.
+TEST(Supervisor, TheErrorFollowsTheContactNodeBetweenMappedNodesAndIsFlaggedBeyondThem) {
+  Scene scene;
+  scene.mesh.nodes = 9;  // middle of the front face: (4, 4, 0)
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  const MapPoint at = PointOfScene(scene);
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};
+  axes[static_cast<int>(MapAxis::kSecondaryLod)] = {2};
+  axes[static_cast<int>(MapAxis::kPrimarySize)] = {1};
+  axes[static_cast<int>(MapAxis::kSecondaryRate)] = {1000};
+  axes[static_cast<int>(MapAxis::kContactNodeX)] = {2, 4};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  ASSERT_EQ(map.samples.size(), 2u);
+  map.samples[0].status = map.samples[1].status = SampleStatus::kOk;
+  map.samples[0].max_magnitude_percent = 3.0;  // node x = 2
+  map.samples[1].max_magnitude_percent = 1.0;  // node x = 4
+  const RegionConfiguration c{1, 2, 1000};
+
+  NodeError e = LookupErrorAt(map, scene, c, {4, 4, 0});
+  EXPECT_TRUE(e.usable);
+  EXPECT_DOUBLE_EQ(e.error_percent, 1.0);
+  EXPECT_FALSE(e.clamped);
+  e = LookupErrorAt(map, scene, c, {3, 4, 0});  // between the mapped nodes
+  EXPECT_DOUBLE_EQ(e.error_percent, 2.0);
+  EXPECT_FALSE(e.clamped);
+  e = LookupErrorAt(map, scene, c, {6, 4, 0});  // beyond them: x = 4's, flagged
+  EXPECT_DOUBLE_EQ(e.error_percent, 1.0);
+  EXPECT_TRUE(e.clamped);
+  e = LookupErrorAt(map, scene, c, {4, 8, 3});  // another face: clamped on y and z
+  EXPECT_TRUE(e.clamped);
+
+  map.samples[0].status = SampleStatus::kPredictedUnstable;
+  e = LookupErrorAt(map, scene, c, {3, 4, 0});
+  EXPECT_FALSE(e.usable);
+  EXPECT_EQ(e.error_percent, -1);
+  EXPECT_TRUE(LookupErrorAt(map, scene, c, {4, 4, 0}).usable);  // weight 0 on the unstable one
+}
+
 }  // namespace
 }  // namespace hapticsim
 

@@ -73,7 +73,7 @@ namespace {
 // The error lookup may run in the 1 kHz thread: point queries, box queries and the frequency
 // bound, on a map the size of the paper's grid.
 TEST(ErrorLookup, NeverAllocates) {
-  const SweepGrid paper = PaperGrid();
+  const SweepGrid paper = PaperGrid(PointOfScene(Scene{}));
   ErrorMap map = ErrorMap::MakeGrid(paper.axes);
   for (size_t i = 0; i < map.samples.size(); ++i) {
     map.samples[i].status = SampleStatus::kOk;

@@ -13,7 +13,7 @@ namespace hapticsim {
 namespace {
 
 ErrorMap PaperSizedMap() {
-  ErrorMap map = ErrorMap::MakeGrid(PaperGrid().axes);
+  ErrorMap map = ErrorMap::MakeGrid(PaperGrid(PointOfScene(Scene{})).axes);
   for (size_t i = 0; i < map.samples.size(); ++i) {
     map.samples[i].status = SampleStatus::kOk;
     map.samples[i].l2_percent = static_cast<double>(i % 89) / 10;

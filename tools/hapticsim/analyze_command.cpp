@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -79,8 +80,15 @@ void WriteReport(const ErrorMap& map, const PartialCorrelationTable& table, Erro
     row.push_back(static_cast<int>(s.status));
     rows.push_back(row);
   }
+  // Parameters the map varies (an axis with one value, e.g. the contact node of most maps, would
+  // be a flat line through every sample).
   std::vector<std::string> parallel;
-  for (int a = 0; a < kNumMapAxes; ++a) parallel.emplace_back(AxisInfo(a).name);
+  for (int a = 0; a < kNumMapAxes; ++a) {
+    const bool varies =
+        std::any_of(map.samples.begin(), map.samples.end(),
+                    [&](const MapSample& s) { return s.point[a] != map.samples.front().point[a]; });
+    if (varies) parallel.emplace_back(AxisInfo(a).name);
+  }
   parallel.emplace_back(ErrorFieldName(field));
   const auto& p = map.provenance;
   data["columns"] = columns;

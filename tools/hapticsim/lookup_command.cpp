@@ -35,7 +35,8 @@ int Run(const LookupCommandOptions& o) {
   const ErrorMap map = LoadErrorMap(o.map, MapLoadParts::kLookupOnly);
   const ErrorLookup lookup(map, field);
   // Unset parameters: the map's own scene.
-  const MapPoint base = PointOfScene(ParseSceneText(map.provenance.scene_toml, o.map));
+  const Scene map_scene = ParseSceneText(map.provenance.scene_toml, o.map);
+  const MapPoint base = PointOfScene(map_scene);
   LookupQuery query = LookupQuery::At(base);
   query.frequency_known = !o.unknown_frequency;
   query.neighbourhood =
@@ -45,6 +46,16 @@ int Run(const LookupCommandOptions& o) {
     HAPTICSIM_THROW_UNLESS(eq != std::string::npos,
                            "--set " + assignment + ": expected KEY=VALUE or KEY=LOW:HIGH");
     const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+    if (key == "contact_node" || key == "input.contact_node") {  // the three axes at once
+      Scene scene = map_scene;  // "middle" is the middle of the map's mesh
+      SetSceneValue(&scene, "input.contact_node", value);  // "ix,iy,iz", refused with the format
+      const LatticeIndex node = ContactNode(scene);
+      for (int c = 0; c < 3; ++c) {
+        const int axis = static_cast<int>(MapAxis::kContactNodeX) + c;
+        query.lo[axis] = query.hi[axis] = node[c];
+      }
+      continue;
+    }
     const int axis = FindAxis(key);
     if (axis < 0) {
       std::string known;
@@ -105,7 +116,9 @@ Command AddLookupCommand(CLI::App& parent) {
   app->add_option("MAP", o->map, "Map file (.hsmap)")->required()->check(CLI::ExistingFile);
   app->add_option("--set", o->assignments,
                   "A parameter (axis name or scene key) = value, or LOW:HIGH for a neighbourhood "
-                  "of heterogeneous material; unset ones take the map's scene values")
+                  "of heterogeneous material; unset ones take the map's scene values. "
+                  "contact_node=IX,IY,IZ sets the three contact-node axes (between mapped nodes "
+                  "the error is interpolated)")
       ->type_name("KEY=VALUE")
       ->take_all();
   app->add_option("--field", o->field,

@@ -61,7 +61,7 @@ bool IndependentlyStable(const Scene& scene) {
 ErrorMap LyingMap(const Scene& scene, std::mt19937_64& rng) {
   std::array<std::vector<double>, kNumMapAxes> axes;
   const MapPoint at = PointOfScene(scene);
-  for (int a = 0; a < 6; ++a) axes[a] = {at[a]};
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};  // material, input, contact node
   axes[static_cast<int>(MapAxis::kSecondaryLod)] = {
       static_cast<double>(scene.adaptivity.secondary_lod)};
   const int size = std::uniform_int_distribution<int>(1, 3)(rng);
