@@ -141,10 +141,12 @@ Command AddSweepCommand(CLI::App& parent) {
       "full-resolution reference (the paper's Section V). Progress on stderr; Ctrl-C keeps what "
       "is done for --resume.");
   AddSceneOptions(app, &o->scene);
-  app->add_option("--grid", o->grid,
-                  "paper (the paper's 77,760 points), quick (2 values per axis, under a minute), "
-                  "scene (the scene's material, all inputs and configurations: the daemon's map) "
-                  "or FILE.toml ([axes] lists)")
+  app->add_option(
+         "--grid", o->grid,
+         "paper (the paper's 77,760 points), quick (2 values per parameter, 2 contact nodes, "
+         "under a minute), "
+         "scene (the scene's material, all inputs and configurations: the daemon's map) "
+         "or FILE.toml ([axes] lists)")
       ->capture_default_str();
   app->add_option("--monte-carlo", o->monte_carlo,
                   "Instead of a grid: N points drawn from the paper's ranges (a scattered map, for "
