@@ -29,7 +29,7 @@ inline constexpr int kMapCostRegions = 4;
 
 /** One point of the map: where it is, and how the adaptive force compared with the reference. */
 struct MapSample {
-  MapPoint point{};                  ///< the nine parameters (MapAxis order), SI units
+  MapPoint point{};                  ///< the map's parameters (MapAxis order), SI units
   double l2_percent = 0;             ///< relative L2 force error over the trial, %
   double max_magnitude_percent = 0;  ///< worst | |F| − |F_ref| |, % of the reference peak
   double max_direction_deg = 0;      ///< worst angle where |F_ref| ≥ threshold × peak, degrees

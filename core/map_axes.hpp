@@ -34,7 +34,9 @@ struct MapAxisInfo {
   std::string_view name;       ///< the key's last part, used in JSON: "poisson_ratio"
   std::string_view unit;       ///< SI unit, "" when dimensionless
   std::string_view label;      ///< short column heading: "ν"
-  bool integer;                ///< values are whole numbers (no interpolation between them)
+  /// Values are whole numbers in a sweep. A lookup interpolates between grid values on every
+  /// axis; queries of spacing factor and primary size hit them exactly, contact nodes may not.
+  bool integer;
   bool material;               ///< a material property (worst case over a neighbourhood)
   /// For the contact-node axes, the index (0, 1, 2: x, y, z) of input.contact_node they set;
   /// -1 for the others, which are scene keys of their own.

@@ -17,14 +17,22 @@ Eigen::VectorXd Residual(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   return y - X * qr.solve(y);
 }
 
+bool Varies(const Eigen::VectorXd& column) {
+  return column.size() > 0 && column.maxCoeff() > column.minCoeff();
+}
+
 std::optional<Correlation> Partial(const Eigen::MatrixXd& variables, int target, int error_column) {
   const Eigen::Index n = variables.rows();
-  const Eigen::Index others = variables.cols() - 2;  // every variable but the target and error
+  // Controls: every variable but the target and the error that varies in this map (a constant
+  // one is the intercept again, and would only take a degree of freedom from the p-value).
+  std::vector<Eigen::Index> controls;
+  for (Eigen::Index c = 0; c < variables.cols(); ++c) {
+    if (c != target && c != error_column && Varies(variables.col(c))) controls.push_back(c);
+  }
+  const auto others = static_cast<Eigen::Index>(controls.size());
   Eigen::MatrixXd X(n, others + 1);
   X.col(0).setOnes();
-  for (Eigen::Index c = 0, k = 1; c < variables.cols(); ++c) {
-    if (c != target && c != error_column) X.col(k++) = variables.col(c);
-  }
+  for (Eigen::Index k = 0; k < others; ++k) X.col(k + 1) = variables.col(controls[k]);
   const Eigen::VectorXd rx = Residual(X, variables.col(target));
   const Eigen::VectorXd ry = Residual(X, variables.col(error_column));
   const double sxx = rx.squaredNorm(), syy = ry.squaredNorm();
@@ -73,9 +81,6 @@ PartialCorrelationTable PartialCorrelations(const ErrorMap& map, ErrorField fiel
   }
   constexpr int kVariables = kNumMapAxes + 1;  // the parameters and the reference force
   const int error_column = kVariables;
-  HAPTICSIM_THROW_UNLESS(ok.size() >= kVariables + 3,
-                         "partial correlations need at least " + std::to_string(kVariables + 3) +
-                             " ok samples; the map has " + std::to_string(ok.size()));
   table.samples = ok.size();
   const auto n = static_cast<Eigen::Index>(ok.size());
   Eigen::MatrixXd values(n, kVariables + 1);
@@ -84,6 +89,12 @@ PartialCorrelationTable PartialCorrelations(const ErrorMap& map, ErrorField fiel
     values(i, kNumMapAxes) = ok[i]->reference_peak_n;
     values(i, error_column) = FieldOf(*ok[i], field);
   }
+  int varying = 0;
+  for (int c = 0; c < kVariables; ++c) varying += Varies(values.col(c)) ? 1 : 0;
+  HAPTICSIM_THROW_UNLESS(ok.size() >= static_cast<size_t>(varying + 3),
+                         "partial correlations need at least " + std::to_string(varying + 3) +
+                             " ok samples (the varying parameters + 3); the map has " +
+                             std::to_string(ok.size()));
   Eigen::MatrixXd ranks(n, kVariables + 1);
   for (int c = 0; c <= kVariables; ++c) {
     const std::vector<double> column(values.col(c).data(), values.col(c).data() + n);

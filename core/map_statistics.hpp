@@ -28,11 +28,11 @@ struct PartialCorrelationTable {
 };
 
 /**
- * Table I of the paper: the partial correlation of the error with each of the nine parameters
- * and the reference force, each controlling for all the others (the error and the parameter are
- * both regressed on the others; the residuals are correlated). p-values from Student's t with
- * n − 2 − k degrees of freedom (k controlled variables), two-sided.
- * @throws Error when fewer ok samples than variables + 3 are available.
+ * Table I of the paper: the partial correlation of the error with each map parameter and the
+ * reference force, each controlling for all the others that vary in the map (the error and the
+ * parameter are both regressed on them; the residuals are correlated). p-values from Student's t
+ * with n − 2 − k degrees of freedom (k controlled variables), two-sided.
+ * @throws Error when fewer ok samples than varying variables + 3 are available.
  */
 PartialCorrelationTable PartialCorrelations(const ErrorMap& map, ErrorField field);
 

@@ -1,5 +1,6 @@
 #include "core/sweep_grid.hpp"
 
+#include <algorithm>
 #include <random>
 
 #include "core/error.hpp"
@@ -42,7 +43,8 @@ SweepGrid PaperGrid(const MapPoint& scene_point) {
   return grid;
 }
 
-SweepGrid QuickGrid(const MapPoint& scene_point) {
+SweepGrid QuickGrid(const Scene& scene) {
+  const MapPoint scene_point = PointOfScene(scene);
   SweepGrid grid;
   grid.name = "quick";
   grid.axes = {{
@@ -57,10 +59,20 @@ SweepGrid QuickGrid(const MapPoint& scene_point) {
       {600, 1000},
   }};
   SetContactAxes(scene_point, &grid);
-  const int x = static_cast<int>(MapAxis::kContactNodeX);
-  const double node_x = scene_point[x];
-  grid.axes[x] = node_x > 0 ? std::vector<double>{node_x - 1, node_x}
-                            : std::vector<double>{node_x, node_x + 1};
+  const LatticeIndex node = ContactNode(scene);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int step : {-1, 1}) {
+      LatticeIndex neighbour = node;
+      neighbour[axis] += step;
+      if (neighbour[axis] < 0 || neighbour[axis] >= scene.mesh.nodes ||
+          !IsSurfaceNode(scene.mesh, neighbour) || IsSupportNode(scene.mesh, neighbour)) {
+        continue;
+      }
+      const double a = node[axis], b = neighbour[axis];
+      grid.axes[static_cast<int>(MapAxis::kContactNodeX) + axis] = {std::min(a, b), std::max(a, b)};
+      return grid;
+    }
+  }
   return grid;
 }
 

@@ -30,9 +30,10 @@ SweepGrid PaperGrid(const MapPoint& scene_point);
 
 /**
  * Two values on every axis of the paper's grid (the ends), and two contact nodes: the scene's and
- * its neighbour along x (−x, or +x from the x = 0 face). Under a minute.
+ * its first neighbour (−x, +x, −y, +y, −z, +z) that is a free surface node of the scene's mesh
+ * (the scene's alone if none is). Under a minute.
  */
-SweepGrid QuickGrid(const MapPoint& scene_point);
+SweepGrid QuickGrid(const Scene& scene);
 
 /**
  * The map the daemon needs for one scene: its material, the paper's inputs and every adaptive

@@ -50,7 +50,7 @@ SweepGrid ChooseSweepGrid(const std::string& name, int monte_carlo, std::uint64_
   const MapPoint at = PointOfScene(scene);
   if (monte_carlo > 0) return MonteCarloGrid(monte_carlo, seed, at);
   if (name == "paper") return PaperGrid(at);
-  if (name == "quick") return QuickGrid(at);
+  if (name == "quick") return QuickGrid(scene);
   if (name == "scene") return SceneGrid(at);
   if (name.size() > 5 && name.substr(name.size() - 5) == ".toml") {
     return LoadGridFile(name, at);

@@ -249,6 +249,9 @@ int Serve(const Arguments& args) {
   // and the node the regions are centred on — interpolated between mapped contact nodes, the
   // nearest mapped one's beyond them (flagged clamped). Where the map has no finite error the
   // status says -1 % and "target exceeded": accuracy unknown is not accuracy met.
+  // The status message shows the same (reported_*).
+  double reported_error = decision.error_percent;
+  bool reported_target_met = decision.target_met;
   auto report_error = [&] {
     std::int32_t flags = DecisionFlags(decision) | (pending ? force_flags::kReconfiguring : 0);
     double error = decision.error_percent;
@@ -259,6 +262,8 @@ int Serve(const Arguments& args) {
       if (here.clamped) flags |= force_flags::kLookupClamped;
       if (!here.usable || error > target) flags |= force_flags::kErrorTargetExceeded;
     }
+    reported_error = error;
+    reported_target_met = decision.have_map && !(flags & force_flags::kErrorTargetExceeded);
     loop.SetErrorState(error, flags);
   };
   // Restarts the regions from rest where they are: the tool must lift off before it feels force.
@@ -320,6 +325,7 @@ int Serve(const Arguments& args) {
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
       MapState reloaded = LoadMap(config.error_map, true);
       if (reloaded.map || config.error_map.empty()) map = std::move(reloaded);
+      report_error();  // the new target or map, until the new choice replaces the decision
       choose_again(pinned);
     }
     const std::int64_t now = HapticLoop::NowNs();
@@ -461,7 +467,10 @@ int Serve(const Arguments& args) {
         const LatticeIndex& node = moved->request.node;
         loop.Reconfigure(SceneWith(config.scene, moved->centred.configuration, node),
                          /*keep_contact=*/true);
-        if (moved->request.applies_pending) {
+        // The pending decision this move was asked for: a newer choice may have replaced or
+        // dropped it while the move was being verified; then it is not applied.
+        if (moved->request.applies_pending && pending &&
+            pending->configuration == moved->request.configuration) {
           decision = *pending;
           pending.reset();
           spdlog::info("reconfigured: {}", decision.reason);
@@ -544,6 +553,8 @@ int Serve(const Arguments& args) {
         SupervisorDecision shown = decision;
         shown.configuration = active;
         shown.spectral_radius = active_radius;
+        shown.error_percent = reported_error;  // for the node the regions are centred on
+        shown.target_met = reported_target_met;
         bridge->PostStatus(
             MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters));
       }

@@ -55,9 +55,14 @@ NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
                         const RegionConfiguration& configuration, const LatticeIndex& node) {
   NodeError out;
   if (!map.grid) return out;
-  const ErrorLookup lookup(map, ErrorField::kMagnitude);
-  const LookupResult result = lookup.Lookup(
-      ConfigurationQuery(map, PointOfScene(SceneWith(scene, configuration, node)), configuration));
+  LookupResult result;
+  try {  // a map the lookup cannot take (an axis of more than 64 values): no error, never a throw
+    const ErrorLookup lookup(map, ErrorField::kMagnitude);
+    result = lookup.Lookup(ConfigurationQuery(
+        map, PointOfScene(SceneWith(scene, configuration, node)), configuration));
+  } catch (const Error&) {
+    return out;
+  }
   out.usable = result.usable();
   out.error_percent = result.usable() ? result.error : -1;
   out.clamped = result.clamped;

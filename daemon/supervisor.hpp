@@ -56,7 +56,7 @@ struct NodeError {
 /**
  * Looks up `configuration`'s error with the regions centred on `node`, the input unknown as in
  * ChooseConfiguration: between mapped contact nodes the error is interpolated, beyond them it is
- * the nearest edge's, flagged clamped.
+ * the nearest edge's, flagged clamped. Does not throw (a map it cannot look up: not usable).
  */
 NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
                         const RegionConfiguration& configuration, const LatticeIndex& node);
