@@ -449,16 +449,9 @@ void AsyncRegions::ScaleAll(double factor) {
   }
 }
 
-CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int window_periods,
-                                                        double longest_s) {
+CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int window_periods) {
   CoupledStability out;
   out.common_period_s = static_cast<double>(common_period_ticks_) / ticks_per_second_;
-  const double planned_s = (burn_in_periods + window_periods) * out.common_period_s;
-  if (planned_s > longest_s) {
-    const double scale = longest_s / planned_s;
-    burn_in_periods = static_cast<int>(std::lround(burn_in_periods * scale));
-    window_periods = std::max(1, static_cast<int>(std::lround(window_periods * scale)));
-  }
   SetRandomState(7);
   ScaleAll(1.0 / StateNorm());
   double log_growth = 0;

@@ -30,14 +30,6 @@ struct CoupledStability {
   bool stable = false;         ///< spectral_radius < kStableBelow
   /** Margin below 1 that counts as stable: a mode decaying slower than this is refused. */
   static constexpr double kStableBelow = 1.0 - 1e-6;
-  /**
-   * Simulated time an estimate runs at most, s. Power iteration separates modes by their growth
-   * per unit of time, not per period: 900 periods of 10 ms (rates of 700 or 900 Hz against
-   * 1 kHz) ran 9 s where 600 and 800 Hz (5 ms periods) ran 4.5 s. Over 382 random paper-grid
-   * configurations at 700 and 900 Hz (53 unstable) 4.5 s gave the verdict of 9 s every time
-   * (docs/benchmarks.md).
-   */
-  static constexpr double kLongestEstimate_s = 4.5;
 };
 
 /**
@@ -159,14 +151,8 @@ class AsyncRegions {
   /** The region whose state is largest (or non-finite): where a divergence grew. */
   RegionIndex LargestStateRegion() const;
 
-  /**
-   * Spectral radius of the one-common-period map by power iteration from a random state: the
-   * growth over `window_periods` after `burn_in_periods`, both scaled down in proportion where
-   * they would run longer than `longest_s` of simulated time.
-   */
-  CoupledStability EstimateCoupledStability(
-      int burn_in_periods = 600, int window_periods = 300,
-      double longest_s = CoupledStability::kLongestEstimate_s);
+  /** Spectral radius of the one-common-period map by power iteration from a random state. */
+  CoupledStability EstimateCoupledStability(int burn_in_periods = 600, int window_periods = 300);
 
   /**
    * Free decay from a random state (no input): the coupled energy at the start and after every

@@ -63,23 +63,6 @@ TEST(AsyncRegions, NestedShellsAtTheirOwnRatesStayStableAndAccurate) {
   EXPECT_LT(CompareForces(result.samples, DefaultReference().samples).l2_percent, 3.5);
 }
 
-// The coupled estimate runs its 600 + 300 common periods unless they would take longer than
-// kLongestEstimate_s of simulated time; then both parts shrink in proportion.
-TEST(AsyncRegions, AStabilityEstimateRunsAtMostItsLongestSimulatedTime) {
-  Scene scene = Adaptive(2, 2, 800);
-  scene.mesh.nodes = 7;
-  const CoupledStability at_800 = AsyncRegions(scene).EstimateCoupledStability();
-  EXPECT_DOUBLE_EQ(at_800.common_period_s, 0.005);
-  EXPECT_EQ(at_800.periods, 900);  // 4.5 s: not shortened
-  scene.adaptivity.secondary_rate_hz = 900;
-  const CoupledStability at_900 = AsyncRegions(scene).EstimateCoupledStability();
-  EXPECT_DOUBLE_EQ(at_900.common_period_s, 0.010);
-  EXPECT_EQ(at_900.periods, 450);  // 9 s planned, 4.5 s run
-  EXPECT_LE(at_900.periods * at_900.common_period_s, CoupledStability::kLongestEstimate_s + 1e-12);
-  scene.adaptivity.secondary_rate_hz = 1000;
-  EXPECT_EQ(AsyncRegions(scene).EstimateCoupledStability().periods, 900);  // 0.9 s
-}
-
 TEST(AsyncRegions, BestPrimarySizeAtTwiceTheSpacingAnd600HzIsBelowTheJnd) {
   double best = INFINITY;
   for (int r = 1; r <= 4; ++r) {

@@ -13,9 +13,9 @@
 namespace hapticsim::cli {
 namespace {
 
-int RunAdaptive(const SceneOptions& options, const Scene& scene, double longest_s) {
+int RunAdaptive(const SceneOptions& options, const Scene& scene) {
   AsyncRegions regions(scene);
-  const CoupledStability coupled = regions.EstimateCoupledStability(600, 300, longest_s);
+  const CoupledStability coupled = regions.EstimateCoupledStability();
   const auto& p = regions.partition();
   if (options.json) {
     nlohmann::json out;
@@ -55,7 +55,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene, double longest_
 
 // The paper's adaptive configurations of the scene: primary size 1–4, spacing factor 1–3,
 // secondary rate 1000–600 Hz (those the mesh allows), each with its coupled verdict.
-int RunAllConfigurations(const SceneOptions& options, const Scene& base, double longest_s) {
+int RunAllConfigurations(const SceneOptions& options, const Scene& base) {
   nlohmann::json rows = nlohmann::json::array();
   int stable_count = 0, total = 0;
   if (!options.json) {
@@ -82,7 +82,7 @@ int RunAllConfigurations(const SceneOptions& options, const Scene& base, double 
           continue;
         }
         AsyncRegions regions(scene);
-        const CoupledStability coupled = regions.EstimateCoupledStability(600, 300, longest_s);
+        const CoupledStability coupled = regions.EstimateCoupledStability();
         ++total;
         stable_count += coupled.stable ? 1 : 0;
         rows.push_back({{"primary_size", r},
@@ -113,10 +113,10 @@ int RunAllConfigurations(const SceneOptions& options, const Scene& base, double 
   return kExitOk;
 }
 
-int Run(const SceneOptions& options, bool all_configurations, double longest_s) {
+int Run(const SceneOptions& options, bool all_configurations) {
   const Scene scene = options.Resolve();
-  if (all_configurations) return RunAllConfigurations(options, scene, longest_s);
-  if (scene.adaptivity.enabled()) return RunAdaptive(options, scene, longest_s);
+  if (all_configurations) return RunAllConfigurations(options, scene);
+  if (scene.adaptivity.enabled()) return RunAdaptive(options, scene);
   const CubeScene cube(scene);
   const StabilityEstimate estimate = EstimateStability(cube.model());
   const double dt = scene.solver.dt_s;
@@ -153,7 +153,6 @@ int Run(const SceneOptions& options, bool all_configurations, double longest_s) 
 Command AddStabilityCommand(CLI::App& parent) {
   auto options = std::make_shared<SceneOptions>();
   auto all_configurations = std::make_shared<bool>(false);
-  auto longest_s = std::make_shared<double>(CoupledStability::kLongestEstimate_s);
   CLI::App* app = parent.add_subcommand(
       "stability",
       "Critical time step of the scene and whether its solver.dt is below it; with adaptivity "
@@ -163,14 +162,7 @@ Command AddStabilityCommand(CLI::App& parent) {
       "--all-configurations", *all_configurations,
       "Coupled verdict for every adaptive configuration of the paper's ranges "
       "(primary size 1-4, spacing factor 1-3, secondary rate 1000-600 Hz); takes minutes");
-  app->add_option("--longest-estimate", *longest_s,
-                  "Simulated time the coupled estimate (600 + 300 common periods of power "
-                  "iteration) may take at most, s; longer checks a verdict the default gives")
-      ->check(CLI::Range(0.01, 1000.0))
-      ->capture_default_str();
-  return {app, [options, all_configurations, longest_s] {
-            return Run(*options, *all_configurations, *longest_s);
-          }};
+  return {app, [options, all_configurations] { return Run(*options, *all_configurations); }};
 }
 
 }  // namespace hapticsim::cli
