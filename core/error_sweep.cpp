@@ -81,29 +81,6 @@ std::vector<int> RegionSignature(const Scene& scene) {
   return signature;
 }
 
-// A grid's contact node that cannot be pressed is the grid's mistake: said so, naming its axes.
-void CheckContactNode(const MeshSettings& mesh, const std::array<double, 3>& node) {
-  const std::string where = "the grid's contact node (contact_node_x, _y, _z) = (" +
-                            FormatReal(node[0]) + ", " + FormatReal(node[1]) + ", " +
-                            FormatReal(node[2]) + ")";
-  LatticeIndex index{};
-  for (int c = 0; c < 3; ++c) {
-    HAPTICSIM_THROW_UNLESS(
-        node[c] == std::round(node[c]) && node[c] >= 0 && node[c] <= mesh.nodes - 1,
-        where +
-            " is not a node of the mesh: indices are whole numbers from 0 "
-            "to mesh.nodes - 1 = " +
-            std::to_string(mesh.nodes - 1));
-    index[c] = static_cast<int>(node[c]);
-  }
-  HAPTICSIM_THROW_UNLESS(IsSurfaceNode(mesh, index),
-                         where +
-                             " is inside the object: list surface nodes (e.g. of one face, "
-                             "contact_node_z = [0.0] for the front face)");
-  HAPTICSIM_THROW_UNLESS(!IsSupportNode(mesh, index),
-                         where + " is a fixed back corner: it cannot be driven");
-}
-
 std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linear,
                             SweepStats* stats) {
   const auto& ax = grid.axes;
@@ -129,14 +106,19 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
     size_groups[c].resize(ax[lod_axis].size());
     std::array<int, kNumMapAxes> index{};
     contact_index(c, &index);
-    CheckContactNode(base.mesh, {ax[kContactAxes[0]][index[kContactAxes[0]]],
-                                 ax[kContactAxes[1]][index[kContactAxes[1]]],
-                                 ax[kContactAxes[2]][index[kContactAxes[2]]]});
+    MapPoint at_node = layout.samples.front().point;
+    for (int a : kContactAxes) at_node[a] = ax[a][index[a]];
+    // A node that cannot be pressed is the grid's mistake, not the configuration's: said so.
+    const LatticeIndex node = *SceneAtPoint(base, at_node).input.contact_node;
+    const std::string problem = ContactNodeProblem(base.mesh, node);
+    HAPTICSIM_THROW_UNLESS(problem.empty(), "the grid's contact node (contact_node_x, _y, _z) = (" +
+                                                std::to_string(node[0]) + ", " +
+                                                std::to_string(node[1]) + ", " +
+                                                std::to_string(node[2]) + ") " + problem);
     for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
       std::map<std::vector<int>, size_t> seen;
       for (size_t s = 0; s < ax[size_axis].size(); ++s) {
-        MapPoint point = layout.samples.front().point;
-        for (int a : kContactAxes) point[a] = ax[a][index[a]];
+        MapPoint point = at_node;
         point[lod_axis] = ax[lod_axis][l];
         point[size_axis] = ax[size_axis][s];
         std::vector<int> signature;

@@ -40,7 +40,9 @@ MapPoint PointOfScene(const Scene& scene) {
 
 Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
   Scene scene = base;
-  LatticeIndex node{};
+  // "ix,iy,iz" (the node axes come in component order), set through the scene key so that it is
+  // checked as any other value.
+  std::string node;
   for (int a = 0; a < kNumMapAxes; ++a) {
     const MapAxisInfo& info = AxisInfo(a);
     if (info.integer) {
@@ -48,10 +50,7 @@ Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
           point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
           std::string(info.scene_key) + " = " + FormatReal(point[a]) + " is not a whole number");
       if (info.node_component >= 0) {
-        HAPTICSIM_THROW_UNLESS(point[a] >= 0, std::string(info.scene_key) + " = " +
-                                                  FormatReal(point[a]) +
-                                                  " is not a lattice index (0 or more)");
-        node[info.node_component] = static_cast<int>(point[a]);
+        node += (node.empty() ? "" : ",") + std::to_string(static_cast<long>(point[a]));
         continue;
       }
       SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));
@@ -59,7 +58,7 @@ Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
       SetSceneValue(&scene, info.scene_key, FormatReal(point[a]));
     }
   }
-  scene.input.contact_node = node;
+  SetSceneValue(&scene, "input.contact_node", node);
   return scene;
 }
 

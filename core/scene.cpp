@@ -332,26 +332,31 @@ void ValidateScene(const Scene& scene) {
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
   if (const auto& node = scene.input.contact_node) {
-    const std::string text = GetSceneValue(scene, "input.contact_node");
-    const int last = scene.mesh.nodes - 1;
-    for (int c : *node) {
-      if (c > last) {
-        throw Error("input.contact_node = " + text + " is outside the mesh: its indices must be " +
-                    "from 0 to mesh.nodes - 1 = " + std::to_string(last));
-      }
-    }
-    if (!IsSurfaceNode(scene.mesh, *node)) {
-      throw Error("input.contact_node = " + text +
-                  " is inside the object: the contact node must be on the surface (some index 0 "
-                  "or " +
-                  std::to_string(last) + ")");
-    }
-    if (IsSupportNode(scene.mesh, *node)) {
-      throw Error("input.contact_node = " + text +
-                  " is a fixed back corner: the contact node must be free to move");
+    const std::string problem = ContactNodeProblem(scene.mesh, *node);
+    if (!problem.empty()) {
+      throw Error("input.contact_node = " + GetSceneValue(scene, "input.contact_node") + " " +
+                  problem);
     }
   }
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
+}
+
+std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node) {
+  const int last = mesh.nodes - 1;
+  for (int c : node) {
+    if (c < 0 || c > last) {
+      return "is outside the mesh: its indices must be from 0 to mesh.nodes - 1 = " +
+             std::to_string(last);
+    }
+  }
+  if (!IsSurfaceNode(mesh, node)) {
+    return "is inside the object: the contact node must be on the surface (some index 0 or " +
+           std::to_string(last) + ")";
+  }
+  if (IsSupportNode(mesh, node)) {
+    return "is a fixed back corner: the contact node must be free to move";
+  }
+  return "";
 }
 
 LatticeIndex CubeContactNode(const MeshSettings& mesh) {

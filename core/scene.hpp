@@ -132,6 +132,12 @@ bool IsSurfaceNode(const MeshSettings& mesh, const LatticeIndex& node);
 bool IsSupportNode(const MeshSettings& mesh, const LatticeIndex& node);
 
 /**
+ * Why `node` cannot be the driven node of `mesh` — "is outside the mesh: …", "is inside the
+ * object: …", "is a fixed back corner: …" — or "" when it can (ValidateScene's check).
+ */
+std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node);
+
+/**
  * The unit inward normal of the face a surface node lies on. Nodes on an edge or a corner belong
  * to the first of their faces in the order front/back (z), left/right (x), bottom/top (y): the
  * paper presses along z, so the front face wins.

@@ -64,10 +64,7 @@ SweepGrid QuickGrid(const Scene& scene) {
     for (int step : {-1, 1}) {
       LatticeIndex neighbour = node;
       neighbour[axis] += step;
-      if (neighbour[axis] < 0 || neighbour[axis] >= scene.mesh.nodes ||
-          !IsSurfaceNode(scene.mesh, neighbour) || IsSupportNode(scene.mesh, neighbour)) {
-        continue;
-      }
+      if (!ContactNodeProblem(scene.mesh, neighbour).empty()) continue;
       const double a = node[axis], b = neighbour[axis];
       grid.axes[static_cast<int>(MapAxis::kContactNodeX) + axis] = {std::min(a, b), std::max(a, b)};
       return grid;
