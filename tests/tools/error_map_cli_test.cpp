@@ -97,6 +97,12 @@ TEST(ErrorMapCli, LookupInterpolatesClampsWithAFlagAndRefusesUnknownAxes) {
   const CommandResult bad = Hapticsim({"lookup", map, "--set", "stiffness=3"});
   EXPECT_EQ(bad.exit_status, 2);
   EXPECT_NE(bad.err.find("not a map axis"), std::string::npos) << bad.err;
+  // A contact node inside the object is no node a tool can press: refused, not clamped.
+  const CommandResult inner = Hapticsim({"lookup", map, "--set", "contact_node=3,3,3"});
+  EXPECT_EQ(inner.exit_status, 2);
+  EXPECT_NE(inner.err.find("contact_node=3,3,3: on the map's mesh this node is inside the object"),
+            std::string::npos)
+      << inner.err;
 }
 
 TEST(ErrorMapCli, ADamagedMapIsRefusedWithAMessageThatSaysHow) {

@@ -50,6 +50,9 @@ int Run(const LookupCommandOptions& o) {
       Scene scene = map_scene;  // "middle" is the middle of the map's mesh
       SetSceneValue(&scene, "input.contact_node", value);  // "ix,iy,iz", refused with the format
       const LatticeIndex node = ContactNode(scene);
+      const std::string problem = ContactNodeProblem(scene.mesh, node);
+      HAPTICSIM_THROW_UNLESS(problem.empty(),
+                             "--set " + assignment + ": on the map's mesh this node " + problem);
       for (int c = 0; c < 3; ++c) {
         const int axis = static_cast<int>(MapAxis::kContactNodeX) + c;
         query.lo[axis] = query.hi[axis] = node[c];
