@@ -10,6 +10,7 @@
 // Exit status: 0 clean stop, 2 bad configuration, 1 anything else.
 #include <signal.h>
 #include <spdlog/async.h>
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <sys/mman.h>
@@ -233,10 +234,19 @@ int Serve(const Arguments& args) {
   std::future<SupervisorDecision> choice;         // a new choice being computed
   std::optional<RegionConfiguration> choice_pin;  // the pin that choice was asked with
   std::optional<SupervisorDecision> pending;      // chosen, waiting for the tool to be away
+  // The scene as the regions run it: centred on the node the tool last touched. A choice is made
+  // for that node — its error looked up there, its stability estimated around it.
+  auto scene_at_centre = [&] {
+    Scene scene = config.scene;
+    scene.input.contact_node = loop.centre_node();
+    return scene;
+  };
+  LatticeIndex chosen_for_node = ContactNode(config.scene);  // the node the last choice was for
   auto choose_again = [&](const std::optional<RegionConfiguration>& pin) {
     // Stability estimates take up to seconds: off the supervisor's tick.
     choice_pin = pin;
-    choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target, pin] {
+    chosen_for_node = loop.centre_node();
+    choice = std::async(std::launch::async, [scene = scene_at_centre(), m = map.map, target, pin] {
       return ChooseConfiguration(scene, m.get(), target, pin);
     });
   };
@@ -426,6 +436,7 @@ int Serve(const Arguments& args) {
         if (choice_pin) spdlog::info("configuration pinned");
         pinned = choice_pin;
         if (chosen.configuration == decision.configuration) {
+          spdlog::info("configuration kept: {}", chosen.reason);
           decision = chosen;
           pending.reset();
         } else {
@@ -477,15 +488,29 @@ int Serve(const Arguments& args) {
         }
         active = moved->centred.configuration;
         active_radius = moved->centred.spectral_radius;
-        spdlog::info("regions centred on contact node ({}, {}, {}) {} s after it was asked for{}",
-                     node[0], node[1], node[2], moved->verify_ms * 1e-3,
-                     moved->centred.fell_back
-                         ? "; the chosen configuration is unstable around it: secondaries at "
-                           "the primary rate there"
-                         : "");
+        spdlog::info(
+            "regions centred on contact node ({}, {}, {}) {:.3f} s after it was asked for{}",
+            node[0], node[1], node[2], moved->verify_ms * 1e-3,
+            moved->centred.fell_back
+                ? "; the chosen configuration is unstable around it: secondaries at "
+                  "the primary rate there"
+                : "");
         match_miss_loggers(now);
         overload.Reset(now);
         report_error();
+        // Around this node the configuration may miss the target that it met where it was
+        // chosen (a box cut by the object's edge, a coarser neighbourhood): choose again for the
+        // node, once per node. What is chosen switches like any other, once the tool is away.
+        if (!reported_target_met && decision.have_map && !pinned && !choice.valid() && !pending &&
+            chosen_for_node != node) {
+          spdlog::warn(
+              "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the "
+              "target {} %: choosing again for this node",
+              node[0], node[1], node[2], DescribeConfiguration(active),
+              reported_error < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error),
+              target);
+          choose_again(std::nullopt);
+        }
       }
     } catch (const Error& e) {
       spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
@@ -512,7 +537,7 @@ int Serve(const Arguments& args) {
             name, overload.last_misses(), rates_hz[region], decision.cost_us_per_ms);
         choice_pin.reset();
         choice_for_overload = true;
-        choice = std::async(std::launch::async, [scene = config.scene, m = map.map, target,
+        choice = std::async(std::launch::async, [scene = scene_at_centre(), m = map.map, target,
                                                  ceiling = decision.cost_us_per_ms] {
           return ChooseConfiguration(scene, m.get(), target, std::nullopt, ceiling);
         });

@@ -16,13 +16,6 @@ constexpr int kLod = static_cast<int>(MapAxis::kSecondaryLod);
 constexpr int kSize = static_cast<int>(MapAxis::kPrimarySize);
 constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
 
-std::string Describe(const RegionConfiguration& c) {
-  std::ostringstream text;
-  text << "primary_size " << c.primary_size << ", secondary_lod " << c.secondary_lod
-       << ", secondary_rate " << c.secondary_rate_hz << " Hz";
-  return text.str();
-}
-
 // Coupled stability of a configuration on this scene; nullopt when the configuration is invalid.
 std::optional<double> CoupledRadius(const Scene& scene, const RegionConfiguration& c) {
   try {
@@ -50,6 +43,13 @@ LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
 }
 
 }  // namespace
+
+std::string DescribeConfiguration(const RegionConfiguration& c) {
+  std::ostringstream text;
+  text << "primary_size " << c.primary_size << ", secondary_lod " << c.secondary_lod
+       << ", secondary_rate " << c.secondary_rate_hz << " Hz";
+  return text.str();
+}
 
 NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
                         const RegionConfiguration& configuration, const LatticeIndex& node) {
@@ -95,7 +95,7 @@ CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfigurati
   if (const std::optional<double> radius = CoupledRadius(centred, equal)) {
     return {equal, *radius, true};
   }
-  throw Error(Describe(configuration) + " is not stable around contact node (" +
+  throw Error(DescribeConfiguration(configuration) + " is not stable around contact node (" +
               std::to_string(node[0]) + ", " + std::to_string(node[1]) + ", " +
               std::to_string(node[2]) + "), not even at equal rates");
 }
@@ -176,7 +176,8 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     decision.spectral_radius = *radius;
     decision.target_met = have_map && candidate.error <= target_percent;
     std::ostringstream reason;
-    reason << Describe(candidate.configuration) << ": coupled spectral radius " << *radius;
+    reason << DescribeConfiguration(candidate.configuration) << ": coupled spectral radius "
+           << *radius;
     if (have_map) {
       reason << ", looked-up error " << candidate.error << " % against the target "
              << target_percent << " %" << (decision.target_met ? "" : " (TARGET EXCEEDED)")
@@ -187,10 +188,10 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     decision.reason = reason.str();
     return decision;
   }
-  throw Error(pinned
-                  ? "the pinned configuration " + Describe(*pinned) + " is not stable on this scene"
-                  : "no stable configuration for this scene (checked " +
-                        std::to_string(decision.stability_checks) + ")");
+  throw Error(pinned ? "the pinned configuration " + DescribeConfiguration(*pinned) +
+                           " is not stable on this scene"
+                     : "no stable configuration for this scene (checked " +
+                           std::to_string(decision.stability_checks) + ")");
 }
 
 }  // namespace hapticsim

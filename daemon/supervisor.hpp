@@ -17,6 +17,9 @@ struct RegionConfiguration {
   bool operator==(const RegionConfiguration&) const = default;
 };
 
+/** "primary_size 3, secondary_lod 2, secondary_rate 1000 Hz": as logs and errors name it. */
+std::string DescribeConfiguration(const RegionConfiguration& configuration);
+
 struct SupervisorDecision {
   RegionConfiguration configuration;
   bool have_map = false;
@@ -33,10 +36,11 @@ struct SupervisorDecision {
  * Stability first: picks the cheapest configuration (by the map's measured cost) whose
  * looked-up error meets `target_percent` and whose coupled regions are stable (estimated here,
  * not only trusted from the map); when none meets the target, the stable one with the least
- * error, target_met = false. The error is looked up for the scene's material with the input
- * frequency and amplitude unknown (their worst case over the map). Without a map: the scene's own
- * configuration if stable, else equal rates (always stable when the primary rate is).
- * `pinned`: only that configuration (refused — an Error — if it is unstable).
+ * error, target_met = false. The error is looked up for the scene's material and contact node
+ * (the daemon passes the node its regions are centred on; stability is estimated around it too)
+ * with the input frequency and amplitude unknown (their worst case over the map). Without a map:
+ * the scene's own configuration if stable, else equal rates (always stable when the primary rate
+ * is). `pinned`: only that configuration (refused — an Error — if it is unstable).
  * `below_cost_us_per_ms`: only configurations the map measured cheaper than this (deadlines
  * before accuracy, when the running one keeps missing them).
  * @throws Error when no stable configuration exists at all (or none cheaper, with a ceiling).

@@ -57,16 +57,21 @@ void WaitUntilServing(testing::BackgroundProcess& daemon) {
 
 // A two-configuration map for the default scene, made by the real sweep (a few seconds): the
 // primary sizes 1 (cheaper, about 2.7 % error) and 3 (about 0.4 %).
+// A map made by the real sweep over the grid file text `axes`; returns its path.
+std::string SweptMap(const std::string& name, const std::string& axes) {
+  const std::string grid = Temp(name + "_grid.toml"), map = Temp(name + ".hsmap");
+  std::ofstream(grid) << "[axes]\n" << axes;
+  const auto result =
+      testing::RunCommand({HAPTICSIM_CLI_PATH, "sweep", "--grid", grid, "--out", map, "--json"});
+  EXPECT_EQ(result.exit_status, 0) << result.err;
+  return map;
+}
+
 const std::string& SmallMap() {
-  static const std::string path = [] {
-    const std::string grid = Temp("grid.toml"), map = Temp("map.hsmap");
-    std::ofstream(grid) << "[axes]\nsecondary_lod = [2]\nprimary_size = [1, 3]\n"
-                           "secondary_rate = [1000.0]\nfrequency = [1.0]\n";
-    const auto result =
-        testing::RunCommand({HAPTICSIM_CLI_PATH, "sweep", "--grid", grid, "--out", map, "--json"});
-    EXPECT_EQ(result.exit_status, 0) << result.err;
-    return map;
-  }();
+  static const std::string path =
+      SweptMap("map",
+               "secondary_lod = [2]\nprimary_size = [1, 3]\nsecondary_rate = [1000.0]\n"
+               "frequency = [1.0]\n");
   return path;
 }
 
@@ -392,6 +397,77 @@ TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
   EXPECT_NE(log.find("black box: t +0.0 ms seq"), std::string::npos) << log;
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0);
+}
+
+// A map over two contact nodes where the cheapest configuration meets the target at the middle of
+// the front face but not two nodes from its edge: there the supervisor chooses again, for that
+// node, and switches once the tool is away. Errors of this grid (the real sweep, spacing factor
+// 3, 1000 Hz): primary size 1 about 1.8 % at (6, 6, 0) and 6.9 % at (2, 6, 0); size 4 below 1 %
+// at both, and several times dearer (its box is 13 × 13 × 7 nodes at the middle).
+TEST(HapticsimdContactNodes, WhereTheConfigurationMissesTheTargetTheSupervisorChoosesForThatNode) {
+  const std::string map =
+      SweptMap("nodes",
+               "secondary_lod = [3]\nprimary_size = [1, 4]\nsecondary_rate = [1000.0]\n"
+               "frequency = [1.0]\ncontact_node_x = [2, 6]\n");
+  auto error_of = [&](int size, const char* node) {
+    const auto looked_up = testing::RunCommand(
+        {HAPTICSIM_CLI_PATH, "lookup", map, "--set", "primary_size=" + std::to_string(size),
+         "--set", "secondary_lod=3", "--set", "secondary_rate=1000", "--set",
+         std::string("contact_node=") + node, "--json"});
+    EXPECT_EQ(looked_up.exit_status, 0) << looked_up.err;
+    return nlohmann::json::parse(looked_up.out).at("error").get<double>();
+  };
+  constexpr double kTarget = 3.0;
+  // What the test stands on: size 1 meets the target at the middle and misses it at (2, 6, 0).
+  ASSERT_LT(error_of(1, "6,6,0"), kTarget);
+  ASSERT_GT(error_of(1, "2,6,0"), kTarget);
+  const std::string config = Temp("nodes.toml");
+  std::ofstream(config) << "[supervisor]\nerror_map = \"" << map
+                        << "\"\nerror_target_percent = " << kTarget << "\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("nodes.log"));
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus(
+      [](const status_t& s) { return s.primary_size == 1 && s.target_met; }, 30))
+      << daemon.Log();
+
+  const double h = kEdge / 12;
+  auto next = Clock::now();
+  std::int64_t seq = 0;
+  auto play = [&](int periods, double z) {
+    for (int i = 0; i < periods; ++i) {
+      client.Send(++seq, 2 * h, 6 * h, z);
+      next += std::chrono::milliseconds(1);
+      std::this_thread::sleep_until(next);
+    }
+  };
+  play(50, -0.002);   // hover over (2, 6, 0)
+  play(1200, 0.004);  // 4 mm in: the regions move there, size 1 still running
+  const size_t in_contact = client.Forces().size();
+  play(3000, -0.002);  // lift off and hover: the new choice switches once the object has settled
+  ASSERT_TRUE(client.WaitForStatus(
+      [](const status_t& s) {
+        return s.contact_node[0] == 2 && s.contact_node[1] == 6 && s.contact_node[2] == 0 &&
+               s.primary_size != 1 && s.target_met && s.error_percent <= kTarget;
+      },
+      10))
+      << daemon.Log();
+  EXPECT_NE(daemon.Log().find("around contact node (2, 6, 0) the looked-up error of primary_size "
+                              "1, secondary_lod 3, secondary_rate 1000 Hz is"),
+            std::string::npos)
+      << daemon.Log();
+  EXPECT_NE(daemon.Log().find("reconfigured: primary_size"), std::string::npos);
+  // While size 1 ran around (2, 6, 0) its forces said the target was exceeded.
+  const std::vector<force_feedback_t> forces = client.Forces();
+  int flagged = 0;
+  for (size_t i = 0; i < in_contact && i < forces.size(); ++i) {
+    if ((forces[i].flags & force_feedback_t::FLAG_IN_CONTACT) &&
+        (forces[i].flags & force_feedback_t::FLAG_ERROR_TARGET_EXCEEDED)) {
+      ++flagged;
+    }
+  }
+  EXPECT_GT(flagged, 100) << daemon.Log();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
 // SIGHUP reloads the map; a damaged one is refused and the loaded one kept, and the loop runs on.
