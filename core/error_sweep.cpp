@@ -33,7 +33,7 @@ using Json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-int Axis(MapAxis axis) { return static_cast<int>(axis); }
+constexpr int Axis(MapAxis axis) { return static_cast<int>(axis); }
 
 // The material and input (with the contact node) a reference depends on.
 using ReferenceKey = std::array<double, 9>;
@@ -51,7 +51,8 @@ struct Reference {
   bool ok = false;
 };
 
-// A sample a run fills: the amplitude it stands for is `scale` × the run's amplitude.
+// A sample a run fills: its forces are `scale` × the run's (another amplitude, by linearity;
+// another density at the same E/ρ, by similarity).
 struct Target {
   std::size_t sample = 0;
   double scale = 1;
@@ -81,7 +82,43 @@ std::vector<int> RegionSignature(const Scene& scene) {
   return signature;
 }
 
-std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linear,
+// The grid's materials (the four material axes, the last fastest) and, per material, the one
+// that is run for it: the first of equal E/ρ, ν and d when `similar`, else itself.
+struct GridMaterials {
+  std::vector<std::array<int, 4>> index;  // per material: its index on each material axis
+  std::vector<std::size_t> run_as;
+};
+GridMaterials MaterialsOf(const std::array<std::vector<double>, kNumMapAxes>& ax, bool similar) {
+  const int nu = Axis(MapAxis::kPoissonRatio), rho = Axis(MapAxis::kDensity),
+            d = Axis(MapAxis::kDamping), e = Axis(MapAxis::kYoungsModulus);
+  static_assert(Axis(MapAxis::kPoissonRatio) == 0 && Axis(MapAxis::kYoungsModulus) == 3,
+                "the material axes are the first four");
+  GridMaterials out;
+  const size_t count = ax[0].size() * ax[1].size() * ax[2].size() * ax[3].size();
+  for (size_t m = 0; m < count; ++m) {
+    std::array<int, 4> index{};
+    for (int a = 3, rest = static_cast<int>(m); a >= 0; --a) {
+      index[a] = rest % static_cast<int>(ax[a].size());
+      rest /= static_cast<int>(ax[a].size());
+    }
+    out.index.push_back(index);
+    out.run_as.push_back(m);
+    if (!similar) continue;
+    const double wave_speed_squared = ax[e][index[e]] / ax[rho][index[rho]];
+    for (size_t earlier = 0; earlier < m; ++earlier) {
+      const std::array<int, 4>& o = out.index[earlier];
+      if (o[nu] == index[nu] && o[d] == index[d] &&
+          std::abs(ax[e][o[e]] / ax[rho][o[rho]] - wave_speed_squared) <=
+              1e-12 * wave_speed_squared) {
+        out.run_as.back() = earlier;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linear, bool similar,
                             SweepStats* stats) {
   const auto& ax = grid.axes;
   const ErrorMap layout = ErrorMap::MakeGrid(ax);
@@ -147,13 +184,17 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
     return p;
   };
   // Materials outermost, then contact node, spacing factor, rate and region group: the order is
-  // the task numbering that shards and journals use.
-  const size_t materials = ax[0].size() * ax[1].size() * ax[2].size() * ax[3].size();
-  for (size_t m = 0; m < materials; ++m) {
-    for (int a = 3, rest = static_cast<int>(m); a >= 0; --a) {  // material axes, last fastest
-      index[a] = rest % static_cast<int>(ax[a].size());
-      rest /= static_cast<int>(ax[a].size());
+  // the task numbering that shards and journals use. A material run as an earlier one has no
+  // tasks: the earlier one's runs fill its samples too.
+  const GridMaterials materials = MaterialsOf(ax, similar);
+  const int density = Axis(MapAxis::kDensity);
+  for (size_t m = 0; m < materials.index.size(); ++m) {
+    if (materials.run_as[m] != m) continue;
+    std::vector<size_t> answered;  // the materials this one's runs answer: itself first
+    for (size_t other = m; other < materials.index.size(); ++other) {
+      if (materials.run_as[other] == m) answered.push_back(other);
     }
+    for (int a = 0; a < 4; ++a) index[a] = materials.index[m][a];
     for (std::size_t c = 0; c < contacts; ++c) {
       contact_index(c, &index);
       for (size_t l = 0; l < ax[lod_axis].size(); ++l) {
@@ -172,16 +213,25 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
                 index[size_axis] = group.front();
                 run.point = point_at(index);
                 const double amplitude = run.point[Axis(MapAxis::kAmplitude)];
-                for (int s : group) {
-                  for (size_t a = 0; a < amps; ++a) {
-                    if (!linear && a != ra) continue;
-                    auto target_index = index;
-                    target_index[size_axis] = s;
-                    target_index[Axis(MapAxis::kAmplitude)] = static_cast<int>(a);
-                    run.targets.push_back({layout.GridIndex(target_index),
-                                           ax[Axis(MapAxis::kAmplitude)][a] / amplitude});
+                for (size_t member : answered) {
+                  auto target_index = index;
+                  for (int a = 0; a < 4; ++a) target_index[a] = materials.index[member][a];
+                  const double density_ratio =
+                      ax[density][target_index[density]] / ax[density][index[density]];
+                  for (int s : group) {
+                    for (size_t a = 0; a < amps; ++a) {
+                      if (!linear && a != ra) continue;
+                      target_index[size_axis] = s;
+                      target_index[Axis(MapAxis::kAmplitude)] = static_cast<int>(a);
+                      run.targets.push_back(
+                          {layout.GridIndex(target_index),
+                           ax[Axis(MapAxis::kAmplitude)][a] / amplitude * density_ratio});
+                    }
                   }
                 }
+                // Counted in this order: similarity, then linearity, then same regions.
+                stats->saved_by_similarity +=
+                    (answered.size() - 1) * (linear ? amps : 1) * group.size();
                 stats->saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
                 stats->saved_by_same_regions += group.size() - 1;
                 task.runs.push_back(std::move(run));
@@ -280,7 +330,8 @@ void ReadSampleRecord(const Json& record, ErrorMap* map) {
 std::string Fingerprint(const ErrorMap& map, const SweepGrid& grid, const SweepOptions& options) {
   std::ostringstream text;
   text << map.provenance.scene_toml << map.provenance.model << map.provenance.code_version
-       << grid.name << options.shard_index << '/' << options.shard_count << options.use_linearity;
+       << grid.name << options.shard_index << '/' << options.shard_count << options.use_linearity
+       << options.use_similarity;
   std::uint64_t hash = 0xcbf29ce484222325ull;
   for (unsigned char c : text.str()) hash = (hash ^ c) * 0x100000001b3ull;
   for (const MapSample& s : map.samples) {
@@ -334,7 +385,7 @@ std::vector<bool> ReadJournal(const std::string& path, const std::string& finger
 
 ModelTraits CurrentModel() {
   return {"linear hexahedral FEM (C3D8, lumped mass, C = d·M), central difference; regions v1",
-          true};
+          true, true};
 }
 
 std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
@@ -369,7 +420,9 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   for (const MapSample& s : map.samples) SceneAtPoint(base, s.point);  // validates every point
 
   std::vector<Task> all_tasks =
-      grid.scattered ? ScatteredTasks(grid) : GridTasks(base, grid, linear, &stats);
+      grid.scattered ? ScatteredTasks(grid)
+                     : GridTasks(base, grid, linear,
+                                 options.use_similarity && model.similar_in_density, &stats);
   std::vector<std::size_t> mine;  // task numbers of this shard
   for (std::size_t t = options.shard_index; t < all_tasks.size(); t += options.shard_count) {
     mine.push_back(t);
@@ -380,6 +433,7 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   }
   if (options.shard_count > 1) {  // savings are counted for this shard's share only
     const double share = static_cast<double>(mine.size()) / all_tasks.size();
+    stats.saved_by_similarity = std::lround(stats.saved_by_similarity * share);
     stats.saved_by_linearity = std::lround(stats.saved_by_linearity * share);
     stats.saved_by_same_regions = std::lround(stats.saved_by_same_regions * share);
   }

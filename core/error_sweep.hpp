@@ -15,6 +15,12 @@ namespace hapticsim {
 struct ModelTraits {
   std::string name;     ///< recorded in the map
   bool linear = false;  ///< force ∝ amplitude at fixed material and configuration
+  /**
+   * Dynamically similar in density: ρü + ρd·u̇ + E·K̂(ν)u = 0 with the motion prescribed at the
+   * contact, so the motion depends on E/ρ, not on E and ρ apart, and the force ∝ ρ at fixed
+   * E/ρ, ν and d — for the reference and every configuration alike.
+   */
+  bool similar_in_density = false;
 };
 /** The model this build solves: linear hexahedral FEM, central difference (linear). */
 ModelTraits CurrentModel();
@@ -28,12 +34,13 @@ struct SweepProgress {
 };
 
 struct SweepOptions {
-  int jobs = 1;                             ///< worker threads
-  int shard_index = 0;                      ///< this slice, 0-based
-  int shard_count = 1;                      ///< slices of the task list
-  bool use_linearity = true;                ///< derive the amplitude axis when the model is linear
-  std::string journal_path;                 ///< completed tasks are appended here ("" = none)
-  bool resume = false;                      ///< read the journal first and skip what it holds
+  int jobs = 1;                ///< worker threads
+  int shard_index = 0;         ///< this slice, 0-based
+  int shard_count = 1;         ///< slices of the task list
+  bool use_linearity = true;   ///< derive the amplitude axis when the model is linear
+  bool use_similarity = true;  ///< materials of equal E/ρ, ν, d: run once, force scaled by ρ
+  std::string journal_path;    ///< completed tasks are appended here ("" = none)
+  bool resume = false;         ///< read the journal first and skip what it holds
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after current tasks
   std::function<void(const SweepProgress&)> progress;
   double progress_interval_s = 0.5;
@@ -48,7 +55,8 @@ struct SweepStats {
   std::size_t adaptive_trials = 0;           ///< adaptive runs made
   std::size_t stability_estimates = 0;       ///< coupled spectral radii computed
   std::size_t saved_by_reference_reuse = 0;  ///< reference runs not made: one per material+input
-  std::size_t saved_by_linearity = 0;        ///< adaptive runs not made: other amplitudes
+  std::size_t saved_by_similarity = 0;  ///< adaptive runs not made: a material of equal E/ρ, ν, d
+  std::size_t saved_by_linearity = 0;   ///< adaptive runs not made: other amplitudes
   std::size_t saved_by_same_regions =
       0;                                ///< adaptive runs not made: a size giving the same regions
   std::size_t saved_by_prediction = 0;  ///< adaptive runs not made: predicted unstable
@@ -65,8 +73,10 @@ struct SweepStats {
  * Work is grouped into tasks of one material and one configuration: the configuration's regions
  * are built and their coupled stability estimated once, then every input is run on them. A
  * configuration predicted unstable is not simulated; its samples say so. References are shared
- * by all configurations of a material and input. Results do not depend on the job count or the
- * order tasks finish in; only the measured costs vary from run to run.
+ * by all configurations of a material and input. On a grid, a material with the same E/ρ, ν and d
+ * as an earlier one is not run at all: its samples are the earlier one's with the forces scaled
+ * by the density ratio (ModelTraits::similar_in_density). Results do not depend on the job count or
+ * the order tasks finish in; only the measured costs vary from run to run.
  *
  * @throws Error when the grid or a configuration is invalid, or the journal belongs to another
  *         sweep.

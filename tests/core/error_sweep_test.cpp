@@ -92,6 +92,75 @@ TEST(ErrorSweep, AmplitudeFromLinearityMatchesRunningEveryAmplitude) {
   }
 }
 
+// Dynamic similarity: ρü + ρd·u̇ + E·K̂u = 0 with the contact's motion prescribed moves the same
+// for E/ρ = 10 kPa / 800 kg/m³ = 15 kPa / 1200 kg/m³, with 1.5 × the force at the denser. Run
+// once and scaled, the samples equal those of running both; the material of another E/ρ differs.
+TEST(ErrorSweep, AMaterialOfTheSameWaveSpeedIsTheEarlierOneScaledByItsDensity) {
+  constexpr int kDensity = 1, kYoungs = 3;
+  SweepGrid grid = SmallGrid();
+  grid.axes[kDamping] = {10};
+  grid.axes[kSize] = {1};
+  grid.axes[kDensity] = {800, 1200};
+  grid.axes[kYoungs] = {10000, 15000};
+  SweepOptions derived, run_all;
+  run_all.use_similarity = false;
+  SweepStats derived_stats, run_all_stats;
+  const ErrorMap a = Sweep(grid, derived, &derived_stats);
+  const ErrorMap b = Sweep(grid, run_all, &run_all_stats);
+  ASSERT_EQ(a.samples.size(), 16u);
+  EXPECT_EQ(derived_stats.saved_by_similarity, 4u);  // (1200, 15 kPa): 2 amplitudes × 2 rates
+  EXPECT_EQ(run_all_stats.saved_by_similarity, 0u);
+  EXPECT_EQ(derived_stats.adaptive_trials, 6u);
+  EXPECT_EQ(run_all_stats.adaptive_trials, 8u);
+  EXPECT_EQ(derived_stats.stability_estimates, 6u);
+  EXPECT_EQ(derived_stats.reference_trials, 3u);
+  EXPECT_EQ(run_all_stats.reference_trials, 4u);
+  auto at = [&](const ErrorMap& map, double density, double youngs, double amplitude,
+                double rate) -> const MapSample& {
+    for (const MapSample& s : map.samples) {
+      if (s.point[kDensity] == density && s.point[kYoungs] == youngs &&
+          s.point[kAmplitude] == amplitude && s.point[kRate] == rate) {
+        return s;
+      }
+    }
+    throw Error("no such sample");
+  };
+  for (double amplitude : grid.axes[kAmplitude]) {
+    for (double rate : grid.axes[kRate]) {
+      const MapSample& light = at(b, 800, 10000, amplitude, rate);
+      const MapSample& dense = at(b, 1200, 15000, amplitude, rate);
+      const MapSample& derived_dense = at(a, 1200, 15000, amplitude, rate);
+      const MapSample& other = at(b, 1200, 10000, amplitude, rate);  // E/ρ = 8.3 m²/s²
+      ASSERT_EQ(light.status, SampleStatus::kOk);
+      // Running both: the physics says they are similar (the code knows nothing of it).
+      ASSERT_EQ(dense.status, SampleStatus::kOk);
+      EXPECT_NEAR(dense.l2_percent, light.l2_percent, 1e-9 * light.l2_percent);
+      EXPECT_NEAR(dense.max_magnitude_percent, light.max_magnitude_percent,
+                  1e-9 * light.max_magnitude_percent);
+      EXPECT_NEAR(dense.max_direction_deg, light.max_direction_deg, 1e-6);
+      EXPECT_NEAR(dense.reference_peak_n, 1.5 * light.reference_peak_n,
+                  1e-9 * dense.reference_peak_n);
+      EXPECT_NEAR(dense.spectral_radius, light.spectral_radius, 1e-12);
+      // Derived: the same as running it.
+      ASSERT_EQ(derived_dense.status, dense.status);
+      EXPECT_NEAR(derived_dense.l2_percent, dense.l2_percent, 1e-9 * dense.l2_percent);
+      EXPECT_NEAR(derived_dense.max_magnitude_percent, dense.max_magnitude_percent,
+                  1e-9 * dense.max_magnitude_percent);
+      EXPECT_NEAR(derived_dense.reference_peak_n, dense.reference_peak_n,
+                  1e-9 * dense.reference_peak_n);
+      // Another wave speed is another answer: the comparison above can tell.
+      ASSERT_EQ(other.status, SampleStatus::kOk);
+      EXPECT_GT(std::abs(other.l2_percent - light.l2_percent), 1e-3 * light.l2_percent);
+    }
+  }
+  // Every other sample is the same whichever way it was made.
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    ASSERT_EQ(a.samples[i].status, b.samples[i].status) << i;
+    if (a.samples[i].status != SampleStatus::kOk) continue;
+    EXPECT_NEAR(a.samples[i].l2_percent, b.samples[i].l2_percent, 1e-9 * b.samples[i].l2_percent);
+  }
+}
+
 TEST(ErrorSweep, SizesGivingTheSameRegionsAreRunOnceWithTheSameAnswer) {
   SweepStats stats;
   const ErrorMap both = Sweep(SmallGrid(), {}, &stats);

@@ -68,6 +68,27 @@ TEST(ErrorMapCli, SweepWritesAMapThatInfoDescribes) {
   EXPECT_NE(info["scene_toml"].get<std::string>().find("nodes = 9"), std::string::npos);
 }
 
+// Two materials of one E/ρ (10 kPa / 800 kg/m³ and 15 kPa / 1200 kg/m³): the second is derived
+// from the first unless --no-similarity.
+TEST(ErrorMapCli, MaterialsOfOneWaveSpeedAreRunOnceUnlessNoSimilarity) {
+  const std::string grid = Temp("similar.toml");
+  std::ofstream(grid) << "[axes]\ndensity = [800.0, 1200.0]\nyoungs_modulus = [10000.0, 15000.0]\n"
+                         "primary_size = [1]\nsecondary_rate = [1000.0]\n";
+  std::vector<std::string> args = {"sweep", "--grid", grid, "--out", Temp("similar.hsmap"),
+                                   "--json"};
+  args.insert(args.end(), kScene.begin(), kScene.end());
+  const nlohmann::json shared = Json(Hapticsim(args));
+  args.push_back("--no-similarity");
+  const nlohmann::json each = Json(Hapticsim(args));
+  EXPECT_EQ(shared["samples"], 4);
+  EXPECT_EQ(shared["saved"]["similarity_trials"], 1);
+  EXPECT_EQ(shared["adaptive_trials"], 3);
+  EXPECT_EQ(shared["reference_trials"], 3);
+  EXPECT_EQ(each["saved"]["similarity_trials"], 0);
+  EXPECT_EQ(each["adaptive_trials"], 4);
+  EXPECT_EQ(each["ok"], shared["ok"]);
+}
+
 TEST(ErrorMapCli, ExportWritesOneCsvRowPerSampleWithUnitsInTheHeader) {
   FullSweep();
   const std::string csv = Temp("full.csv");

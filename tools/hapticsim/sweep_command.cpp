@@ -29,6 +29,7 @@ struct SweepCommandOptions {
   bool resume = false;
   std::string shard = "1/1";
   bool no_linearity = false;
+  bool no_similarity = false;
 };
 
 std::pair<int, int> ParseShard(const std::string& text) {
@@ -54,6 +55,7 @@ nlohmann::json StatsJson(const SweepStats& s, const ErrorMap& map) {
           {"stability_estimates", s.stability_estimates},
           {"saved",
            {{"reference_reuse_trials", s.saved_by_reference_reuse},
+            {"similarity_trials", s.saved_by_similarity},
             {"linearity_trials", s.saved_by_linearity},
             {"same_regions_trials", s.saved_by_same_regions},
             {"predicted_unstable_trials", s.saved_by_prediction}}},
@@ -74,6 +76,7 @@ int Run(const SweepCommandOptions& o) {
   options.shard_index = shard_index;
   options.shard_count = shard_count;
   options.use_linearity = !o.no_linearity;
+  options.use_similarity = !o.no_similarity;
   options.journal_path = o.out + ".journal";
   options.resume = o.resume;
   options.stop = &g_stop;
@@ -122,6 +125,7 @@ int Run(const SweepCommandOptions& o) {
                                       : "")
             << "\n"
             << "  runs saved: " << stats.saved_by_reference_reuse << " references (reuse), "
+            << stats.saved_by_similarity << " adaptive (materials of equal E/ρ, ν, d), "
             << stats.saved_by_linearity << " adaptive (linearity in amplitude), "
             << stats.saved_by_same_regions << " adaptive (sizes giving the same regions), "
             << stats.saved_by_prediction << " adaptive (predicted unstable)\n"
@@ -164,6 +168,9 @@ Command AddSweepCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_flag("--no-linearity", o->no_linearity,
                 "Run every amplitude instead of deriving the amplitude axis from linearity");
+  app->add_flag("--no-similarity", o->no_similarity,
+                "Run every material instead of deriving a material of the same E/ρ, ν and d as "
+                "an earlier one from it (its forces scaled by the density ratio)");
   return {app, [o] { return Run(*o); }};
 }
 

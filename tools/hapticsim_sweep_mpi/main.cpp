@@ -28,6 +28,7 @@ struct Options {
   int jobs = 1;
   std::string out = "error-map.hsmap";
   bool no_linearity = false;
+  bool no_similarity = false;
 };
 
 int Sweep(const Options& o, int rank, int size) {
@@ -39,6 +40,7 @@ int Sweep(const Options& o, int rank, int size) {
   options.shard_index = rank;
   options.shard_count = size;
   options.use_linearity = !o.no_linearity;
+  options.use_similarity = !o.no_similarity;
   const std::string shard_path =
       o.out + ".rank" + std::to_string(rank) + "of" + std::to_string(size);
   if (rank == 0) {
@@ -89,6 +91,7 @@ int main(int argc, char** argv) {
   app.add_option("--jobs,-j", o.jobs, "Worker threads per rank")->capture_default_str();
   app.add_option("--out,-o", o.out, "Merged map to write")->capture_default_str();
   app.add_flag("--no-linearity", o.no_linearity, "Run every amplitude");
+  app.add_flag("--no-similarity", o.no_similarity, "Run every material (equal E/ρ, ν, d too)");
   int status = 0;
   try {
     app.parse(argc, argv);
