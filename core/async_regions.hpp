@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/boundary_channel.hpp"
@@ -27,6 +28,7 @@ struct CoupledStability {
   double spectral_radius = 0;  ///< per common period; < 1 decays, > 1 grows
   double common_period_s = 0;  ///< the shortest time after which every region's schedule repeats
   int periods = 0;             ///< periods of power iteration used
+  int windows = 0;             ///< windows after the burn-in (more while the growth still rose)
   bool stable = false;         ///< spectral_radius < kStableBelow
   /** Margin below 1 that counts as stable: a mode decaying slower than this is refused. */
   static constexpr double kStableBelow = 1.0 - 1e-6;
@@ -151,8 +153,17 @@ class AsyncRegions {
   /** The region whose state is largest (or non-finite): where a divergence grew. */
   RegionIndex LargestStateRegion() const;
 
-  /** Spectral radius of the one-common-period map by power iteration from a random state. */
-  CoupledStability EstimateCoupledStability(int burn_in_periods = 600, int window_periods = 300);
+  /**
+   * Spectral radius of the one-common-period map by power iteration from a random state: after
+   * `burn_in_periods`, the growth per period averaged over windows of `window_periods`, window
+   * after window while it still rises (by more than kStillRising of its distance from neutral,
+   * up to `max_windows`); the radius is the largest window's. One window (max_windows = 1) is a
+   * plain fixed-length iteration.
+   */
+  CoupledStability EstimateCoupledStability(int burn_in_periods = 600, int window_periods = 300,
+                                            int max_windows = 8);
+  /** A window growing faster than the one before by this fraction of |log growth| is rising. */
+  static constexpr double kStillRising = 0.1;
 
   /**
    * Free decay from a random state (no input): the coupled energy at the start and after every
@@ -176,6 +187,15 @@ class AsyncRegions {
   void AdvancePrimaryTo(std::int64_t ticks) noexcept;
   void ScaleAll(double factor);
   double StateNorm() const;
+  /**
+   * √ of the energy central difference conserves along a mode, ½ Σ m v² + ½ u_{n−1}ᵀ K u_n, summed
+   * over the regions: unlike the Euclidean norm of (u_n, u_{n−1}), it does not swing with an
+   * oscillating mode's phase, so growth measured in it is the modulus alone.
+   */
+  double OrbitNorm() noexcept;
+  /** EstimateCoupledStability in one norm; nullopt when the orbit norm is not positive. */
+  std::optional<CoupledStability> PowerIterate(int burn_in_periods, int window_periods,
+                                               int max_windows, bool orbit_norm);
 
   RegionPartition partition_;
   Coupling coupling_;
