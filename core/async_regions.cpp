@@ -454,6 +454,7 @@ double AsyncRegions::OrbitNorm() noexcept {
     }
     for (int i : region->dofs->outer_interface) twice += up[i] * ku[i];
   }
+  if (!std::isfinite(twice)) return twice;  // grown past doubles: for the caller to see
   return std::sqrt(std::max(0.0, 0.5 * twice));
 }
 
@@ -466,24 +467,30 @@ void AsyncRegions::ScaleAll(double factor) {
 }
 
 CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int window_periods,
-                                                        int max_windows) {
+                                                        int max_windows, unsigned seed) {
   // Growth is measured in the orbit norm: the Euclidean norm swings with each oscillating mode's
   // phase, which made a window's growth wrong by up to ±0.004 per period (a configuration whose
   // windows all grow in the orbit norm had one that decayed, and the reverse; docs/regions.md).
   // Where that energy is indefinite — a region past its own step limit, which production
   // substeps never allow — the Euclidean norm is the one left.
+  HAPTICSIM_THROW_UNLESS(
+      window_periods >= 1 && burn_in_periods >= window_periods && max_windows >= 1,
+      "the stability estimate needs window_periods ≥ 1, burn_in_periods ≥ "
+      "window_periods and max_windows ≥ 1");
   std::optional<CoupledStability> estimate =
-      PowerIterate(burn_in_periods, window_periods, max_windows, true);
-  if (!estimate) estimate = PowerIterate(burn_in_periods, window_periods, max_windows, false);
+      PowerIterate(burn_in_periods, window_periods, max_windows, true, seed);
+  if (!estimate) estimate = PowerIterate(burn_in_periods, window_periods, max_windows, false, seed);
   return *estimate;
 }
 
 std::optional<CoupledStability> AsyncRegions::PowerIterate(int burn_in_periods, int window_periods,
-                                                           int max_windows, bool orbit_norm) {
+                                                           int max_windows, bool orbit_norm,
+                                                           unsigned seed) {
   auto norm = [&] { return orbit_norm ? OrbitNorm() : StateNorm(); };
   CoupledStability out;
   out.common_period_s = static_cast<double>(common_period_ticks_) / ticks_per_second_;
-  SetRandomState(7);
+  out.orbit_norm = orbit_norm;
+  SetRandomState(seed);
   const double start = norm();
   if (!(start > 0)) {
     Reset();

@@ -29,6 +29,7 @@ struct CoupledStability {
   double common_period_s = 0;  ///< the shortest time after which every region's schedule repeats
   int periods = 0;             ///< periods of power iteration used
   int windows = 0;             ///< windows after the burn-in (more while the growth still rose)
+  bool orbit_norm = true;      ///< false: the orbit energy was indefinite, the Euclidean norm used
   bool stable = false;         ///< spectral_radius < kStableBelow
   /** Margin below 1 that counts as stable: a mode decaying slower than this is refused. */
   static constexpr double kStableBelow = 1.0 - 1e-6;
@@ -158,10 +159,11 @@ class AsyncRegions {
    * `burn_in_periods`, the growth per period averaged over windows of `window_periods`, window
    * after window while it still rises (by more than kStillRising of its distance from neutral,
    * up to `max_windows`); the radius is the largest window's. One window (max_windows = 1) is a
-   * plain fixed-length iteration.
+   * plain fixed-length iteration. `seed`: the random start state.
+   * @throws Error when window_periods < 1, burn_in_periods < window_periods or max_windows < 1.
    */
   CoupledStability EstimateCoupledStability(int burn_in_periods = 600, int window_periods = 300,
-                                            int max_windows = 8);
+                                            int max_windows = 8, unsigned seed = 7);
   /** A window growing faster than the one before by this fraction of |log growth| is rising. */
   static constexpr double kStillRising = 0.1;
 
@@ -195,7 +197,7 @@ class AsyncRegions {
   double OrbitNorm() noexcept;
   /** EstimateCoupledStability in one norm; nullopt when the orbit norm is not positive. */
   std::optional<CoupledStability> PowerIterate(int burn_in_periods, int window_periods,
-                                               int max_windows, bool orbit_norm);
+                                               int max_windows, bool orbit_norm, unsigned seed);
 
   RegionPartition partition_;
   Coupling coupling_;

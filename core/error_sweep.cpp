@@ -68,6 +68,8 @@ struct Run {
 struct Task {
   MapPoint point{};  // material + configuration (+ the first run's input)
   std::vector<Run> runs;
+  // Adaptive runs this task's runs stand for but not make, by saving (a shard sums its own).
+  std::size_t saved_by_similarity = 0, saved_by_linearity = 0, saved_by_same_regions = 0;
 };
 
 // Identifies the regions a configuration produces: per region its element and node counts.
@@ -106,6 +108,7 @@ GridMaterials MaterialsOf(const std::array<std::vector<double>, kNumMapAxes>& ax
     if (!similar) continue;
     const double wave_speed_squared = ax[e][index[e]] / ax[rho][index[rho]];
     for (size_t earlier = 0; earlier < m; ++earlier) {
+      if (out.run_as[earlier] != earlier) continue;  // only a material that is run answers
       const std::array<int, 4>& o = out.index[earlier];
       if (o[nu] == index[nu] && o[d] == index[d] &&
           std::abs(ax[e][o[e]] / ax[rho][o[rho]] - wave_speed_squared) <=
@@ -118,8 +121,7 @@ GridMaterials MaterialsOf(const std::array<std::vector<double>, kNumMapAxes>& ax
   return out;
 }
 
-std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linear, bool similar,
-                            SweepStats* stats) {
+std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linear, bool similar) {
   const auto& ax = grid.axes;
   const ErrorMap layout = ErrorMap::MakeGrid(ax);
   const int lod_axis = Axis(MapAxis::kSecondaryLod), size_axis = Axis(MapAxis::kPrimarySize);
@@ -230,10 +232,10 @@ std::vector<Task> GridTasks(const Scene& base, const SweepGrid& grid, bool linea
                   }
                 }
                 // Counted in this order: similarity, then linearity, then same regions.
-                stats->saved_by_similarity +=
+                task.saved_by_similarity +=
                     (answered.size() - 1) * (linear ? amps : 1) * group.size();
-                stats->saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
-                stats->saved_by_same_regions += group.size() - 1;
+                task.saved_by_linearity += linear ? (amps - 1) * group.size() : 0;
+                task.saved_by_same_regions += group.size() - 1;
                 task.runs.push_back(std::move(run));
               }
             }
@@ -420,22 +422,20 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   for (const MapSample& s : map.samples) SceneAtPoint(base, s.point);  // validates every point
 
   std::vector<Task> all_tasks =
-      grid.scattered ? ScatteredTasks(grid)
-                     : GridTasks(base, grid, linear,
-                                 options.use_similarity && model.similar_in_density, &stats);
+      grid.scattered
+          ? ScatteredTasks(grid)
+          : GridTasks(base, grid, linear, options.use_similarity && model.similar_in_density);
   std::vector<std::size_t> mine;  // task numbers of this shard
   for (std::size_t t = options.shard_index; t < all_tasks.size(); t += options.shard_count) {
     mine.push_back(t);
   }
   stats.tasks = mine.size();
-  for (std::size_t t : mine) {
-    for (const Run& run : all_tasks[t].runs) stats.samples += run.targets.size();
-  }
-  if (options.shard_count > 1) {  // savings are counted for this shard's share only
-    const double share = static_cast<double>(mine.size()) / all_tasks.size();
-    stats.saved_by_similarity = std::lround(stats.saved_by_similarity * share);
-    stats.saved_by_linearity = std::lround(stats.saved_by_linearity * share);
-    stats.saved_by_same_regions = std::lround(stats.saved_by_same_regions * share);
+  for (std::size_t t : mine) {  // savings are counted for this shard's tasks only
+    const Task& task = all_tasks[t];
+    for (const Run& run : task.runs) stats.samples += run.targets.size();
+    stats.saved_by_similarity += task.saved_by_similarity;
+    stats.saved_by_linearity += task.saved_by_linearity;
+    stats.saved_by_same_regions += task.saved_by_same_regions;
   }
 
   const std::string fingerprint = Fingerprint(map, grid, options);

@@ -24,7 +24,9 @@
 #include <filesystem>
 #include <future>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <set>
 #include <thread>
 
 #include "core/error.hpp"
@@ -234,6 +236,7 @@ int Serve(const Arguments& args) {
   std::future<SupervisorDecision> choice;         // a new choice being computed
   std::optional<RegionConfiguration> choice_pin;  // the pin that choice was asked with
   std::optional<SupervisorDecision> pending;      // chosen, waiting for the tool to be away
+  bool choice_for_overload = false;               // the running choice is for deadlines
   // The scene as the regions run it: centred on the node the tool last touched. A choice is made
   // for that node — its error looked up there, its stability estimated around it.
   auto scene_at_centre = [&] {
@@ -241,14 +244,30 @@ int Serve(const Arguments& args) {
     scene.input.contact_node = loop.centre_node();
     return scene;
   };
-  LatticeIndex chosen_for_node = ContactNode(config.scene);  // the node the last choice was for
-  auto choose_again = [&](const std::optional<RegionConfiguration>& pin) {
+  // The nodes a choice was made for since the target, the map or the pin last changed: around
+  // each, the supervisor chooses once. The cost ceiling an overload set holds as long (deadlines
+  // before accuracy: a choice for a node does not bring the dear configuration back).
+  std::set<LatticeIndex> chosen_for_nodes{ContactNode(config.scene)};
+  double cost_ceiling = std::numeric_limits<double>::infinity();
+  // Choices replaced while still running: their futures are kept until they finish, since
+  // destroying a running std::async future waits for it (the tick must not).
+  std::vector<std::future<SupervisorDecision>> abandoned;
+  auto start_choice = [&](const std::optional<RegionConfiguration>& pin) {
     // Stability estimates take up to seconds: off the supervisor's tick.
+    if (choice.valid()) abandoned.push_back(std::move(choice));
     choice_pin = pin;
-    chosen_for_node = loop.centre_node();
-    choice = std::async(std::launch::async, [scene = scene_at_centre(), m = map.map, target, pin] {
-      return ChooseConfiguration(scene, m.get(), target, pin);
-    });
+    chosen_for_nodes.insert(loop.centre_node());
+    choice = std::async(std::launch::async,
+                        [scene = scene_at_centre(), m = map.map, target, pin, cost_ceiling] {
+                          return ChooseConfiguration(scene, m.get(), target, pin, cost_ceiling);
+                        });
+  };
+  // A new target, map or pin: every node may be chosen for again, at any cost.
+  auto choose_again = [&](const std::optional<RegionConfiguration>& pin) {
+    chosen_for_nodes.clear();
+    cost_ceiling = std::numeric_limits<double>::infinity();
+    choice_for_overload = false;
+    start_choice(pin);
   };
   // The regions run `active` centred on loop.centre_node(): the decision's configuration, or its
   // equal-rate fallback where the decision's is unstable around that node.
@@ -276,6 +295,23 @@ int Serve(const Arguments& args) {
     reported_target_met = decision.have_map && !(flags & force_flags::kErrorTargetExceeded);
     loop.SetErrorState(error, flags);
   };
+  // Around the node the regions moved to, the configuration may miss the target that it met
+  // where it was chosen (a box cut by the object's edge, a coarser neighbourhood): choose again
+  // for that node, once per node. What is chosen switches like any other, once the tool is away.
+  auto choose_for_centre_if_missed = [&] {
+    const LatticeIndex& node = loop.centre_node();
+    if (reported_target_met || !decision.have_map || !map.map || pinned || choice.valid() ||
+        pending || chosen_for_nodes.count(node)) {
+      return;
+    }
+    spdlog::warn(
+        "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the target "
+        "{} %: choosing again for this node",
+        node[0], node[1], node[2], DescribeConfiguration(active),
+        reported_error < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error),
+        target);
+    start_choice(std::nullopt);
+  };
   // Restarts the regions from rest where they are: the tool must lift off before it feels force.
   auto restart_from_rest = [&](const char* why) {
     try {
@@ -293,7 +329,6 @@ int Serve(const Arguments& args) {
   std::int64_t last_overload_line_ns = 0;
   // The cost of a configuration the map has nothing cheaper than: not asked again.
   double cheapest_cost_us_per_ms = -1;
-  bool choice_for_overload = false;
   std::optional<LatticeIndex> hover_node;  // the node the tool hovers over, and since when
   std::int64_t hover_since_ns = 0;
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
@@ -453,7 +488,11 @@ int Serve(const Arguments& args) {
                       e.what());
       }
       choice_for_overload = false;
+      choose_for_centre_if_missed();  // the regions may have moved while it was being made
     }
+    std::erase_if(abandoned, [](const std::future<SupervisorDecision>& f) {
+      return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    });
     // Moving the regions — to the pending configuration, or onto the node the tool touches or
     // hovers over. A new configuration only out of contact, after the object has settled: the
     // force is zero then and the regions restart from rest, so the user feels no step. A touch on
@@ -498,19 +537,7 @@ int Serve(const Arguments& args) {
         match_miss_loggers(now);
         overload.Reset(now);
         report_error();
-        // Around this node the configuration may miss the target that it met where it was
-        // chosen (a box cut by the object's edge, a coarser neighbourhood): choose again for the
-        // node, once per node. What is chosen switches like any other, once the tool is away.
-        if (!reported_target_met && decision.have_map && !pinned && !choice.valid() && !pending &&
-            chosen_for_node != node) {
-          spdlog::warn(
-              "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the "
-              "target {} %: choosing again for this node",
-              node[0], node[1], node[2], DescribeConfiguration(active),
-              reported_error < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error),
-              target);
-          choose_again(std::nullopt);
-        }
+        choose_for_centre_if_missed();
       }
     } catch (const Error& e) {
       spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
@@ -535,12 +562,9 @@ int Serve(const Arguments& args) {
             "each of the 3 before: choosing a configuration cheaper than {} µs per simulated "
             "ms (deadlines before accuracy)",
             name, overload.last_misses(), rates_hz[region], decision.cost_us_per_ms);
-        choice_pin.reset();
+        cost_ceiling = decision.cost_us_per_ms;
         choice_for_overload = true;
-        choice = std::async(std::launch::async, [scene = scene_at_centre(), m = map.map, target,
-                                                 ceiling = decision.cost_us_per_ms] {
-          return ChooseConfiguration(scene, m.get(), target, std::nullopt, ceiling);
-        });
+        start_choice(std::nullopt);
       } else if (now - last_overload_line_ns > 60'000'000'000) {
         last_overload_line_ns = now;
         spdlog::error(

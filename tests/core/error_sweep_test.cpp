@@ -180,15 +180,22 @@ TEST(ErrorSweep, SizesGivingTheSameRegionsAreRunOnceWithTheSameAnswer) {
 }
 
 TEST(ErrorSweep, ShardsMergeIntoTheWholeMap) {
-  const ErrorMap whole = Sweep(SmallGrid());
+  SweepStats whole_stats;
+  const ErrorMap whole = Sweep(SmallGrid(), {}, &whole_stats);
   std::vector<ErrorMap> shards;
+  std::size_t linearity = 0, same_regions = 0;  // what the shards say they saved, summed
   for (int i = 0; i < 3; ++i) {
     SweepOptions options;
     options.shard_index = i;
     options.shard_count = 3;
-    shards.push_back(Sweep(SmallGrid(), options));
+    SweepStats stats;
+    shards.push_back(Sweep(SmallGrid(), options, &stats));
+    linearity += stats.saved_by_linearity;
+    same_regions += stats.saved_by_same_regions;
     EXPECT_GT(shards.back().CountStatus(SampleStatus::kNotComputed), 0u);
   }
+  EXPECT_EQ(linearity, whole_stats.saved_by_linearity);
+  EXPECT_EQ(same_regions, whole_stats.saved_by_same_regions);
   const ErrorMap merged = MergeErrorMaps(shards);
   EXPECT_EQ(merged.CountStatus(SampleStatus::kNotComputed), 0u);
   EXPECT_EQ(merged.ResultsChecksum(), whole.ResultsChecksum());

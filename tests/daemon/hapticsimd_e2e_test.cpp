@@ -55,8 +55,6 @@ void WaitUntilServing(testing::BackgroundProcess& daemon) {
   }
 }
 
-// A two-configuration map for the default scene, made by the real sweep (a few seconds): the
-// primary sizes 1 (cheaper, about 2.7 % error) and 3 (about 0.4 %).
 // A map made by the real sweep over the grid file text `axes`; returns its path.
 std::string SweptMap(const std::string& name, const std::string& axes) {
   const std::string grid = Temp(name + "_grid.toml"), map = Temp(name + ".hsmap");
@@ -67,6 +65,8 @@ std::string SweptMap(const std::string& name, const std::string& axes) {
   return map;
 }
 
+// A two-configuration map for the default scene, made by the real sweep (a few seconds): the
+// primary sizes 1 (cheaper, about 2.7 % error) and 3 (about 0.4 %).
 const std::string& SmallMap() {
   static const std::string path =
       SweptMap("map",

@@ -47,12 +47,13 @@ struct SupervisorCheck {
 };
 
 // Not the supervisor's estimate: one fixed iteration of 3 × its base length (1800 + 900 common
-// periods), no early stop — a slowly growing mode the supervisor's estimate took for decaying
-// shows here as a failure.
+// periods), no early stop, from another random start — a slowly growing mode the supervisor's
+// estimate took for decaying shows here as a failure. (The same orbit norm: the Euclidean one
+// swings by up to ±0.004 per period and would accuse stable configurations.)
 bool IndependentlyStable(const Scene& scene) {
   try {
     AsyncRegions regions(scene);
-    return regions.EstimateCoupledStability(1800, 900, 1).stable;
+    return regions.EstimateCoupledStability(1800, 900, 1, /*seed=*/11).stable;
   } catch (const Error&) {
     return false;
   }
