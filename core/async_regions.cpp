@@ -472,7 +472,8 @@ CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int
   // phase, which made a window's growth wrong by up to ±0.004 per period (a configuration whose
   // windows all grow in the orbit norm had one that decayed, and the reverse; docs/regions.md).
   // Where that energy is indefinite — a region past its own step limit, which production
-  // substeps never allow — the Euclidean norm is the one left.
+  // substeps (0.95 of each region's own limit) are chosen to avoid — the Euclidean norm is the
+  // one left, and the estimate says so (orbit_norm).
   HAPTICSIM_THROW_UNLESS(
       window_periods >= 1 && burn_in_periods >= window_periods && max_windows >= 1,
       "the stability estimate needs window_periods ≥ 1, burn_in_periods ≥ "
@@ -536,7 +537,6 @@ std::optional<CoupledStability> AsyncRegions::PowerIterate(int burn_in_periods, 
     if (unstable || !rising || windows >= max_windows) break;
     previous_growth = growth;
   }
-  out.windows = windows;
   out.spectral_radius = std::exp(worst_growth);
   out.stable = out.spectral_radius < CoupledStability::kStableBelow;
   Reset();

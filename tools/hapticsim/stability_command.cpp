@@ -25,6 +25,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     out["coupled_spectral_radius"] = coupled.spectral_radius;
     out["common_period_s"] = coupled.common_period_s;
     out["power_iteration_periods"] = coupled.periods;
+    out["power_iteration_norm"] = coupled.orbit_norm ? "orbit" : "euclidean";
     for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
       const RegionSchedule& s = regions.schedule(r);
       out["regions"].push_back({{"name", p.RegionName(r)},
@@ -47,8 +48,11 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     }
     std::cout << "  coupled: spectral radius of the " << Duration(coupled.common_period_s)
               << " period map " << Quantity(coupled.spectral_radius, "") << "(" << coupled.periods
-              << " periods of power iteration): "
-              << (coupled.stable ? "stable" : "UNSTABLE — this configuration is refused") << "\n";
+              << " periods of power iteration, "
+              << (coupled.orbit_norm ? "orbit norm"
+                                     : "Euclidean norm: the orbit energy is indefinite")
+              << "): " << (coupled.stable ? "stable" : "UNSTABLE — this configuration is refused")
+              << "\n";
   }
   return kExitOk;
 }
