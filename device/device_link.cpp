@@ -61,6 +61,10 @@ class LcmLink final : public DeviceLink {
     std::lock_guard lock(mutex_);
     return status_;
   }
+  std::vector<RegionExecution> Execution() const override {
+    std::lock_guard lock(mutex_);
+    return execution_.Summary();
+  }
   std::string name() const override { return "lcm"; }
 
  private:
@@ -78,6 +82,7 @@ class LcmLink final : public DeviceLink {
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t* s) {
     std::lock_guard lock(mutex_);
     status_ = *s;
+    execution_.Add(*s);
   }
 
   lcm::LCM lcm_;
@@ -88,6 +93,7 @@ class LcmLink final : public DeviceLink {
   mutable std::mutex mutex_;
   std::vector<Answer> pending_;
   std::optional<status_t> status_;
+  ExecutionHistory execution_;
 };
 
 class ShmLink final : public DeviceLink {

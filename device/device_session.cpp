@@ -202,6 +202,9 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
   report.latency = Summarise(latencies_us);
   report.status =
       link.LastStatus() ? link.LastStatus() : (monitor ? monitor->LastStatus() : std::nullopt);
+  report.execution = link.LastStatus() ? link.Execution()
+                     : monitor         ? monitor->Execution()
+                                       : std::vector<RegionExecution>{};
   report.duration_s = settings.duration_s;
   return report;
 }

@@ -101,6 +101,18 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
         {"contact_node",
          {r.status->contact_node[0], r.status->contact_node[1], r.status->contact_node[2]}},
         {"regions", regions}};
+    nlohmann::json execution = nlohmann::json::array();
+    for (const device::RegionExecution& e : r.execution) {
+      execution.push_back({{"region", e.region},
+                           {"rate_hz", e.rate_hz},
+                           {"status_intervals", e.intervals},
+                           {"p50_median_us", e.p50_median_us},
+                           {"p50_period_share", e.p50_period_share()},
+                           {"p99_median_us", e.p99_median_us},
+                           {"p99_worst_us", e.p99_worst_us},
+                           {"max_us", e.max_us}});
+    }
+    out["daemon"]["execution"] = execution;
   }
   nlohmann::json seconds = nlohmann::json::array();
   for (const device::SecondSummary& s : r.seconds) {
@@ -151,6 +163,13 @@ std::string ReportText(const device::SessionReport& r) {
       add("  daemon %-19s %lld deadline misses in %lld periods, worst lateness %.0f µs",
           (region.name + " thread").c_str(), static_cast<long long>(region.deadline_misses),
           static_cast<long long>(region.cycles), region.worst_lateness_us);
+    }
+    for (const device::RegionExecution& e : r.execution) {
+      add("  daemon %-19s median %.0f µs (%.1f %% of its %.2f ms period), p99 %.0f µs "
+          "(worst interval %.0f µs), longest %.0f µs; over %lld status intervals",
+          (e.region + " step").c_str(), e.p50_median_us, 100 * e.p50_period_share(),
+          1e3 / e.rate_hz, e.p99_median_us, e.p99_worst_us, e.max_us,
+          static_cast<long long>(e.intervals));
     }
   }
   return text.str();

@@ -1,0 +1,49 @@
+#include "device/execution_history.hpp"
+
+#include <algorithm>
+
+namespace hapticsim::device {
+namespace {
+
+// The upper median: one of the values, as the daemon's own percentiles are.
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+void ExecutionHistory::Add(const status_t& status) {
+  for (const region_status_t& region : status.regions) {
+    // A thread asleep at rest (or not started) has no steps in the interval: median 0.
+    if (!(region.execution_p50_us > 0)) continue;
+    auto [at, inserted] = samples_.try_emplace(region.name);
+    if (inserted) order_.push_back(region.name);
+    Samples& s = at->second;
+    s.rate_hz = region.rate_hz;
+    s.p50_us.push_back(region.execution_p50_us);
+    s.p99_us.push_back(region.execution_p99_us);
+    s.max_us = std::max(s.max_us, region.execution_max_us);
+  }
+}
+
+std::vector<RegionExecution> ExecutionHistory::Summary() const {
+  std::vector<RegionExecution> out;
+  for (const std::string& name : order_) {
+    const Samples& s = samples_.at(name);
+    RegionExecution r;
+    r.region = name;
+    r.rate_hz = s.rate_hz;
+    r.intervals = static_cast<std::int64_t>(s.p50_us.size());
+    r.p50_median_us = Median(s.p50_us);
+    r.p99_median_us = Median(s.p99_us);
+    r.p99_worst_us = *std::max_element(s.p99_us.begin(), s.p99_us.end());
+    r.max_us = s.max_us;
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace hapticsim::device
