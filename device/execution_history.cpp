@@ -5,10 +5,10 @@
 namespace hapticsim::device {
 namespace {
 
-// The upper median: one of the values, as the daemon's own percentiles are.
+// The lower median — the value of rank ceil(n/2), as the daemon ranks its own percentiles.
 double Median(std::vector<double> values) {
   if (values.empty()) return 0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>((values.size() - 1) / 2);
   std::nth_element(values.begin(), middle, values.end());
   return *middle;
 }
@@ -16,14 +16,18 @@ double Median(std::vector<double> values) {
 }  // namespace
 
 void ExecutionHistory::Add(const status_t& status) {
+  // Asleep, the primary still answers every input but steps nothing: its periods then say
+  // nothing about what a step costs.
+  if (status.asleep) return;
   for (const region_status_t& region : status.regions) {
-    // A thread asleep at rest (or not started) has no steps in the interval: median 0.
+    // A thread that did not run in the interval (parked, not started): median 0.
     if (!(region.execution_p50_us > 0)) continue;
     auto [at, inserted] = samples_.try_emplace(region.name);
     if (inserted) order_.push_back(region.name);
     Samples& s = at->second;
     s.rate_hz = region.rate_hz;
     s.p50_us.push_back(region.execution_p50_us);
+    s.p50_share.push_back(region.execution_p50_us * 1e-6 * region.rate_hz);
     s.p99_us.push_back(region.execution_p99_us);
     s.max_us = std::max(s.max_us, region.execution_max_us);
   }
@@ -38,8 +42,9 @@ std::vector<RegionExecution> ExecutionHistory::Summary() const {
     r.rate_hz = s.rate_hz;
     r.intervals = static_cast<std::int64_t>(s.p50_us.size());
     r.p50_median_us = Median(s.p50_us);
-    r.p99_median_us = Median(s.p99_us);
-    r.p99_worst_us = *std::max_element(s.p99_us.begin(), s.p99_us.end());
+    r.p50_period_share = Median(s.p50_share);
+    r.p99_interval_median_us = Median(s.p99_us);
+    r.p99_interval_worst_us = *std::max_element(s.p99_us.begin(), s.p99_us.end());
     r.max_us = s.max_us;
     out.push_back(r);
   }

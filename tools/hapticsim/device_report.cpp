@@ -107,9 +107,9 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
                            {"rate_hz", e.rate_hz},
                            {"status_intervals", e.intervals},
                            {"p50_median_us", e.p50_median_us},
-                           {"p50_period_share", e.p50_period_share()},
-                           {"p99_median_us", e.p99_median_us},
-                           {"p99_worst_us", e.p99_worst_us},
+                           {"p50_period_share", e.p50_period_share},
+                           {"p99_interval_median_us", e.p99_interval_median_us},
+                           {"p99_interval_worst_us", e.p99_interval_worst_us},
                            {"max_us", e.max_us}});
     }
     out["daemon"]["execution"] = execution;
@@ -165,10 +165,10 @@ std::string ReportText(const device::SessionReport& r) {
           static_cast<long long>(region.cycles), region.worst_lateness_us);
     }
     for (const device::RegionExecution& e : r.execution) {
-      add("  daemon %-19s median %.0f µs (%.1f %% of its %.2f ms period), p99 %.0f µs "
-          "(worst interval %.0f µs), longest %.0f µs; over %lld status intervals",
-          (e.region + " step").c_str(), e.p50_median_us, 100 * e.p50_period_share(),
-          1e3 / e.rate_hz, e.p99_median_us, e.p99_worst_us, e.max_us,
+      add("  daemon %-19s median %.0f µs (%.1f %% of its %.2f ms period), interval p99 median "
+          "%.0f µs, worst %.0f µs; longest %.0f µs; %lld status intervals",
+          (e.region + " step").c_str(), e.p50_median_us, 100 * e.p50_period_share, 1e3 / e.rate_hz,
+          e.p99_interval_median_us, e.p99_interval_worst_us, e.max_us,
           static_cast<long long>(e.intervals));
     }
   }
