@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -22,14 +23,24 @@ using Setter = std::function<void(DaemonConfig*, const toml::node&, const std::s
 template <typename T>
 T Get(const toml::node& node, const std::string& key, const std::string& where, const char* type) {
   // A flag must be true or false as written: toml++'s value<bool>() would take 3 or 0 as well.
+  // A whole number must be written as one: value<int64_t>() would cast a float, and one beyond
+  // the range of int64 (1e103) is undefined behaviour.
   std::optional<T> value;
-  if constexpr (std::is_same_v<T, bool>) {
-    value = node.value_exact<bool>();
+  if constexpr (std::is_same_v<T, bool> || std::is_integral_v<T>) {
+    value = node.value_exact<T>();
   } else {
     value = node.value<T>();
   }
   if (!value) throw Error(where + ": " + key + " must be " + type);
   return *value;
+}
+
+// A whole number for an int field: one beyond int's range becomes -1, which every such field's
+// validation refuses, instead of wrapping round into its range (2³² + 10 would read as 10).
+int SmallInt(std::int64_t value) {
+  return value >= std::numeric_limits<int>::min() && value <= std::numeric_limits<int>::max()
+             ? static_cast<int>(value)
+             : -1;
 }
 
 const std::map<std::string, Setter>& Setters() {
@@ -70,7 +81,7 @@ const std::map<std::string, Setter>& Setters() {
     real("input.max_force_n", &DaemonConfig::max_force_n);
     s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
       c->fifo_priority =
-          static_cast<int>(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
+          SmallInt(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
     };
     s["realtime.cpus"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
       const toml::array* list = n.as_array();
@@ -78,7 +89,7 @@ const std::map<std::string, Setter>& Setters() {
       c->cpus.clear();
       for (const toml::node& cpu : *list) {
         c->cpus.push_back(
-            static_cast<int>(Get<std::int64_t>(cpu, "realtime.cpus", where, "whole numbers")));
+            SmallInt(Get<std::int64_t>(cpu, "realtime.cpus", where, "whole numbers")));
       }
     };
     flag("realtime.lock_memory", &DaemonConfig::lock_memory);

@@ -114,6 +114,20 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
                 .find("realtime.sleep_at_rest must be true or false"),
             std::string::npos)
       << ConfigError("[realtime]\nsleep_at_rest = 3\n");
+  // Whole numbers as written: no float cast (1e103 does not fit an int64: found by fuzzing), no
+  // wrapping round into range.
+  for (const char* priority : {"4.4e103", "10.0"}) {
+    const std::string text = std::string("[realtime]\nfifo_priority = ") + priority + "\n";
+    EXPECT_NE(ConfigError(text).find("realtime.fifo_priority must be a whole number"),
+              std::string::npos)
+        << ConfigError(text);
+  }
+  EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 4294967306\n")
+                .find("realtime.fifo_priority must be from 0 (off) to 99"),
+            std::string::npos)
+      << ConfigError("[realtime]\nfifo_priority = 4294967306\n");
+  EXPECT_NE(ConfigError("[realtime]\ncpus = [4294967297]\n").find("realtime.cpus"),
+            std::string::npos);
   EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find("hapticsimd_config_test.toml:1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
 }
