@@ -39,7 +39,7 @@ class DeviceLink {
   virtual bool needs_polling() const = 0;
   /** The daemon's newest status, where the link carries it (LCM). */
   virtual std::optional<status_t> LastStatus() const { return std::nullopt; }
-  /** The daemon threads' step compute times over every status received so far (LCM). */
+  /** The daemon threads' compute time per period over every status received so far (LCM). */
   virtual std::vector<RegionExecution> Execution() const { return {}; }
   virtual std::string name() const = 0;
 };

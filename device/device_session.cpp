@@ -38,6 +38,12 @@ class StreamCounter {
   StreamSummary summary_;
 };
 
+// The link the daemon's status comes in on: the device's own where it carries status (LCM),
+// else the listening LCM monitor, if any.
+const DeviceLink* StatusLink(const DeviceLink& link, const DeviceLink* monitor) {
+  return link.LastStatus() ? &link : monitor;
+}
+
 }  // namespace
 
 LatencySummary Summarise(std::vector<double>& values_us) {
@@ -183,8 +189,8 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
       ++next_second;
       report.stream = stream.summary();
       report.latency.count = static_cast<std::int64_t>(latencies_us.size());
-      report.status =
-          link.LastStatus() ? link.LastStatus() : (monitor ? monitor->LastStatus() : std::nullopt);
+      const DeviceLink* status_link = StatusLink(link, monitor);
+      report.status = status_link ? status_link->LastStatus() : std::nullopt;
       if (each_second) each_second(report);
     }
   }
@@ -200,11 +206,10 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
   report.stream = stream.summary();
   if (monitor) report.monitor = watched.summary();
   report.latency = Summarise(latencies_us);
-  report.status =
-      link.LastStatus() ? link.LastStatus() : (monitor ? monitor->LastStatus() : std::nullopt);
-  report.execution = link.LastStatus() ? link.Execution()
-                     : monitor         ? monitor->Execution()
-                                       : std::vector<RegionExecution>{};
+  if (const DeviceLink* status_link = StatusLink(link, monitor)) {
+    report.status = status_link->LastStatus();
+    report.execution = status_link->Execution();
+  }
   report.duration_s = settings.duration_s;
   return report;
 }

@@ -55,7 +55,7 @@ struct SessionReport {
   std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
   std::int64_t answers_after_last_burst = 0;
   std::optional<status_t> status;          ///< the daemon's last status (LCM)
-  std::vector<RegionExecution> execution;  ///< its threads' step times over the session (LCM)
+  std::vector<RegionExecution> execution;  ///< its threads' compute per period, session (LCM)
   std::vector<SecondSummary> seconds;
   double duration_s = 0;
 };

@@ -22,9 +22,10 @@ void ExecutionHistory::Add(const status_t& status) {
   for (const region_status_t& region : status.regions) {
     // A thread that did not run in the interval (parked, not started): median 0.
     if (!(region.execution_p50_us > 0)) continue;
-    auto [at, inserted] = samples_.try_emplace(region.name);
-    if (inserted) order_.push_back(region.name);
-    Samples& s = at->second;
+    auto at = std::find_if(regions_.begin(), regions_.end(),
+                           [&](const Samples& s) { return s.region == region.name; });
+    if (at == regions_.end()) at = regions_.insert(at, Samples{region.name});
+    Samples& s = *at;
     s.rate_hz = region.rate_hz;
     s.p50_us.push_back(region.execution_p50_us);
     s.p50_share.push_back(region.execution_p50_us * 1e-6 * region.rate_hz);
@@ -35,10 +36,9 @@ void ExecutionHistory::Add(const status_t& status) {
 
 std::vector<RegionExecution> ExecutionHistory::Summary() const {
   std::vector<RegionExecution> out;
-  for (const std::string& name : order_) {
-    const Samples& s = samples_.at(name);
+  for (const Samples& s : regions_) {
     RegionExecution r;
-    r.region = name;
+    r.region = s.region;
     r.rate_hz = s.rate_hz;
     r.intervals = static_cast<std::int64_t>(s.p50_us.size());
     r.p50_median_us = Median(s.p50_us);

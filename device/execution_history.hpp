@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -40,12 +39,12 @@ class ExecutionHistory {
 
  private:
   struct Samples {
+    std::string region;
     double rate_hz = 0;
     std::vector<double> p50_us, p50_share, p99_us;
     double max_us = 0;
   };
-  std::vector<std::string> order_;
-  std::map<std::string, Samples> samples_;
+  std::vector<Samples> regions_;  // in the order first seen (a handful: a linear search)
 };
 
 }  // namespace hapticsim::device
