@@ -36,6 +36,8 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
                                                std::int64_t now_ns,
                                                const std::optional<LatticeIndex>& centre) noexcept {
   tip_ = tip_m;
+  const bool after_gap = held_;
+  held_ = false;
   const double edge = mesh_.edge_m;
   bool inside = true;
   for (double x : tip_m) inside = inside && x > 0 && x < edge;
@@ -58,11 +60,16 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     }
     entry_ = tip_m;
     entry_[axis] = face;
+    inward_ = {0, 0, 0};
+    inward_[axis] = face == 0 ? 1.0 : -1.0;
     node_ = NearestContactNode(entry_);
     wanted_ = node_;
     const bool centred = centre && *centre == node_;
     state_ = centred ? State::kEngaged : State::kWaiting;
-    late_ = false;
+    ramping_ = false;
+    if (centred && depth > kDeepTouchDown_m) StartRamp({0, 0, 0}, now_ns);
+  } else if (after_gap && state_ == State::kEngaged) {
+    StartRamp(displacement_, now_ns);  // input back after a gap: from where the node was held
   }
   return Advance(now_ns, centre);
 }
@@ -70,7 +77,14 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
 ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
                                              const std::optional<LatticeIndex>& centre) noexcept {
   if (state_ == State::kFree || state_ == State::kAwaitLiftOff) return {};
+  held_ = state_ == State::kEngaged;
   return Advance(now_ns, centre);
+}
+
+void ContactTracker::StartRamp(const std::array<double, 3>& from_m, std::int64_t now_ns) noexcept {
+  ramping_ = true;
+  ramp_from_ = from_m;
+  ramp_start_ns_ = now_ns;
 }
 
 ContactTracker::Contact ContactTracker::Advance(
@@ -78,8 +92,7 @@ ContactTracker::Contact ContactTracker::Advance(
   if (state_ == State::kWaiting && centre && *centre == node_) {
     // Engage late: the tip went on while the regions moved; ramp its depth in from zero.
     state_ = State::kEngaged;
-    late_ = true;
-    ramp_start_ns_ = now_ns;
+    StartRamp({0, 0, 0}, now_ns);
   }
   Contact contact;
   if (state_ == State::kWaiting) {
@@ -87,23 +100,37 @@ ContactTracker::Contact ContactTracker::Advance(
     return contact;
   }
   contact.engaged = true;
-  // A late engagement scales the displacement by a smoothstep 3τ² − 2τ³ over the ramp: it starts
-  // at zero with zero velocity and ends with the tip's own, so neither the node's velocity nor
-  // its position jumps (a velocity jump is an acceleration spike, and the node's inertia would
-  // send it to the user as a force spike).
+  contact.inward_normal = inward_;
+  if (held_) {  // no fresh tip: the node stays where it was
+    contact.displacement_m = displacement_;
+    return contact;
+  }
+  // A ramp blends from its start displacement to the tip's by a smoothstep 3τ² − 2τ³: it starts
+  // where the node was with zero velocity and ends with the tip's own, so neither the node's
+  // velocity nor its position jumps (a velocity jump is an acceleration spike, and the node's
+  // inertia would send it to the user as a force spike).
   double weight = 1;
-  if (late_ && ramp_ns_ > 0) {
+  if (ramping_ && ramp_ns_ > 0) {
     const double tau = std::min(1.0, static_cast<double>(now_ns - ramp_start_ns_) / ramp_ns_);
     weight = tau * tau * (3 - 2 * tau);
+    if (tau >= 1) ramping_ = false;
   }
-  for (int c = 0; c < 3; ++c) contact.displacement_m[c] = weight * (tip_[c] - entry_[c]);
+  for (int c = 0; c < 3; ++c) {
+    contact.displacement_m[c] = ramp_from_[c] + weight * (tip_[c] - entry_[c] - ramp_from_[c]);
+  }
+  if (!ramping_) ramp_from_ = {0, 0, 0};
+  displacement_ = contact.displacement_m;
   return contact;
 }
 
-void ContactTracker::RestartFromRest() noexcept { state_ = State::kAwaitLiftOff; }
+void ContactTracker::RestartFromRest() noexcept {
+  state_ = State::kAwaitLiftOff;
+  held_ = false;
+}
 
 void ContactTracker::RestartKeepingContact() noexcept {
   if (state_ == State::kEngaged) state_ = State::kWaiting;
+  held_ = false;
 }
 
 }  // namespace hapticsim

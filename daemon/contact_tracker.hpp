@@ -26,6 +26,11 @@ namespace hapticsim {
  *
  * After a restart from rest (a reset or a fault) a tip already inside renders nothing until it has
  * left the object once: engaging it at once would step the contact from rest to its depth.
+ *
+ * Every other way into contact that would step the node ramps too, over the same smoothstep:
+ * a touch-down found deeper than kDeepTouchDown_m (a session that begins inside the object, or a
+ * tip that jumped in) ramps from zero, and fresh input after a stale gap (Hold) ramps from the
+ * held displacement to the tip's.
  */
 class ContactTracker {
  public:
@@ -36,6 +41,7 @@ class ContactTracker {
     bool engaged = false;  ///< the contact node is driven: render its reaction
     bool waiting = false;  ///< the tip is inside, on a node the regions are not centred on
     std::array<double, 3> displacement_m{};  ///< of the contact node (zero unless engaged)
+    std::array<double, 3> inward_normal{};   ///< the entry face's, into the object (0: none)
   };
 
   /**
@@ -60,12 +66,19 @@ class ContactTracker {
    */
   std::optional<LatticeIndex> wanted_node() const { return wanted_; }
 
+  /** True while the tip is outside the object (or before the first input). */
+  bool outside() const { return state_ == State::kFree; }
+
+  /** A touch-down deeper than this ramps in from zero, m (a tip at 1 kHz moves far less). */
+  static constexpr double kDeepTouchDown_m = 0.5e-3;
+
   /** The surface node nearest to a point on (or projected onto) the surface; never a support. */
   LatticeIndex NearestContactNode(const std::array<double, 3>& surface_point_m) const noexcept;
 
  private:
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
+  void StartRamp(const std::array<double, 3>& from_m, std::int64_t now_ns) noexcept;
 
   MeshSettings mesh_;
   double h_ = 0;
@@ -73,8 +86,14 @@ class ContactTracker {
   State state_ = State::kAwaitLiftOff;
   std::array<double, 3> tip_{};
   std::array<double, 3> entry_{};
-  bool late_ = false;  // engaged after waiting: ramped in
+  std::array<double, 3> inward_{};
+  // A ramp from ramp_from_ (zero after waiting or a deep touch-down, the held displacement after a
+  // stale gap) to the tip's displacement, started at ramp_start_ns_.
+  bool ramping_ = false;
+  std::array<double, 3> ramp_from_{};
   std::int64_t ramp_start_ns_ = 0;
+  bool held_ = false;  // the last period was a Hold while engaged
+  std::array<double, 3> displacement_{};  // the last engaged displacement
   LatticeIndex node_{};
   std::optional<LatticeIndex> wanted_;
 };

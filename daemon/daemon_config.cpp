@@ -78,7 +78,25 @@ const std::map<std::string, Setter>& Setters() {
     flag("input.zero_force_when_stale", &DaemonConfig::zero_force_when_stale);
     real("input.max_speed_m_per_s", &DaemonConfig::max_speed_m_per_s);
     real("input.workspace_margin_m", &DaemonConfig::workspace_margin_m);
-    real("input.max_force_n", &DaemonConfig::max_force_n);
+    s["input.max_force_n"] = [](DaemonConfig*, const toml::node&, const std::string& where) {
+      throw Error(where +
+                  ": input.max_force_n moved to [device] max_force_n, the device's force "
+                  "ceiling (desktop devices: 8 N; a force above device.fault_force_n is a fault)");
+    };
+    text("device.input", &DaemonConfig::device_input);
+    auto port = [&s](const std::string& key, double PortGuardSettings::*field) {
+      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+        c->port.*field = Get<double>(n, key, where, "a number");
+      };
+    };
+    port("device.max_force_n", &PortGuardSettings::max_force_n);
+    port("device.max_force_rate_n_per_ms", &PortGuardSettings::max_force_rate_n_per_ms);
+    port("device.engage_rate_n_per_ms", &PortGuardSettings::engage_rate_n_per_ms);
+    port("device.fault_force_n", &PortGuardSettings::fault_force_n);
+    port("device.watchdog_s", &PortGuardSettings::watchdog_s);
+    s["device.passivity"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
+      c->port.passivity = Get<bool>(n, "device.passivity", where, "true or false");
+    };
     s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
       c->fifo_priority =
           SmallInt(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
@@ -127,7 +145,26 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
           "input.max_speed_m_per_s must be > 0 m/s");
   require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0,
           "input.workspace_margin_m must be >= 0 m");
-  require(std::isfinite(c.max_force_n) && c.max_force_n > 0, "input.max_force_n must be > 0 N");
+  const PortGuardSettings& p = c.port;
+  require(std::isfinite(p.max_force_n) && p.max_force_n > 0 && p.max_force_n <= 100,
+          "device.max_force_n must be in (0, 100] N (desktop devices: 3–9 N peak)");
+  require(std::isfinite(p.max_force_rate_n_per_ms) && p.max_force_rate_n_per_ms > 0 &&
+              p.max_force_rate_n_per_ms <= 100,
+          "device.max_force_rate_n_per_ms must be in (0, 100] N per ms");
+  require(std::isfinite(p.engage_rate_n_per_ms) && p.engage_rate_n_per_ms > 0 &&
+              p.engage_rate_n_per_ms <= p.max_force_rate_n_per_ms,
+          "device.engage_rate_n_per_ms must be > 0 and at most device.max_force_rate_n_per_ms");
+  require(std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n &&
+              p.fault_force_n <= 1000,
+          "device.fault_force_n must be from device.max_force_n to 1000 N");
+  require(std::isfinite(p.watchdog_s) && p.watchdog_s >= 0.005 && p.watchdog_s <= 10,
+          "device.watchdog_s must be from 0.005 to 10 s");
+  require(c.device_input.empty() || c.device_input == "lcm" || c.device_input == "shm",
+          "device.input must be \"lcm\" or \"shm\"");
+  require(c.device_input != "shm" || c.shm_enabled,
+          "device.input = \"shm\" needs shm.enabled = true");
+  require(c.device_input != "lcm" || c.lcm_enabled,
+          "device.input = \"lcm\" needs lcm.enabled = true");
   require(c.fifo_priority >= 0 && c.fifo_priority <= 99,
           "realtime.fifo_priority must be from 0 (off) to 99");
   for (int cpu : c.cpus) require(cpu >= 0 && cpu < 4096, "realtime.cpus: CPU numbers are >= 0");
@@ -151,6 +188,11 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
   ValidateScene(c.scene);
+}
+
+std::string DeviceInputOf(const DaemonConfig& config) {
+  if (!config.device_input.empty()) return config.device_input;
+  return config.shm_enabled ? "shm" : "lcm";
 }
 
 DaemonConfig DefaultDaemonConfig() {
@@ -253,8 +295,15 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "[input]\nstale_after_s = " << real(c.stale_after_s) << "\n"
       << "zero_force_when_stale = " << (c.zero_force_when_stale ? "true" : "false") << "\n"
       << "max_speed_m_per_s = " << real(c.max_speed_m_per_s) << "\n"
-      << "workspace_margin_m = " << real(c.workspace_margin_m) << "\n"
-      << "max_force_n = " << real(c.max_force_n) << "\n\n"
+      << "workspace_margin_m = " << real(c.workspace_margin_m) << "\n\n"
+      << "[device]  # the driver's transport and the force envelope (docs/operations.md)\n"
+      << "input = " << quote(DeviceInputOf(c)) << "  # \"lcm\" or \"shm\": the other is refused\n"
+      << "max_force_n = " << real(c.port.max_force_n) << "\n"
+      << "max_force_rate_n_per_ms = " << real(c.port.max_force_rate_n_per_ms) << "\n"
+      << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"
+      << "fault_force_n = " << real(c.port.fault_force_n) << "\n"
+      << "watchdog_s = " << real(c.port.watchdog_s) << "\n"
+      << "passivity = " << (c.port.passivity ? "true" : "false") << "\n\n"
       << "[realtime]\nfifo_priority = " << c.fifo_priority << "\ncpus = [";
   for (size_t i = 0; i < c.cpus.size(); ++i) out << (i ? ", " : "") << c.cpus[i];
   out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n"

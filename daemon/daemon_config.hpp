@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/scene.hpp"
+#include "daemon/port_guard.hpp"
 
 namespace hapticsim {
 
@@ -36,7 +37,11 @@ struct DaemonConfig {
   bool zero_force_when_stale = true;  ///< stale: render zero force (else hold the last)
   double max_speed_m_per_s = 5.0;     ///< faster jumps are rejected (no hand moves so)
   double workspace_margin_m = 0.1;    ///< accepted positions: the object's box grown by this
-  double max_force_n = 50.0;          ///< a larger force is a fault: zero force, reset
+  // [device]: who drives the tool, and the profile the force sent obeys (PortGuard)
+  /// "lcm" or "shm": the one transport whose device input is used; input on the other is
+  /// rejected and counted. Empty: "shm" when shm.enabled, else "lcm".
+  std::string device_input;
+  PortGuardSettings port;
   // [realtime]
   int fifo_priority = 0;      ///< SCHED_FIFO priority of the region threads (0: normal)
   std::vector<int> cpus;      ///< CPUs the region threads are pinned to (empty: any)
@@ -60,6 +65,9 @@ DaemonConfig LoadDaemonConfig(const std::string& path);
  */
 DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& origin,
                                    bool read_scene_file = true);
+
+/** The transport that owns the device input: device.input, or its default. */
+std::string DeviceInputOf(const DaemonConfig& config);
 
 /** The defaults, as with an empty config file. */
 DaemonConfig DefaultDaemonConfig();

@@ -49,8 +49,10 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene),
       options_(options),
       nodes_(scene.mesh.nodes),
-      contact_(scene.mesh, options.engage_ramp_s) {
+      contact_(scene.mesh, options.engage_ramp_s),
+      guard_(options.port, 1e-3) {
   Install(scene, std::make_unique<AsyncRegions>(scene));
+  guard_ = PortGuard(options.port, primary_period_ns_ * 1e-9);
   tip_ =
       InputResampler(primary_period_ns_ * 1e-9, kMaxPredictedPeriods * primary_period_ns_ * 1e-9);
 }
@@ -275,9 +277,12 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     switch (restart_kind_.exchange(kNoRestart, std::memory_order_acq_rel)) {
       case kRestartFromRest:
         contact_.RestartFromRest();
+        restarted_since_fault_ = guard_.latched();
+        guard_.Reengage();
         break;
       case kRestartKeepingContact:
         contact_.RestartKeepingContact();
+        guard_.Reengage();
         break;
       default:
         break;
@@ -323,36 +328,64 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     }
   }
   idle_.store(usable && sleep_state_ == kAsleep && stale, std::memory_order_relaxed);
-  ForceRecord out;
-  out.period = periods_run_++;
-  BlackBoxRecord box;
-  box.raw_force_n = {-reaction[0], -reaction[1], -reaction[2]};
-  out.seq = last_input_.seq;
-  out.utime_us = now_ns / 1000;
-  out.error_percent = error_percent_.load(std::memory_order_relaxed);
   const bool render = in_contact && !(stale && options_.zero_force_when_stale);
-  if (render) {
-    for (int c = 0; c < 3; ++c) out.force_n[c] = -reaction[c];
-    const double magnitude = std::hypot(out.force_n[0], out.force_n[1], out.force_n[2]);
-    // Stability first: a force no tissue model should give is never sent to a device.
-    if (!std::isfinite(magnitude) || magnitude > options_.max_force_n) {
-      out.force_n = {0.0, 0.0, 0.0};
-      force_faults_.fetch_add(1, std::memory_order_relaxed);
-    }
+  PortGuard::Input port;
+  port.now_ns = now_ns;
+  port.simulated_n = {-reaction[0], -reaction[1], -reaction[2]};
+  port.render = render;
+  port.position_m = last_input_.position_m;
+  port.have_position = have;
+  port.inward_normal = contact.inward_normal;
+  const PortGuard::Output sent = guard_.Period(port);
+  UpdateFaultState(sent, contact.engaged);
+  if (sent.limited) {
+    flags |= force_flags::kForceLimited;
+    limited_periods_.fetch_add(1, std::memory_order_relaxed);
   }
+  if (sent.dissipating) {
+    flags |= force_flags::kPortDissipating;
+    dissipating_periods_.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (sent.latched) flags |= force_flags::kFaultLatched;
   if (in_contact) {
     flags |= force_flags::kInContact;
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);
   }
+  ForceRecord out;
+  out.period = periods_run_++;
+  out.seq = last_input_.seq;
+  out.utime_us = now_ns / 1000;
+  out.error_percent = error_percent_.load(std::memory_order_relaxed);
+  out.force_n = sent.force_n;
   out.flags = flags;
   forces_.Push(out);
+  BlackBoxRecord box;
   box.time_ns = now_ns;
   box.seq = out.seq;
   box.position_m = last_input_.position_m;
   box.force_n = out.force_n;
+  box.raw_force_n = port.simulated_n;
+  box.port_energy_j = guard_.port_energy_j();
   box.error_percent = out.error_percent;
   box.flags = flags;
   black_box_.Push(box);
+}
+
+void HapticLoop::UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept {
+  if (sent.new_fault != PortGuard::Fault::kNone) {
+    last_fault_.store(static_cast<int>(sent.new_fault), std::memory_order_relaxed);
+    fault_latched_.store(true, std::memory_order_relaxed);
+    restarted_since_fault_ = false;
+    force_faults_.fetch_add(1, std::memory_order_relaxed);  // the supervisor restarts the regions
+  }
+  // Re-armed only from rest with the tool out of the object: the next touch engages from zero.
+  if (guard_.latched() && restarted_since_fault_ && !engaged && contact_.outside()) {
+    guard_.Rearm();
+    restarted_since_fault_ = false;
+    fault_latched_.store(false, std::memory_order_relaxed);
+    rearms_.fetch_add(1, std::memory_order_relaxed);
+  }
+  port_dissipated_j_.store(guard_.dissipated_j(), std::memory_order_relaxed);
 }
 
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {

@@ -14,6 +14,7 @@
 #include "daemon/contact_tracker.hpp"
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/input_resampler.hpp"
+#include "daemon/port_guard.hpp"
 #include "daemon/spsc_ring.hpp"
 
 namespace hapticsim {
@@ -43,6 +44,7 @@ struct BlackBoxRecord {
   std::array<double, 3> position_m{};
   std::array<double, 3> force_n{};      ///< as sent (zero out of contact or after a fault)
   std::array<double, 3> raw_force_n{};  ///< as simulated
+  double port_energy_j = 0;             ///< the port guard's observed energy (PortGuard)
   double error_percent = -1;
   std::int32_t flags = 0;
 };
@@ -57,6 +59,9 @@ inline constexpr std::int32_t kReconfiguring = 16;
 inline constexpr std::int32_t kNoErrorMap = 32;
 inline constexpr std::int32_t kInputRejected = 64;
 inline constexpr std::int32_t kBoundaryStale = 128;
+inline constexpr std::int32_t kForceLimited = 256;
+inline constexpr std::int32_t kPortDissipating = 512;
+inline constexpr std::int32_t kFaultLatched = 1024;
 }  // namespace force_flags
 
 /**
@@ -92,7 +97,7 @@ class HapticLoop {
   struct Options {
     double stale_after_s = 0.05;
     bool zero_force_when_stale = true;
-    double max_force_n = 50;
+    PortGuardSettings port;      ///< the device profile the force sent obeys
     int fifo_priority = 0;       ///< SCHED_FIFO for the region threads (0: normal scheduling)
     std::vector<int> cpus;       ///< pin the region threads here (empty: no pinning)
     double engage_ramp_s = 0.1;  ///< a contact that engages late ramps its force in over this
@@ -159,9 +164,30 @@ class HapticLoop {
   /** Supervisor: per region. */
   DeadlineMonitor& monitor(RegionIndex region) { return *monitors_[region]; }
   const AsyncRegions& regions() const { return *regions_; }
-  /** Primary periods run on stale input, and force faults (non-finite or above max_force_n). */
+  /** Primary periods run on stale input. */
   std::int64_t stale_periods() const { return stale_periods_.load(std::memory_order_relaxed); }
+  /**
+   * Faults the port guard latched (non-finite or diverging force, a stalled primary), and the
+   * re-arms since: a latched fault holds the force at zero until the regions have restarted from
+   * rest (the supervisor's RestartFromRest) and the tool is out of the object.
+   */
   std::int64_t force_faults() const { return force_faults_.load(std::memory_order_relaxed); }
+  std::int64_t rearms() const { return rearms_.load(std::memory_order_relaxed); }
+  bool fault_latched() const { return fault_latched_.load(std::memory_order_relaxed); }
+  /** The kind of the newest latched fault (PortGuard::Fault). */
+  PortGuard::Fault last_fault() const {
+    return static_cast<PortGuard::Fault>(last_fault_.load(std::memory_order_relaxed));
+  }
+  /** Periods whose force the guard limited (envelope, ramp, slew) or dissipated energy from. */
+  std::int64_t limited_periods() const { return limited_periods_.load(std::memory_order_relaxed); }
+  std::int64_t dissipating_periods() const {
+    return dissipating_periods_.load(std::memory_order_relaxed);
+  }
+  const PortGuardSettings& port_settings() const { return options_.port; }
+  /** Energy the port guard's passivity controller has dissipated, J. */
+  double port_energy_dissipated_j() const {
+    return port_dissipated_j_.load(std::memory_order_relaxed);
+  }
   /**
    * A secondary region's stalls (woke more than kSkipAfterLatePeriods of its periods late) and the
    * periods it skipped holding its state, since the loop was made. Any thread.
@@ -218,6 +244,8 @@ class HapticLoop {
   void WatchForRest(bool touched) noexcept;
   void WakeSecondaries(std::int64_t origin_ns) noexcept;
   void WaitForInput() noexcept;
+  // Primary thread: a newly latched fault counted, a latched one re-armed when it may be.
+  void UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
   void ForgetSleep();
 
@@ -234,7 +262,10 @@ class HapticLoop {
   std::atomic<double> error_percent_{-1};
   std::atomic<std::int32_t> error_flags_{0};
   std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0},
-      paused_periods_{0};
+      paused_periods_{0}, rearms_{0}, limited_periods_{0}, dissipating_periods_{0};
+  std::atomic<bool> fault_latched_{false};
+  std::atomic<int> last_fault_{0};
+  std::atomic<double> port_dissipated_j_{0};
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;
@@ -282,6 +313,8 @@ class HapticLoop {
 
   // Primary thread state.
   ContactTracker contact_;
+  PortGuard guard_;
+  bool restarted_since_fault_ = false;  // the regions restarted from rest after the latch
   InputResampler tip_{1e-3, kMaxPredictedPeriods * 1e-3};  // re-made for the primary's period
   std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
   DeviceSample last_input_;

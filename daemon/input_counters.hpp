@@ -12,6 +12,8 @@ namespace hapticsim {
 struct InputCounters {
   std::atomic<std::int64_t> inputs_received{0}, inputs_rejected{0}, decode_errors{0};
   std::atomic<std::int64_t> forces_published{0}, commands_received{0};
+  /// Device inputs on the transport that does not own the input (device.input): refused unread.
+  std::atomic<std::int64_t> inputs_wrong_transport{0};
   std::array<std::atomic<std::int64_t>, kNumInputRejections> rejected_by_kind{};
   std::atomic<int> last_rejection{0};  ///< newest rejection not yet logged (InputRejection)
 

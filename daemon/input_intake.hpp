@@ -17,8 +17,11 @@ namespace hapticsim {
 class InputIntake {
  public:
   InputIntake(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s,
-              HapticLoop& loop, InputCounters& counters)
-      : guard_(mesh, workspace_margin_m, max_speed_m_per_s), loop_(loop), counters_(counters) {}
+              HapticLoop& loop, InputCounters& counters, bool owns_input)
+      : guard_(mesh, workspace_margin_m, max_speed_m_per_s),
+        loop_(loop),
+        counters_(counters),
+        owns_input_(owns_input) {}
 
   void Offer(std::int64_t seq, const std::array<double, 3>& position_m);
 
@@ -26,6 +29,7 @@ class InputIntake {
   InputGuard guard_;
   HapticLoop& loop_;
   InputCounters& counters_;
+  bool owns_input_;
   DeviceSample last_accepted_;
 };
 

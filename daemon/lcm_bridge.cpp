@@ -13,7 +13,7 @@ LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters
       counters_(counters),
       lcm_(config.lcm_url),
       intake_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s, loop,
-              counters) {
+              counters, DeviceInputOf(config) == "lcm") {
   if (!lcm_.good()) {
     throw Error("LCM could not start on " + config.lcm_url +
                 " (for udpm:// the interface needs a multicast route, e.g. `ip route add "

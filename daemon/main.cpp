@@ -95,6 +95,22 @@ MapState LoadMap(const std::string& path, bool reload = false) {
   return state;
 }
 
+std::string FaultName(PortGuard::Fault fault, const PortGuardSettings& port) {
+  switch (fault) {
+    case PortGuard::Fault::kNonFinite:
+      return "the simulated force is not finite";
+    case PortGuard::Fault::kDivergence:
+      return fmt::format("the simulated force exceeded device.fault_force_n = {} N", port.fault_force_n);
+    case PortGuard::Fault::kWatchdog:
+      return fmt::format(
+          "the primary thread was stalled for more than device.watchdog_s = {} s while force "
+          "was sent",
+          port.watchdog_s);
+    default:
+      return "unknown";
+  }
+}
+
 std::int32_t DecisionFlags(const SupervisorDecision& d) {
   std::int32_t flags = 0;
   if (!d.have_map) flags |= force_flags::kNoErrorMap;
@@ -146,7 +162,7 @@ int Serve(const Arguments& args) {
   HapticLoop::Options options;
   options.stale_after_s = config.stale_after_s;
   options.zero_force_when_stale = config.zero_force_when_stale;
-  options.max_force_n = config.max_force_n;
+  options.port = config.port;
   options.fifo_priority = config.fifo_priority;
   options.cpus = config.cpus;
   options.sleep_at_rest = config.sleep_at_rest;
@@ -168,11 +184,17 @@ int Serve(const Arguments& args) {
   if (config.shm_enabled) {
     shm = std::make_unique<ShmServer>(config.shm_name, config.shm_group, config.scene.mesh,
                                       config.workspace_margin_m, config.max_speed_m_per_s, loop,
-                                      counters);
+                                      counters, DeviceInputOf(config) == "shm");
     spdlog::info("shared memory /dev/shm{} (mode 0660{})", config.shm_name,
                  config.shm_group.empty() ? "" : ", group " + config.shm_group);
   }
   if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");
+  spdlog::info(
+      "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage "
+      "ramp {} N/ms, fault above {} N or a {} s primary stall, passivity {}",
+      DeviceInputOf(config) == "shm" ? "shared memory" : "LCM", config.port.max_force_n,
+      config.port.max_force_rate_n_per_ms, config.port.engage_rate_n_per_ms,
+      config.port.fault_force_n, config.port.watchdog_s, config.port.passivity ? "on" : "off");
   const std::string refused = loop.Start();
   if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
   std::atomic<bool> stop_io{false};
@@ -229,7 +251,8 @@ int Serve(const Arguments& args) {
   match_miss_loggers(HapticLoop::NowNs());
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
-  std::int64_t faults_seen = 0, last_rejection_line_ns = 0;
+  std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
+  std::int64_t wrong_transport_seen = 0;
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
   constexpr int kOverrunBurst = 10;
@@ -422,6 +445,15 @@ int Serve(const Arguments& args) {
     const auto rejection = may_log
                                ? static_cast<InputRejection>(counters.last_rejection.exchange(0))
                                : InputRejection::kAccepted;
+    const std::int64_t wrong_transport = counters.inputs_wrong_transport.load();
+    if (may_log && wrong_transport != wrong_transport_seen) {
+      last_rejection_line_ns = now;
+      spdlog::warn(
+          "device input on {} refused: {} owns the input (device.input); {} refused so far",
+          DeviceInputOf(config) == "shm" ? "LCM" : "shared memory",
+          DeviceInputOf(config) == "shm" ? "shared memory" : "LCM", wrong_transport);
+      wrong_transport_seen = wrong_transport;
+    }
     if (rejection != InputRejection::kAccepted) {
       last_rejection_line_ns = now;
       spdlog::warn(
@@ -581,16 +613,22 @@ int Serve(const Arguments& args) {
     if (loop.force_faults() > faults_seen) {
       faults_seen = loop.force_faults();
       if (now - last_fault_dump_ns > 10'000'000'000) {  // one black box per 10 s of faults
+        black_box.Drain(loop);
         black_box.Dump("force fault");
         last_fault_dump_ns = now;
       }
       spdlog::error(
-          "force fault (non-finite or above input.max_force_n = {} N): zero force sent; "
-          "the simulation restarts from rest and renders again after the tool has "
-          "left the object",
-          config.max_force_n);
+          "force fault latched ({}): the force ramps to zero and stays there; the simulation "
+          "restarts from rest and the fault re-arms once the tool is out of the object "
+          "({} fault(s) so far)",
+          FaultName(loop.last_fault(), config.port), faults_seen);
       restart_from_rest("force fault");
-      faults_seen = loop.force_faults();  // the periods up to the restart included
+    }
+    if (loop.rearms() > rearms_seen) {
+      rearms_seen = loop.rearms();
+      spdlog::warn(
+          "force fault re-armed: the tool is out of the object and the simulation restarted "
+          "from rest; the next touch engages from zero force");
     }
     if (now >= next_status_ns) {
       next_status_ns = now + static_cast<std::int64_t>(1e9 / config.status_rate_hz);
@@ -604,8 +642,10 @@ int Serve(const Arguments& args) {
         shown.spectral_radius = active_radius;
         shown.error_percent = reported_error;  // for the node the regions are centred on
         shown.target_met = reported_target_met;
-        bridge->PostStatus(
-            MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters));
+        status_t status =
+            MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters);
+        status.input_owner = DeviceInputOf(config);
+        bridge->PostStatus(status);
       }
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {

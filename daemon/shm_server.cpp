@@ -4,9 +4,9 @@ namespace hapticsim {
 
 ShmServer::ShmServer(const std::string& name, const std::string& group, const MeshSettings& mesh,
                      double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
-                     InputCounters& counters)
+                     InputCounters& counters, bool owns_input)
     : mapping_(shm::MappedSegment::Create(name, group)),
-      intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters) {}
+      intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input) {}
 
 void ShmServer::PollInput() {
   shm::ShmDeviceInput input;

@@ -17,7 +17,7 @@ class ShmServer {
   /** @throws Error when the segment cannot be created (the message says what to check). */
   ShmServer(const std::string& name, const std::string& group, const MeshSettings& mesh,
             double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
-            InputCounters& counters);
+            InputCounters& counters, bool owns_input);
 
   void PollInput();
   void Publish(const ForceRecord& record);

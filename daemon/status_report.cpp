@@ -21,7 +21,15 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
     s.inputs_rejected = counters->inputs_rejected.load();
     s.decode_errors = counters->decode_errors.load();
     s.forces_published = counters->forces_published.load();
+    s.inputs_wrong_transport = counters->inputs_wrong_transport.load();
   }
+  s.max_force_n = loop.port_settings().max_force_n;
+  s.force_limited_periods = loop.limited_periods();
+  s.port_dissipating_periods = loop.dissipating_periods();
+  s.port_energy_dissipated_j = loop.port_energy_dissipated_j();
+  s.fault_latched = loop.fault_latched();
+  s.latched_faults = loop.force_faults();
+  s.fault_rearms = loop.rearms();
   s.stale_periods = loop.stale_periods();
   for (int c = 0; c < 3; ++c) s.contact_node[c] = loop.centre_node()[c];
   s.reconfigurations = loop.reconfigurations();

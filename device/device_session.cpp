@@ -91,8 +91,20 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     const bool contact = a.flags & force_feedback_t::FLAG_IN_CONTACT;
     const bool stale = a.flags & force_feedback_t::FLAG_INPUT_STALE;
     if (contact) ++report.contact_answers;
-    if (!contact && finite && (a.force_n[0] != 0 || a.force_n[1] != 0 || a.force_n[2] != 0)) {
+    const bool limited = a.flags & force_feedback_t::FLAG_FORCE_LIMITED;
+    if (!contact && !limited && finite &&
+        (a.force_n[0] != 0 || a.force_n[1] != 0 || a.force_n[2] != 0)) {
       ++report.force_out_of_contact;
+    }
+    if (finite) {
+      report.largest_force_n =
+          std::max(report.largest_force_n, std::hypot(a.force_n[0], a.force_n[1], a.force_n[2]));
+    }
+    if (previous && finite) {
+      report.largest_force_step_any_n = std::max(
+          report.largest_force_step_any_n,
+          std::hypot(a.force_n[0] - previous->force_n[0], a.force_n[1] - previous->force_n[1],
+                     a.force_n[2] - previous->force_n[2]));
     }
     if (previous && contact && !stale && (previous->flags & force_feedback_t::FLAG_IN_CONTACT) &&
         finite) {

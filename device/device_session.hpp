@@ -49,8 +49,11 @@ struct SessionReport {
   std::optional<StreamSummary> monitor;  ///< on the listening LCM link, when there is one
   LatencySummary latency;
   std::int64_t nonfinite_forces = 0;
-  std::int64_t force_out_of_contact = 0;  ///< a non-zero force without the in-contact flag
+  /// A non-zero force flagged neither in contact nor limited (the port guard's ramp to zero).
+  std::int64_t force_out_of_contact = 0;
   double largest_force_step_n = 0;        ///< between consecutive answers in contact, fresh input
+  double largest_force_step_any_n = 0;    ///< between any consecutive answers
+  double largest_force_n = 0;             ///< the largest force magnitude received
   std::int64_t contact_answers = 0;
   std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
   std::int64_t answers_after_last_burst = 0;

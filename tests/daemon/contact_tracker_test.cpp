@@ -40,7 +40,7 @@ TEST(ContactTracker, ATouchThroughAnyFacePicksTheNearestNodeOnThatFace) {
     LatticeIndex node;
     std::array<double, 3> displacement;
   };
-  const double d = 0.001;
+  const double d = 0.0004;  // within kDeepTouchDown_m: engaged at once
   const Case cases[] = {
       {{0.1, 0.2, -d}, {0.1, 0.2, d}, {5, 10, 0}, {0, 0, d}},                   // front, z = 0
       {{0.1, 0.2, kEdge + d}, {0.1, 0.2, kEdge - d}, {5, 10, 12}, {0, 0, -d}},  // back
@@ -133,8 +133,43 @@ TEST(ContactTracker, ARestartKeepingContactEngagesAgainFromZero) {
   const auto again = tracker.Update({0.125, 0.125, 0.003}, 2 * kMs, middle);
   EXPECT_TRUE(again.engaged);
   EXPECT_NEAR(again.displacement_m[2], 0.0, 1e-15);
-  EXPECT_NEAR(tracker.Hold(52 * kMs, middle).displacement_m[2], 0.0015, 1e-12);  // half way
-  EXPECT_NEAR(tracker.Hold(102 * kMs, middle).displacement_m[2], 0.003, 1e-15);  // all the way
+  const std::array<double, 3> tip{0.125, 0.125, 0.003};
+  EXPECT_NEAR(tracker.Update(tip, 52 * kMs, middle).displacement_m[2], 0.0015, 1e-12);  // half
+  EXPECT_NEAR(tracker.Update(tip, 102 * kMs, middle).displacement_m[2], 0.003, 1e-15);  // all
+}
+
+TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
+  // A session that begins with the tool 1 cm inside (or a tip that jumped in): no step.
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  tracker.Update({0.125, 0.125, -0.001}, 0, middle);
+  const std::array<double, 3> tip{0.125, 0.125, 0.01};
+  const auto touch = tracker.Update(tip, kMs, middle);
+  EXPECT_TRUE(touch.engaged);
+  EXPECT_EQ(touch.displacement_m[2], 0.0);
+  EXPECT_EQ(touch.inward_normal, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_NEAR(tracker.Update(tip, 51 * kMs, middle).displacement_m[2], 0.005, 1e-12);
+  EXPECT_NEAR(tracker.Update(tip, 101 * kMs, middle).displacement_m[2], 0.01, 1e-15);
+}
+
+TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  tracker.Update({0.125, 0.125, -0.0001}, 0, middle);
+  for (int n = 1; n <= 40; ++n) tracker.Update({0.125, 0.125, 1e-4 * n}, n * kMs, middle);
+  // Stale: the node holds 4 mm in whatever the time.
+  EXPECT_NEAR(tracker.Hold(100 * kMs, middle).displacement_m[2], 0.004, 1e-15);
+  EXPECT_NEAR(tracker.Hold(600 * kMs, middle).displacement_m[2], 0.004, 1e-15);
+  // The device is back with the tool 8 mm in: from 4 mm to 8 mm over the ramp, not at once.
+  const std::array<double, 3> tip{0.125, 0.125, 0.008};
+  EXPECT_NEAR(tracker.Update(tip, 601 * kMs, middle).displacement_m[2], 0.004, 1e-15);
+  EXPECT_NEAR(tracker.Update(tip, 651 * kMs, middle).displacement_m[2], 0.006, 1e-12);
+  EXPECT_NEAR(tracker.Update(tip, 701 * kMs, middle).displacement_m[2], 0.008, 1e-15);
+  // Through the back face the inward normal is −z.
+  ContactTracker back(Mesh(), 0.1);
+  back.Update({0.125, 0.125, kEdge + 0.0001}, 0, middle);
+  EXPECT_EQ(back.Update({0.125, 0.125, kEdge - 0.0001}, kMs, LatticeIndex{6, 6, 12}).inward_normal,
+            (std::array<double, 3>{0, 0, -1}));
 }
 
 }  // namespace

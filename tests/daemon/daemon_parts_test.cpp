@@ -74,6 +74,9 @@ TEST(LcmTypes, TheDaemonsForceFlagsAreTheMessageConstants) {
   EXPECT_EQ(force_flags::kNoErrorMap, force_feedback_t::FLAG_NO_ERROR_MAP);
   EXPECT_EQ(force_flags::kInputRejected, force_feedback_t::FLAG_INPUT_REJECTED);
   EXPECT_EQ(force_flags::kBoundaryStale, force_feedback_t::FLAG_BOUNDARY_STALE);
+  EXPECT_EQ(force_flags::kForceLimited, force_feedback_t::FLAG_FORCE_LIMITED);
+  EXPECT_EQ(force_flags::kPortDissipating, force_feedback_t::FLAG_PORT_DISSIPATING);
+  EXPECT_EQ(force_flags::kFaultLatched, force_feedback_t::FLAG_FAULT_LATCHED);
 }
 
 std::string ConfigError(const std::string& text) {
@@ -130,6 +133,41 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find("hapticsimd_config_test.toml:1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
+}
+
+TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
+  const std::string path = ::testing::TempDir() + "hapticsimd_config_device.toml";
+  std::ofstream(path) << "[shm]\nenabled = true\n[device]\nmax_force_n = 3.0\n"
+                         "max_force_rate_n_per_ms = 0.2\nengage_rate_n_per_ms = 0.03\n"
+                         "fault_force_n = 20.0\nwatchdog_s = 0.05\npassivity = false\n";
+  const DaemonConfig config = LoadDaemonConfig(path);
+  EXPECT_EQ(config.port.max_force_n, 3.0);
+  EXPECT_EQ(config.port.max_force_rate_n_per_ms, 0.2);
+  EXPECT_EQ(config.port.engage_rate_n_per_ms, 0.03);
+  EXPECT_EQ(config.port.fault_force_n, 20.0);
+  EXPECT_EQ(config.port.watchdog_s, 0.05);
+  EXPECT_FALSE(config.port.passivity);
+  EXPECT_EQ(DeviceInputOf(config), "shm");  // shared memory enabled: it owns the input
+  std::ofstream(path) << FormatDaemonConfig(config);
+  EXPECT_EQ(FormatDaemonConfig(LoadDaemonConfig(path)), FormatDaemonConfig(config));
+  // A desktop device by default, the input LCM's.
+  EXPECT_EQ(DefaultDaemonConfig().port.max_force_n, 8.0);
+  EXPECT_EQ(DeviceInputOf(DefaultDaemonConfig()), "lcm");
+  const std::pair<const char*, const char*> refused[] = {
+      {"[input]\nmax_force_n = 50.0\n", "input.max_force_n moved to [device] max_force_n"},
+      {"[device]\nmax_force_n = 1e300\n", "device.max_force_n must be in (0, 100] N"},
+      {"[device]\nmax_force_n = 10.0\nfault_force_n = 9.0\n",
+       "device.fault_force_n must be from device.max_force_n"},
+      {"[device]\nengage_rate_n_per_ms = 1.0\n", "at most device.max_force_rate_n_per_ms"},
+      {"[device]\nwatchdog_s = 0.0\n", "device.watchdog_s must be from 0.005 to 10 s"},
+      {"[device]\ninput = \"usb\"\n", "device.input must be \"lcm\" or \"shm\""},
+      {"[device]\ninput = \"shm\"\n", "device.input = \"shm\" needs shm.enabled = true"},
+      {"[lcm]\nenabled = false\n[device]\ninput = \"lcm\"\n",
+       "device.input = \"lcm\" needs lcm.enabled = true"},
+  };
+  for (const auto& [text, message] : refused) {
+    EXPECT_NE(ConfigError(text).find(message), std::string::npos) << text << ConfigError(text);
+  }
 }
 
 TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {

@@ -1,6 +1,7 @@
 // The time step runs in the 1 kHz thread: it must never touch the heap.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -61,6 +62,7 @@ TEST(RegionSteps, NeverAllocate) {
   }
 }
 
+
 }  // namespace
 }  // namespace hapticsim
 
@@ -94,6 +96,7 @@ TEST(ErrorLookup, NeverAllocates) {
   EXPECT_EQ(count.count(), 0u);
   EXPECT_GT(sum, 0);
 }
+
 
 }  // namespace
 }  // namespace hapticsim
@@ -135,6 +138,38 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
                                  "waking are covered too)";
   EXPECT_TRUE(pushed_back);
   EXPECT_TRUE(record.flags & force_flags::kInputStale);
+}
+
+
+
+// The port guard acting in the primary period: the envelope saturating, the engagement ramp, the
+// passivity controller and a fault latching (a fault_force_n below the press's force) cost no
+// allocation either.
+TEST(DaemonPrimaryPeriod, NeverAllocatesWhileThePortGuardActs) {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  HapticLoop::Options options;
+  options.port.max_force_n = 0.3;
+  options.port.fault_force_n = 0.6;
+  HapticLoop loop(scene, options);
+  std::int64_t now = HapticLoop::NowNs();
+  ForceRecord record;
+  std::int32_t flags = 0;
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 500; ++n, now += 1'000'000) {
+    // In 1 cm, out again (the passivity controller watches the way out), in again.
+    const double z = n < 20 ? -0.002 : 0.01 * std::sin(3.14159 * (n - 20) / 240.0);
+    loop.OfferInput(DeviceSample{n, now, {0.125, 0.125, z}, false});
+    loop.PrimaryPeriod(now, now);
+    for (int r = 1; r < loop.regions().num_regions(); ++r) {
+      if (loop.SecondaryMayStep(r)) const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+    }
+    while (loop.forces().Pop(&record)) flags |= record.flags;
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_TRUE(flags & force_flags::kForceLimited);
+  EXPECT_EQ(loop.force_faults(), 1);
+  EXPECT_TRUE(flags & force_flags::kFaultLatched);
 }
 
 }  // namespace

@@ -40,6 +40,9 @@ struct SoakOptions {
   unsigned seed = 1;
   double max_lcm_loss_percent = 1.0;
   double max_rss_growth_kib = 2048;
+  int cpu_load = 0;              // busy threads beside daemon and device, normal priority
+  double max_force_step_n = 1.0;  // largest force change between answers in contact
+  double min_answered_percent = 95;
   bool json = false;
 };
 
@@ -202,6 +205,19 @@ int RunSoak(const SoakOptions& o) {
   auto monitor = device::MakeLcmLink(device::kHostLocalLcmUrl, "HAPTIC_DEVICE", "HAPTIC_FORCE",
                                      "HAPTIC_STATUS");
 
+  // Load as on a user's desktop: busy threads at normal priority, no real-time privileges, for
+  // the whole run.
+  std::atomic<bool> loading{true};
+  std::vector<std::thread> load;
+  for (int i = 0; i < o.cpu_load; ++i) {
+    load.emplace_back([&loading] {
+      volatile double sink = 0;
+      while (loading.load(std::memory_order_relaxed)) {
+        for (int k = 0; k < 100000; ++k) sink = sink + 1e-9 * k;
+      }
+    });
+  }
+
   std::vector<ResourceSample> resources;
   std::mutex resources_mutex;
   std::atomic<bool> sampling{true};
@@ -250,6 +266,8 @@ int RunSoak(const SoakOptions& o) {
   if (terminal) std::fprintf(stderr, "\n");
   sampling = false;
   sampler.join();
+  loading = false;
+  for (std::thread& t : load) t.join();
   int status = 0;
   const bool stopped_in_time = stop_daemon(&status);
   const bool clean_exit = stopped_in_time && WIFEXITED(status) && WEXITSTATUS(status) == 0;
@@ -277,8 +295,18 @@ int RunSoak(const SoakOptions& o) {
                         {"worst_lateness_us", r.worst_lateness_us}};
     }
   }
+  const std::int64_t good_inputs = report.inputs_sent;
+  const double answered_percent =
+      good_inputs > 0
+          ? 100.0 * static_cast<double>(good_inputs - report.unanswered_inputs) / good_inputs
+          : 0.0;
+  const status_t last_status = report.status.value_or(status_t{});
   const nlohmann::json checks = {
       {"no_nonfinite_force", report.nonfinite_forces == 0},
+      {"force_step_in_contact_within_limit", report.largest_force_step_n <= o.max_force_step_n},
+      {"force_within_device_limit",
+       !report.status || report.largest_force_n <= last_status.max_force_n + 1e-9},
+      {"inputs_answered_shm", answered_percent >= o.min_answered_percent},
       {"no_lost_answers_shm", report.stream.lost_answers == 0},
       {"no_duplicated_answers_shm", report.stream.duplicated_answers == 0},
       {"lcm_loss_within_budget", lcm_loss_percent <= o.max_lcm_loss_percent},
@@ -315,6 +343,18 @@ int RunSoak(const SoakOptions& o) {
       {"cpu_percent_mean", resources.empty() ? 0.0 : cpu_sum / resources.size()},
       {"deadline_misses", misses},
       {"largest_force_step_N", report.largest_force_step_n},
+      {"cpu_load_threads", o.cpu_load},
+      {"max_force_step_in_contact_n", report.largest_force_step_n},
+      {"max_force_step_any_n", report.largest_force_step_any_n},
+      {"max_force_step_limit_n", o.max_force_step_n},
+      {"max_force_n", report.largest_force_n},
+      {"device_max_force_n", last_status.max_force_n},
+      {"answered_percent_shm", answered_percent},
+      {"latched_faults", last_status.latched_faults},
+      {"fault_rearms", last_status.fault_rearms},
+      {"force_limited_periods", last_status.force_limited_periods},
+      {"port_dissipating_periods", last_status.port_dissipating_periods},
+      {"port_energy_dissipated_j", last_status.port_energy_dissipated_j},
       {"daemon_exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
       {"report",
        {{"json", (dir / "soak.json").string()},
@@ -333,8 +373,20 @@ int RunSoak(const SoakOptions& o) {
     std::cout << summary.dump(2) << "\n";
   } else {
     std::cout << "hapticsimd soak, " << o.duration_s << " s (" << o.input << " input over shared "
-              << "memory, forces also watched on LCM): " << (passed ? "passed" : "FAILED") << "\n"
+              << "memory, forces also watched on LCM" << (o.cpu_load ? ", " : "")
+              << (o.cpu_load ? std::to_string(o.cpu_load) + " busy threads beside" : "")
+              << "): " << (passed ? "passed" : "FAILED") << "\n"
               << ReportText(report);
+    std::printf(
+        "  port guard                 largest force %.3f N (device ceiling %.3g N); largest "
+        "step in contact %.3f N (limit %.3g N); %lld fault(s) latched; %lld period(s) limited; "
+        "%.3g J dissipated\n",
+        report.largest_force_n, last_status.max_force_n, report.largest_force_step_n,
+        o.max_force_step_n, static_cast<long long>(last_status.latched_faults),
+        static_cast<long long>(last_status.force_limited_periods),
+        last_status.port_energy_dissipated_j);
+    std::printf("  shared-memory inputs answered %.2f %% (at least %.3g %%)\n", answered_percent,
+                o.min_answered_percent);
     std::printf("  LCM answers lost           %lld of %lld (%.3f %%, budget %.3g %%)\n",
                 static_cast<long long>(lcm.lost_answers),
                 static_cast<long long>(lcm.answers + lcm.lost_answers), lcm_loss_percent,
@@ -382,6 +434,19 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
   app->add_option("--max-rss-growth-kib", options->max_rss_growth_kib,
                   "Tolerance for resident-memory growth after the warm-up, KiB")
       ->capture_default_str();
+  app->add_option("--cpu-load", options->cpu_load,
+                  "Busy threads at normal priority beside daemon and device for the whole run (a "
+                  "user's desktop)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  app->add_option("--max-force-step", options->max_force_step_n,
+                  "Largest force change between consecutive answers in contact, N")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app->add_option("--min-answered-percent", options->min_answered_percent,
+                  "Shared-memory inputs that must be answered, %")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   app->add_flag("--json", options->json, "Print the summary as JSON");
   return {app, [options, argc, argv] {
             if (!std::getenv(kInNetnsVariable)) ReexecInPrivateNetns(argc, argv);

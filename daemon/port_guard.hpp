@@ -1,0 +1,118 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace hapticsim {
+
+/**
+ * The device profile: what the force sent to the device may do ([device] in the daemon config).
+ * The defaults suit a desktop device rated 3–9 N peak; docs/operations.md lists profiles.
+ */
+struct PortGuardSettings {
+  double max_force_n = 8.0;               ///< magnitude ceiling: larger forces are saturated
+  double max_force_rate_n_per_ms = 0.5;   ///< slew ceiling between consecutive periods, N per ms
+  double engage_rate_n_per_ms = 0.05;     ///< engaging and releasing ramp (from and to zero)
+  double fault_force_n = 50.0;            ///< a simulated force above this is a divergence: fault
+  double watchdog_s = 0.1;                ///< a primary gap this long while sending force: fault
+  bool passivity = true;                  ///< time-domain passivity observer and controller
+};
+
+/**
+ * The force-safety layer between the primary region and the device port: whatever the simulation,
+ * the threads or the input do, the force sent stays inside the device's envelope and the port
+ * does not create energy. Plain logic for the primary thread: no allocation, no locks, no
+ * exceptions, no I/O.
+ *
+ * Each period it takes the simulated force on the user, whether that force may be rendered (in
+ * contact, fresh input, regions running) and the device's newest received position, and returns
+ * the force to send. In this order:
+ *
+ *  1. Faults latch. A non-finite simulated force, one above fault_force_n (a diverging
+ *     simulation), or a gap of more than watchdog_s between primary periods while force is being
+ *     sent latches a fault: the output releases to zero and stays there until Rearm().
+ *  2. Unilateral contact. The normal force never pulls the tool into the surface: a component
+ *     along the contact's inward normal is removed.
+ *  3. Envelope. The magnitude is saturated at max_force_n.
+ *  4. Engagement. Whenever rendering starts or stops, or the simulation restarts under it
+ *     (Reengage), the output moves to the new target (the simulated force, or zero) at
+ *     engage_rate_n_per_ms at most, so every engagement (start-up, a
+ *     new session, input back after a gap, a re-arm, a reconfiguration) ramps from zero and every
+ *     release ramps to zero. A touch-down whose force is still within one ramp step needs no ramp:
+ *     a normal touch renders unchanged.
+ *  5. Passivity (Hannaford and Ryu's time-domain passivity observer and controller, in
+ *     impedance form). The observer sums the energy the port has absorbed since the engagement,
+ *     E = −Σ F_sent(k−1) · (p(k) − p(k−1)), the exact work a force held over each period does on
+ *     a device moving from p(k−1) to p(k). A passive environment keeps E ≥ 0. Before sending F,
+ *     the controller predicts the next period's motion Δp from the last kVelocityPeriods periods;
+ *     if F · Δp (the energy F would give the user) exceeds E, it adds damping along Δp that takes
+ *     away exactly the excess: F ← F − ((F·Δp − E) / |Δp|²) Δp. With E < 0 (the prediction was
+ *     short) the excess includes the deficit, so the observed energy returns to zero.
+ *  6. Slew. The change from the last force sent is at most max_force_rate_n_per_ms per period.
+ *
+ * Every period where 2–6 changed the force is counted as limited; dissipation by 5 is summed in
+ * joules. The caller flags both on the force sent (the looked-up error no longer describes it).
+ */
+class PortGuard {
+ public:
+  enum class Fault : int { kNone = 0, kNonFinite, kDivergence, kWatchdog };
+
+  struct Output {
+    std::array<double, 3> force_n{};
+    bool limited = false;      ///< envelope, unilateral, ramp or slew changed the force
+    bool dissipating = false;  ///< the passivity controller took energy out this period
+    bool latched = false;      ///< a fault holds the output at (or on its way to) zero
+    Fault new_fault = Fault::kNone;  ///< the fault latched in this period, if any
+  };
+
+  /** One period's input. */
+  struct Input {
+    std::int64_t now_ns = 0;               ///< when this period runs (CLOCK_MONOTONIC)
+    std::array<double, 3> simulated_n{};   ///< the simulation's force on the user
+    bool render = false;                   ///< the simulated force may be sent
+    std::array<double, 3> position_m{};    ///< the device's newest received position
+    bool have_position = false;
+    std::array<double, 3> inward_normal{};  ///< the contact surface's, into the object (0: none)
+  };
+
+  PortGuard(const PortGuardSettings& settings, double period_s) noexcept;
+
+  Output Period(const Input& in) noexcept;
+
+  /** Clears a latched fault: the caller has restarted the simulation from rest and the tool is
+   * out of contact. The next engagement ramps from zero. */
+  void Rearm() noexcept;
+
+  /** The simulation restarted under the force being sent (new regions, a reset): move to its new
+   * force at the engage rate, as after any engagement. */
+  void Reengage() noexcept { engaging_ = true; }
+
+  bool latched() const noexcept { return latched_; }
+  /** Energy the port has absorbed since the current engagement began, J (the observer's E). */
+  double port_energy_j() const noexcept { return energy_j_; }
+  /** Energy the passivity controller has dissipated since construction, J. */
+  double dissipated_j() const noexcept { return dissipated_j_; }
+  const PortGuardSettings& settings() const noexcept { return settings_; }
+
+  /** Periods the controller's velocity estimate spans (the device's jitter averages out). */
+  static constexpr int kVelocityPeriods = 4;
+
+ private:
+  void Latch(Fault fault, Output* out) noexcept;
+  std::array<double, 3> PredictedStep() const noexcept;
+
+  PortGuardSettings settings_;
+  double period_ms_;
+  bool latched_ = false;
+  std::array<double, 3> sent_{};       // the force sent last period
+  bool engaging_ = false;              // ramping towards the target at the engage rate
+  double energy_j_ = 0;                // the observer's E since the engagement began
+  double dissipated_j_ = 0;
+  std::int64_t last_now_ns_ = 0;
+  // The newest kVelocityPeriods + 1 received positions, one per period (a ring).
+  std::array<std::array<double, 3>, kVelocityPeriods + 1> positions_{};
+  int positions_held_ = 0;
+  int next_position_ = 0;
+};
+
+}  // namespace hapticsim

@@ -1,0 +1,171 @@
+// Every way back into contact ramps from zero: a new device session with the tool already inside,
+// input back after a 100 ms or 1 s gap at another depth, a re-arm after a fault, and new regions
+// while the tool presses. Each is played through hapticsimd's real primary period (contact
+// tracker, regions, port guard) on one thread, period by period; the force sent must never step
+// by more than 0.1 N between periods, never pull the tool into the surface, and come back to the
+// tissue's force afterwards (a guard that only zeroes the force would fail that).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "daemon/haptic_loop.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr double kMaxStep_n = 0.1;
+
+// The device's tip depth (z, the front face's middle) in period n, or none: nothing sent.
+using Depth = std::function<std::optional<double>(int)>;
+
+struct Played {
+  std::vector<double> force_z;  // sent, one per period
+  std::vector<std::int32_t> flags;
+  double largest_step_n = 0;
+  double most_attractive_n = 0;  // the largest +z force (pulling the tool in); 0 is right
+};
+
+// hapticsimd's threads played on this one: each period the input that arrived at its release
+// (when the device sent one), the secondary regions stepped in virtual time as far as the
+// primary's coming step needs, then the primary period. `before(n)` runs first (a supervisor).
+Played Play(HapticLoop& loop, const Depth& depth, int periods,
+            const std::function<void(int)>& before = [](int) {}, std::int64_t seq_origin = 0) {
+  auto& regions = const_cast<AsyncRegions&>(loop.regions());
+  Played played;
+  static std::int64_t release = 1'000'000'000;  // one clock across the plays of a test
+  ForceRecord record;
+  double last = 0;
+  for (int n = 0; n < periods; ++n, release += 1'000'000) {
+    before(n);
+    if (const std::optional<double> z = depth(n)) {
+      loop.OfferInput(DeviceSample{seq_origin + n, release, {0.125, 0.125, *z}, false});
+    }
+    bool may_step = true;
+    auto& live = const_cast<AsyncRegions&>(loop.regions());
+    for (int r = 1; r < live.num_regions() && may_step; ++r) may_step &= loop.SecondaryMayStep(r);
+    if (may_step) {
+      live.AdvanceSecondariesTo(live.state_ticks(kPrimaryRegion) +
+                                live.period_ticks(kPrimaryRegion));
+    }
+    loop.PrimaryPeriod(release, release);
+    while (loop.forces().Pop(&record)) {
+      const double z = record.force_n[2];
+      played.largest_step_n = std::max(played.largest_step_n, std::abs(z - last));
+      played.most_attractive_n = std::max(played.most_attractive_n, z);
+      played.force_z.push_back(z);
+      played.flags.push_back(record.flags);
+      last = z;
+    }
+  }
+  (void)regions;
+  return played;
+}
+
+Scene DefaultScene() {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  scene.adaptivity.secondary_lod = 2;
+  scene.adaptivity.secondary_rate_hz = 1000;
+  return scene;
+}
+
+// Above the surface for 50 ms, then in to `depth` at 10 mm/s and held.
+Depth PressTo(double depth_m) {
+  return [depth_m](int n) -> std::optional<double> {
+    if (n < 50) return -0.002;
+    return std::min(depth_m, 1e-5 * (n - 50));
+  };
+}
+
+// The force a tool held at `depth_m` settles to, pressed in smoothly (the reference for "the
+// force came back").
+double SettledForce(double depth_m) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  return Play(loop, PressTo(depth_m), 2500).force_z.back();
+}
+
+void ExpectSmooth(const Played& played, const std::string& what) {
+  EXPECT_LE(played.largest_step_n, kMaxStep_n) << what;
+  EXPECT_LE(played.most_attractive_n, 1e-12) << what << ": a force pulling the tool in";
+}
+
+class StaleGap : public ::testing::TestWithParam<int> {};
+
+TEST_P(StaleGap, InputBackAtAnotherDepthRampsFromZeroAndTheForceComesBack) {
+  const int gap = GetParam();  // periods without input
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  // Pressed to 5 mm and held; silent for the gap; back 8 mm in (the hand moved meanwhile).
+  const int silent_from = 1000, back_at = silent_from + gap;
+  const Played played = Play(
+      loop,
+      [&](int n) -> std::optional<double> {
+        if (n >= silent_from && n < back_at) return std::nullopt;
+        return n < back_at ? PressTo(0.005)(n) : 0.008;
+      },
+      back_at + 1500);
+  ExpectSmooth(played, "gap of " + std::to_string(gap) + " ms");
+  const bool stale_seen = std::any_of(played.flags.begin(), played.flags.end(),
+                                      [](std::int32_t f) { return f & force_flags::kInputStale; });
+  EXPECT_TRUE(stale_seen);
+  EXPECT_NEAR(played.force_z.back(), SettledForce(0.008), 0.02 * std::abs(SettledForce(0.008)));
+  EXPECT_LT(played.force_z.back(), -0.5);  // 8 mm in pushes back
+}
+
+INSTANTIATE_TEST_SUITE_P(Gaps, StaleGap, ::testing::Values(100, 1000));
+
+TEST(Engagement, ANewSessionWithTheToolInsideRampsInFromZero) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  // A first session touches and leaves.
+  Play(loop, [](int n) -> std::optional<double> { return n < 300 ? PressTo(0.002)(n) : -0.002; },
+       600);
+  // 0.5 s of silence, then a new driver (its seq from 0 again) with the tool 1 cm in.
+  Play(loop, [](int) -> std::optional<double> { return std::nullopt; }, 500);
+  const Played played =
+      Play(loop, [](int) -> std::optional<double> { return 0.01; }, 2000, [](int) {}, 0);
+  ExpectSmooth(played, "new session at 1 cm");
+  EXPECT_NEAR(played.force_z.back(), SettledForce(0.01), 0.02 * std::abs(SettledForce(0.01)));
+}
+
+TEST(Engagement, AFaultReArmsOnlyOutOfContactFromRestAndThenRampsIn) {
+  HapticLoop::Options options;
+  options.port.max_force_n = 0.5;
+  options.port.fault_force_n = 0.6;  // a 1 cm press gives about 1.3 N: a fault on the way in
+  HapticLoop loop(DefaultScene(), options);
+  bool restarted = false;
+  Played in = Play(loop, PressTo(0.01), 1500, [&](int) {
+    // The supervisor: on the fault, restart the regions from rest (as hapticsimd does).
+    if (loop.force_faults() > 0 && !restarted) {
+      loop.Reconfigure(DefaultScene());
+      restarted = true;
+    }
+  });
+  ExpectSmooth(in, "fault");
+  ASSERT_EQ(loop.force_faults(), 1);
+  EXPECT_TRUE(loop.fault_latched());
+  EXPECT_EQ(in.force_z.back(), 0.0);  // latched: zero, though the tool still presses
+  EXPECT_EQ(loop.rearms(), 0);
+  // Out of the object: re-armed. In again to 3 mm (about 0.4 N): rendered.
+  Played again = Play(loop, PressTo(0.003), 2500);
+  ExpectSmooth(again, "re-armed");
+  EXPECT_EQ(loop.rearms(), 1);
+  EXPECT_FALSE(loop.fault_latched());
+  EXPECT_NEAR(again.force_z.back(), SettledForce(0.003), 0.02 * std::abs(SettledForce(0.003)));
+}
+
+TEST(Engagement, NewRegionsWhileTheToolPressesRampInFromZero) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  Scene other = DefaultScene();
+  other.adaptivity.primary_size = 2;
+  const Played played = Play(loop, PressTo(0.006), 3000, [&](int n) {
+    if (n == 1200) loop.Reconfigure(other, /*keep_contact=*/true);
+  });
+  ExpectSmooth(played, "reconfiguration in contact");
+  EXPECT_LT(played.force_z.back(), -0.5);  // pressing again
+}
+
+}  // namespace
+}  // namespace hapticsim
