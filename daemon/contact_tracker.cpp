@@ -4,6 +4,13 @@
 #include <cmath>
 
 namespace hapticsim {
+namespace {
+
+std::array<double, 3> Minus(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
+}  // namespace
 
 ContactTracker::ContactTracker(const MeshSettings& mesh, double engage_ramp_s)
     : mesh_(mesh),
@@ -36,6 +43,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
                                                std::int64_t now_ns,
                                                const std::optional<LatticeIndex>& centre) noexcept {
   tip_ = tip_m;
+  if (held_) last_tip_valid_ = false;  // a gap: its jump is the stale ramp's
   const bool after_gap = held_;
   held_ = false;
   const double edge = mesh_.edge_m;
@@ -43,6 +51,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   for (double x : tip_m) inside = inside && x > 0 && x < edge;
   if (!inside) {
     state_ = State::kFree;
+    last_tip_valid_ = false;
     std::array<double, 3> nearest = tip_m;
     for (double& x : nearest) x = std::clamp(x, 0.0, edge);
     wanted_ = NearestContactNode(nearest);
@@ -67,10 +76,26 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     const bool centred = centre && *centre == node_;
     state_ = centred ? State::kEngaged : State::kWaiting;
     ramping_ = false;
-    if (centred && depth > kDeepTouchDown_m) StartRamp({0, 0, 0}, now_ns);
+    velocity_ = {0, 0, 0};
+    if (centred && depth > kDeepTouchDown_m) StartRamp({0, 0, 0}, {0, 0, 0}, ramp_ns_, now_ns);
   } else if (after_gap && state_ == State::kEngaged) {
-    StartRamp(displacement_, now_ns);  // input back after a gap: from where the node was held
+    // Input back after a gap: from where the node was held, at rest.
+    StartRamp(displacement_, {0, 0, 0}, ramp_ns_, now_ns);
+  } else if (state_ == State::kEngaged && TipJumped(tip_m)) {
+    // Input that came late by more than the resampler continues over (a driver that stalled for
+    // a few milliseconds) moves the tip several periods' worth in one. The node catches up from
+    // its own path instead, over what is left of a ramp under way or kCatchUp_ns.
+    std::int64_t duration = kCatchUp_ns;
+    if (ramping_) duration = std::max(duration, ramp_start_ns_ + ramp_duration_ns_ - now_ns);
+    // Where the node's own path is now: on from the last period at its velocity.
+    const double dt = last_ns_ > 0 ? static_cast<double>(now_ns - last_ns_) * 1e-9 : 0.0;
+    std::array<double, 3> here = displacement_;
+    for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
+    StartRamp(here, velocity_, duration, now_ns);
   }
+  tip_step_ = last_tip_valid_ ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
+  last_tip_ = tip_m;
+  last_tip_valid_ = true;
   return Advance(now_ns, centre);
 }
 
@@ -81,10 +106,22 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
   return Advance(now_ns, centre);
 }
 
-void ContactTracker::StartRamp(const std::array<double, 3>& from_m, std::int64_t now_ns) noexcept {
+bool ContactTracker::TipJumped(const std::array<double, 3>& tip_m) const noexcept {
+  if (!last_tip_valid_) return false;
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(tip_m[c] - last_tip_[c] - tip_step_[c]) > kCatchUpJump_m) return true;
+  }
+  return false;
+}
+
+void ContactTracker::StartRamp(const std::array<double, 3>& from_m,
+                               const std::array<double, 3>& velocity_m_per_s,
+                               std::int64_t duration_ns, std::int64_t now_ns) noexcept {
   ramping_ = true;
   ramp_from_ = from_m;
+  ramp_velocity_ = velocity_m_per_s;
   ramp_start_ns_ = now_ns;
+  ramp_duration_ns_ = duration_ns;
 }
 
 ContactTracker::Contact ContactTracker::Advance(
@@ -92,7 +129,7 @@ ContactTracker::Contact ContactTracker::Advance(
   if (state_ == State::kWaiting && centre && *centre == node_) {
     // Engage late: the tip went on while the regions moved; ramp its depth in from zero.
     state_ = State::kEngaged;
-    StartRamp({0, 0, 0}, now_ns);
+    StartRamp({0, 0, 0}, {0, 0, 0}, ramp_ns_, now_ns);
   }
   Contact contact;
   if (state_ == State::kWaiting) {
@@ -103,22 +140,32 @@ ContactTracker::Contact ContactTracker::Advance(
   contact.inward_normal = inward_;
   if (held_) {  // no fresh tip: the node stays where it was
     contact.displacement_m = displacement_;
+    velocity_ = {0, 0, 0};
+    last_ns_ = now_ns;
     return contact;
   }
-  // A ramp blends from its start displacement to the tip's by a smoothstep 3τ² − 2τ³: it starts
-  // where the node was with zero velocity and ends with the tip's own, so neither the node's
-  // velocity nor its position jumps (a velocity jump is an acceleration spike, and the node's
-  // inertia would send it to the user as a force spike).
-  double weight = 1;
-  if (ramping_ && ramp_ns_ > 0) {
-    const double tau = std::min(1.0, static_cast<double>(now_ns - ramp_start_ns_) / ramp_ns_);
+  // A ramp blends from the node's own path (where it was, going on at the velocity it had) to the
+  // tip's by a smoothstep w = 3τ² − 2τ³: it starts with the node's position and velocity and
+  // ends with the tip's, so neither jumps (a velocity jump is an acceleration spike, and the
+  // node's inertia would send it to the user as a force spike).
+  double weight = 1, since_s = 0;
+  if (ramping_ && ramp_duration_ns_ > 0) {
+    const double tau =
+        std::min(1.0, static_cast<double>(now_ns - ramp_start_ns_) / ramp_duration_ns_);
     weight = tau * tau * (3 - 2 * tau);
+    since_s = static_cast<double>(now_ns - ramp_start_ns_) * 1e-9;
     if (tau >= 1) ramping_ = false;
   }
   for (int c = 0; c < 3; ++c) {
-    contact.displacement_m[c] = ramp_from_[c] + weight * (tip_[c] - entry_[c] - ramp_from_[c]);
+    const double own_path = ramp_from_[c] + ramp_velocity_[c] * since_s;
+    contact.displacement_m[c] = (1 - weight) * own_path + weight * (tip_[c] - entry_[c]);
   }
-  if (!ramping_) ramp_from_ = {0, 0, 0};
+  if (!ramping_) ramp_from_ = ramp_velocity_ = {0, 0, 0};
+  if (last_ns_ > 0 && now_ns > last_ns_) {
+    const double dt = static_cast<double>(now_ns - last_ns_) * 1e-9;
+    for (int c = 0; c < 3; ++c) velocity_[c] = (contact.displacement_m[c] - displacement_[c]) / dt;
+  }
+  last_ns_ = now_ns;
   displacement_ = contact.displacement_m;
   return contact;
 }

@@ -29,8 +29,9 @@ namespace hapticsim {
  *
  * Every other way into contact that would step the node ramps too, over the same smoothstep:
  * a touch-down found deeper than kDeepTouchDown_m (a session that begins inside the object, or a
- * tip that jumped in) ramps from zero, and fresh input after a stale gap (Hold) ramps from the
- * held displacement to the tip's.
+ * tip that jumped in) ramps from zero, fresh input after a stale gap (Hold) ramps from the
+ * held displacement to the tip's, and a tip that jumped while engaged (late input) is caught up
+ * with over kCatchUp_ns from the node's own path.
  */
 class ContactTracker {
  public:
@@ -71,6 +72,13 @@ class ContactTracker {
 
   /** A touch-down deeper than this ramps in from zero, m (a tip at 1 kHz moves far less). */
   static constexpr double kDeepTouchDown_m = 0.5e-3;
+  /**
+   * A tip whose step differs from its last step by more than this jumped (input late by more
+   * than the resampler continues over): the node catches up over kCatchUp_ns. A hand at 1 kHz
+   * changes its per-period motion by far less (a 1 cm, 1 Hz press: 0.2 µm).
+   */
+  static constexpr double kCatchUpJump_m = 50e-6;
+  static constexpr std::int64_t kCatchUp_ns = 20'000'000;
 
   /** The surface node nearest to a point on (or projected onto) the surface; never a support. */
   LatticeIndex NearestContactNode(const std::array<double, 3>& surface_point_m) const noexcept;
@@ -78,7 +86,10 @@ class ContactTracker {
  private:
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
-  void StartRamp(const std::array<double, 3>& from_m, std::int64_t now_ns) noexcept;
+  bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
+  void StartRamp(const std::array<double, 3>& from_m,
+                 const std::array<double, 3>& velocity_m_per_s, std::int64_t duration_ns,
+                 std::int64_t now_ns) noexcept;
 
   MeshSettings mesh_;
   double h_ = 0;
@@ -87,13 +98,19 @@ class ContactTracker {
   std::array<double, 3> tip_{};
   std::array<double, 3> entry_{};
   std::array<double, 3> inward_{};
-  // A ramp from ramp_from_ (zero after waiting or a deep touch-down, the held displacement after a
-  // stale gap) to the tip's displacement, started at ramp_start_ns_.
+  // A ramp from the node's own path — ramp_from_ going on at ramp_velocity_ (zero and at rest after
+  // waiting or a deep touch-down, the held displacement after a stale gap, where the node was
+  // going after a jump) — to the tip's displacement, started at ramp_start_ns_.
   bool ramping_ = false;
-  std::array<double, 3> ramp_from_{};
-  std::int64_t ramp_start_ns_ = 0;
+  std::array<double, 3> ramp_from_{}, ramp_velocity_{};
+  std::int64_t ramp_start_ns_ = 0, ramp_duration_ns_ = 0;
   bool held_ = false;  // the last period was a Hold while engaged
   std::array<double, 3> displacement_{};  // the last engaged displacement
+  std::array<double, 3> velocity_{};      // of the displacement over the last period, m/s
+  std::int64_t last_ns_ = 0;              // when displacement_ was set
+  // The tip's last fresh position and its step before that: a jump is a step unlike the last.
+  std::array<double, 3> last_tip_{}, tip_step_{};
+  bool last_tip_valid_ = false;
   LatticeIndex node_{};
   std::optional<LatticeIndex> wanted_;
 };

@@ -71,6 +71,10 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     burst_starts.push_back(std::llround(t * settings.rate_hz));
 
   SessionReport report;
+  if (settings.press_period_inputs > 0) {  // whole presses only: a partial last one is left out
+    report.press_peaks_n.assign(static_cast<std::size_t>(periods / settings.press_period_inputs),
+                                0.0);
+  }
   std::vector<std::int64_t> sent_ns(static_cast<std::size_t>(periods) + 2, 0);
   std::vector<char> bad(sent_ns.size(), 0), answered(sent_ns.size(), 0);
   std::vector<double> latencies_us, second_latencies_us;
@@ -97,8 +101,14 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
       ++report.force_out_of_contact;
     }
     if (finite) {
-      report.largest_force_n =
-          std::max(report.largest_force_n, std::hypot(a.force_n[0], a.force_n[1], a.force_n[2]));
+      const double magnitude = std::hypot(a.force_n[0], a.force_n[1], a.force_n[2]);
+      report.largest_force_n = std::max(report.largest_force_n, magnitude);
+      if (settings.press_period_inputs > 0 && a.seq >= 1) {
+        const auto press = static_cast<std::size_t>((a.seq - 1) / settings.press_period_inputs);
+        if (press < report.press_peaks_n.size()) {
+          report.press_peaks_n[press] = std::max(report.press_peaks_n[press], magnitude);
+        }
+      }
     }
     if (previous && finite) {
       report.largest_force_step_any_n = std::max(

@@ -17,6 +17,9 @@ struct SessionSettings {
   /// message that is no device input and one of another type) starting at these times, s; each
   /// lasts 8 periods and is followed by 0.1 s of silence (stale input).
   std::vector<double> bad_input_bursts_s;
+  /// A repeating press: inputs per press (seq 1 … n the first); 0: none. Each press's peak force
+  /// is reported (press_peaks_n).
+  std::int64_t press_period_inputs = 0;
 };
 
 /** Round-trip latency percentiles, µs (input sent → the first force answering it received). */
@@ -54,6 +57,7 @@ struct SessionReport {
   double largest_force_step_n = 0;        ///< between consecutive answers in contact, fresh input
   double largest_force_step_any_n = 0;    ///< between any consecutive answers
   double largest_force_n = 0;             ///< the largest force magnitude received
+  std::vector<double> press_peaks_n;      ///< each whole press's largest force (a press input)
   std::int64_t contact_answers = 0;
   std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
   std::int64_t answers_after_last_burst = 0;

@@ -23,7 +23,8 @@ constexpr double kMaxStep_n = 0.1;
 using Depth = std::function<std::optional<double>(int)>;
 
 struct Played {
-  std::vector<double> force_z;  // sent, one per period
+  std::vector<double> force_z;      // sent, one per period
+  std::vector<double> simulated_z;  // the simulation's (the black box's), one per period
   std::vector<std::int32_t> flags;
   double largest_step_n = 0;
   double most_attractive_n = 0;  // the largest +z force (pulling the tool in); 0 is right
@@ -52,6 +53,8 @@ Played Play(HapticLoop& loop, const Depth& depth, int periods,
                                 live.period_ticks(kPrimaryRegion));
     }
     loop.PrimaryPeriod(release, release);
+    BlackBoxRecord box;
+    while (loop.black_box().Pop(&box)) played.simulated_z.push_back(box.raw_force_n[2]);
     while (loop.forces().Pop(&record)) {
       const double z = record.force_n[2];
       played.largest_step_n = std::max(played.largest_step_n, std::abs(z - last));
@@ -91,6 +94,40 @@ double SettledForce(double depth_m) {
 void ExpectSmooth(const Played& played, const std::string& what) {
   EXPECT_LE(played.largest_step_n, kMaxStep_n) << what;
   EXPECT_LE(played.most_attractive_n, 1e-12) << what << ": a force pulling the tool in";
+}
+
+// On a quiet machine the guard leaves the tissue's force alone: the paper's press (1 cm, 1 Hz, from
+// 2 mm above) sends exactly the simulated force in every period the guard did not flag, and the
+// only periods it flags are those where the retracting tool would be pulled into the surface.
+TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  const double pi = 3.141592653589793;
+  const Played played = Play(
+      loop, [&](int n) -> std::optional<double> {
+        return -0.002 + 0.012 * (1 - std::cos(2 * pi * n / 1000.0)) / 2;
+      },
+      1000);
+  ASSERT_EQ(played.force_z.size(), played.simulated_z.size());
+  int limited = 0, pulling = 0;
+  double peak = 0, simulated_peak = 0;
+  for (size_t n = 0; n < played.force_z.size(); ++n) {
+    const bool acted =
+        played.flags[n] & (force_flags::kForceLimited | force_flags::kPortDissipating);
+    const bool contact = played.flags[n] & force_flags::kInContact;
+    if (contact) simulated_peak = std::max(simulated_peak, -played.simulated_z[n]);
+    peak = std::max(peak, -played.force_z[n]);
+    if (!acted && contact) EXPECT_EQ(played.force_z[n], played.simulated_z[n]) << n;
+    if (acted) {
+      ++limited;
+      pulling += played.simulated_z[n] > 0;  // the tissue would pull the tool in: cut to zero
+      EXPECT_EQ(played.force_z[n], 0.0) << n;
+    }
+  }
+  EXPECT_EQ(limited, pulling);
+  EXPECT_EQ(peak, simulated_peak);  // about 1.5 N
+  EXPECT_GT(peak, 1.3);
+  ExpectSmooth(played, "quiet press");
+  RecordProperty("periods_cut_as_pulling", limited);
 }
 
 class StaleGap : public ::testing::TestWithParam<int> {};

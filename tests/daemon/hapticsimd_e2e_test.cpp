@@ -811,6 +811,36 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
   EXPECT_EQ(shm_daemon.Wait(5), 0) << shm_daemon.Log();
 }
 
+// Accuracy under load, as on a user's desktop: ten 1 cm presses at 1 Hz over LCM, first on a quiet
+// machine, then with two busy threads at normal priority beside the daemon (no real-time
+// privileges). Every press's peak stays within 10 % of the same press's quiet peak — a guard that
+// clamped the force to zero, or a coupling that ran away, would fail — and the force never steps
+// by more than the device's slew ceiling.
+TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH}, Temp("load.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  auto presses = [&](const char* load) {
+    const auto run = testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--input", "press",
+                                          "--duration", "10", "--cpu-load", load, "--json"});
+    EXPECT_EQ(run.exit_status, 0) << run.out << run.err;
+    return nlohmann::json::parse(run.out);
+  };
+  const auto quiet = presses("0");
+  const auto loaded = presses("2");
+  ASSERT_EQ(quiet["press_peaks_n"].size(), 10u) << quiet.dump();
+  ASSERT_EQ(loaded["press_peaks_n"].size(), 10u) << loaded.dump();
+  for (int k = 0; k < 10; ++k) {
+    const double q = quiet["press_peaks_n"][k], l = loaded["press_peaks_n"][k];
+    EXPECT_GT(q, 1.3) << "press " << k;  // the default scene's 1 cm press: about 1.43–1.53 N
+    EXPECT_NEAR(l, q, 0.1 * q) << "press " << k << "\nquiet " << quiet.dump()
+                               << "\nloaded " << loaded.dump();
+  }
+  EXPECT_LE(loaded["max_force_step_in_contact_n"].get<double>(), 0.5 + 1e-9);
+  EXPECT_EQ(loaded["nonfinite_forces"], 0);
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+}
+
 // One owner of the device input: with shared memory owning it, a process that publishes device
 // input on LCM changes nothing the shared-memory driver feels, and is refused and counted.
 TEST(HapticsimdInputOwner, LcmInputIsRefusedWhileSharedMemoryOwnsTheInput) {

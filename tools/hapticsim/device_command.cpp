@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "core/error.hpp"
+#include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
 #include "tools/hapticsim/command.hpp"
@@ -23,6 +24,7 @@ struct DeviceOptions {
   device::MotionSettings motion;
   std::vector<double> at;
   double duration_s = 10;
+  int cpu_load = 0;
   std::vector<double> bad_input_at_s;
   bool json = false;
   DeviceLimits limits;
@@ -55,6 +57,10 @@ int Run(DeviceOptions o) {
   device::SessionSettings settings;
   settings.duration_s = o.duration_s;
   settings.bad_input_bursts_s = o.bad_input_at_s;
+  if (o.motion.kind == "press") {
+    settings.press_period_inputs = std::lround(settings.rate_hz / o.motion.frequency_hz);
+  }
+  const device::CpuLoad load(o.cpu_load);
   const bool terminal = isatty(STDERR_FILENO);
   const device::SessionReport report = device::RunSession(
       motion, *link, status_link.get(), settings, [&](const device::SessionReport& r) {
@@ -143,6 +149,11 @@ Command AddDeviceCommand(CLI::App& parent) {
                   "old seq; on LCM also a message of no type and one of another type), then "
                   "0.1 s of silence (stale input)")
       ->delimiter(',');
+  app->add_option("--cpu-load", options->cpu_load,
+                  "Busy threads at normal priority in this process for the whole run (a user's "
+                  "desktop)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
   app->add_flag("--json", options->json, "Print the summary as JSON");
   app->add_option("--max-p99-us", options->limits.p99_us, "Limit: p99 round trip, µs");
   app->add_option("--max-latency-us", options->limits.max_latency_us,

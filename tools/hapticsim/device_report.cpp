@@ -17,6 +17,9 @@ constexpr std::pair<std::int32_t, const char*> kFlagNames[] = {
     {force_feedback_t::FLAG_NO_ERROR_MAP, "no error map"},
     {force_feedback_t::FLAG_INPUT_REJECTED, "input rejected"},
     {force_feedback_t::FLAG_BOUNDARY_STALE, "boundary stale"},
+    {force_feedback_t::FLAG_FORCE_LIMITED, "force limited"},
+    {force_feedback_t::FLAG_PORT_DISSIPATING, "port dissipating"},
+    {force_feedback_t::FLAG_FAULT_LATCHED, "fault latched"},
 };
 
 nlohmann::json LatencyJson(const device::LatencySummary& l) {
@@ -74,9 +77,13 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
                         {"nonfinite_forces", r.nonfinite_forces},
                         {"force_out_of_contact", r.force_out_of_contact},
                         {"largest_force_step_N", r.largest_force_step_n},
+                        {"max_force_step_in_contact_n", r.largest_force_step_n},
+                        {"max_force_step_any_n", r.largest_force_step_any_n},
+                        {"max_force_n", r.largest_force_n},
                         {"contact_answers", r.contact_answers},
                         {"flags_seen", FlagNames(r.flags_seen)},
                         {"answers_after_last_bad_input", r.answers_after_last_burst}};
+  if (!r.press_peaks_n.empty()) out["press_peaks_n"] = r.press_peaks_n;
   if (r.monitor) out["lcm_monitor"] = StreamJson(*r.monitor);
   if (r.status) {
     nlohmann::json regions = nlohmann::json::array();
@@ -98,6 +105,15 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
         {"inputs_rejected", r.status->inputs_rejected},
         {"decode_errors", r.status->decode_errors},
         {"reconfigurations", r.status->reconfigurations},
+        {"input_owner", r.status->input_owner},
+        {"inputs_wrong_transport", r.status->inputs_wrong_transport},
+        {"max_force_n", r.status->max_force_n},
+        {"force_limited_periods", r.status->force_limited_periods},
+        {"port_dissipating_periods", r.status->port_dissipating_periods},
+        {"port_energy_dissipated_j", r.status->port_energy_dissipated_j},
+        {"fault_latched", r.status->fault_latched},
+        {"latched_faults", r.status->latched_faults},
+        {"fault_rearms", r.status->fault_rearms},
         {"contact_node",
          {r.status->contact_node[0], r.status->contact_node[1], r.status->contact_node[2]}},
         {"regions", regions}};
@@ -152,13 +168,30 @@ std::string ReportText(const device::SessionReport& r) {
       "%.4f N between periods in contact",
       static_cast<long long>(r.nonfinite_forces), static_cast<long long>(r.force_out_of_contact),
       r.largest_force_step_n);
-  add("  in contact                 %lld answers", static_cast<long long>(r.contact_answers));
+  add("  in contact                 %lld answers; largest force %.3f N",
+      static_cast<long long>(r.contact_answers), r.largest_force_n);
+  if (!r.press_peaks_n.empty()) {
+    std::string peaks;
+    for (double p : r.press_peaks_n) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%s%.3f", peaks.empty() ? "" : ", ", p);
+      peaks += value;
+    }
+    text << "  press peaks                " << peaks << " N\n";
+  }
   text << "  flags seen                 " << FlagNames(r.flags_seen) << "\n";
   if (r.status) {
     add("  daemon                     primary_size %d, secondary_lod %d, %.0f Hz; error %.2f %% "
         "(target %.1f %%)",
         r.status->primary_size, r.status->secondary_lod, r.status->secondary_rate_hz,
         r.status->error_percent, r.status->error_target_percent);
+    add("  daemon port guard          input from %s (%lld refused on the other transport); "
+        "%lld periods limited, %lld dissipating (%.3g J); %lld fault(s) latched, %lld re-armed",
+        r.status->input_owner.c_str(), static_cast<long long>(r.status->inputs_wrong_transport),
+        static_cast<long long>(r.status->force_limited_periods),
+        static_cast<long long>(r.status->port_dissipating_periods),
+        r.status->port_energy_dissipated_j, static_cast<long long>(r.status->latched_faults),
+        static_cast<long long>(r.status->fault_rearms));
     for (const region_status_t& region : r.status->regions) {
       add("  daemon %-19s %lld deadline misses in %lld periods, worst lateness %.0f µs",
           (region.name + " thread").c_str(), static_cast<long long>(region.deadline_misses),

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
 #include "tools/hapticsim/command.hpp"
@@ -207,16 +208,7 @@ int RunSoak(const SoakOptions& o) {
 
   // Load as on a user's desktop: busy threads at normal priority, no real-time privileges, for
   // the whole run.
-  std::atomic<bool> loading{true};
-  std::vector<std::thread> load;
-  for (int i = 0; i < o.cpu_load; ++i) {
-    load.emplace_back([&loading] {
-      volatile double sink = 0;
-      while (loading.load(std::memory_order_relaxed)) {
-        for (int k = 0; k < 100000; ++k) sink = sink + 1e-9 * k;
-      }
-    });
-  }
+  auto load = std::make_unique<device::CpuLoad>(o.cpu_load);
 
   std::vector<ResourceSample> resources;
   std::mutex resources_mutex;
@@ -266,8 +258,7 @@ int RunSoak(const SoakOptions& o) {
   if (terminal) std::fprintf(stderr, "\n");
   sampling = false;
   sampler.join();
-  loading = false;
-  for (std::thread& t : load) t.join();
+  load.reset();
   int status = 0;
   const bool stopped_in_time = stop_daemon(&status);
   const bool clean_exit = stopped_in_time && WIFEXITED(status) && WEXITSTATUS(status) == 0;
