@@ -140,6 +140,7 @@ ContactTracker::Contact ContactTracker::Advance(
   contact.inward_normal = inward_;
   if (held_) {  // no fresh tip: the node stays where it was
     contact.displacement_m = displacement_;
+    for (int c = 0; c < 3; ++c) contact.point_m[c] = entry_[c] + displacement_[c];
     velocity_ = {0, 0, 0};
     last_ns_ = now_ns;
     return contact;
@@ -167,6 +168,7 @@ ContactTracker::Contact ContactTracker::Advance(
   }
   last_ns_ = now_ns;
   displacement_ = contact.displacement_m;
+  for (int c = 0; c < 3; ++c) contact.point_m[c] = entry_[c] + displacement_[c];
   return contact;
 }
 

@@ -43,6 +43,7 @@ class ContactTracker {
     bool waiting = false;  ///< the tip is inside, on a node the regions are not centred on
     std::array<double, 3> displacement_m{};  ///< of the contact node (zero unless engaged)
     std::array<double, 3> inward_normal{};   ///< the entry face's, into the object (0: none)
+    std::array<double, 3> point_m{};  ///< where the driven node is: entry point + displacement
   };
 
   /**

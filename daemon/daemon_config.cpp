@@ -94,6 +94,7 @@ const std::map<std::string, Setter>& Setters() {
     port("device.engage_rate_n_per_ms", &PortGuardSettings::engage_rate_n_per_ms);
     port("device.fault_force_n", &PortGuardSettings::fault_force_n);
     port("device.watchdog_s", &PortGuardSettings::watchdog_s);
+    port("device.max_damping_n_s_per_m", &PortGuardSettings::max_damping_n_s_per_m);
     s["device.passivity"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
       c->port.passivity = Get<bool>(n, "device.passivity", where, "true or false");
     };
@@ -159,6 +160,9 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
           "device.fault_force_n must be from device.max_force_n to 1000 N");
   require(std::isfinite(p.watchdog_s) && p.watchdog_s >= 0.005 && p.watchdog_s <= 10,
           "device.watchdog_s must be from 0.005 to 10 s");
+  require(std::isfinite(p.max_damping_n_s_per_m) && p.max_damping_n_s_per_m >= 0 &&
+              p.max_damping_n_s_per_m <= 1000,
+          "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m");
   require(c.device_input.empty() || c.device_input == "lcm" || c.device_input == "shm",
           "device.input must be \"lcm\" or \"shm\"");
   require(c.device_input != "shm" || c.shm_enabled,
@@ -303,7 +307,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"
       << "fault_force_n = " << real(c.port.fault_force_n) << "\n"
       << "watchdog_s = " << real(c.port.watchdog_s) << "\n"
-      << "passivity = " << (c.port.passivity ? "true" : "false") << "\n\n"
+      << "passivity = " << (c.port.passivity ? "true" : "false") << "\n"
+      << "max_damping_n_s_per_m = " << real(c.port.max_damping_n_s_per_m) << "\n\n"
       << "[realtime]\nfifo_priority = " << c.fifo_priority << "\ncpus = [";
   for (size_t i = 0; i < c.cpus.size(); ++i) out << (i ? ", " : "") << c.cpus[i];
   out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n"

@@ -149,6 +149,7 @@ void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcep
 }
 
 void HapticLoop::OfferInput(const DeviceSample& sample) noexcept {
+  inputs_.Push(sample);  // full (a primary stalled for 256 inputs): the slot below still has it
   input_.Write(sample);
   // Sequentially consistent with the primary's waiting flag: either it sees this arrival before
   // it waits, or this sees it waiting and wakes it.
@@ -251,9 +252,11 @@ void HapticLoop::WaitForInput() noexcept {
 void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
   arrivals_seen_ = input_arrivals_.load();
   DeviceSample sample;
-  if (input_.Read(&sample)) {
-    if (sample.seq != last_input_.seq) tip_.Add(sample.seq, sample.received_ns, sample.position_m);
-    last_input_ = sample;
+  while (inputs_.Pop(&sample)) TakeInput(sample);
+  // The ring was full: the newest input still counts (the ones in between are lost).
+  if (inputs_.dropped() != inputs_dropped_seen_ && input_.Read(&sample)) {
+    inputs_dropped_seen_ = inputs_.dropped();
+    TakeInput(sample);
   }
   const bool have = last_input_.seq >= 0;
   const bool stale =
@@ -333,7 +336,10 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   port.now_ns = now_ns;
   port.simulated_n = {-reaction[0], -reaction[1], -reaction[2]};
   port.render = render;
-  port.position_m = last_input_.position_m;
+  // The port's motion: in contact, the contact point's path — the positions received, resampled
+  // on this period, and during an engagement ramp the ramp's, so that what the ramp stores in the
+  // tissue counts as absorbed (else a tissue engaged at depth could never push back).
+  port.position_m = contact.engaged ? contact.point_m : last_input_.position_m;
   port.have_position = have;
   port.inward_normal = contact.inward_normal;
   const PortGuard::Output sent = guard_.Period(port);
@@ -354,6 +360,9 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   ForceRecord out;
   out.period = periods_run_++;
   out.seq = last_input_.seq;
+  out.first_seq = first_taken_seq_ >= 0 && taken_in_sequence_ ? first_taken_seq_ : out.seq;
+  first_taken_seq_ = -1;
+  taken_in_sequence_ = true;
   out.utime_us = now_ns / 1000;
   out.error_percent = error_percent_.load(std::memory_order_relaxed);
   out.force_n = sent.force_n;
@@ -369,6 +378,20 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   box.error_percent = out.error_percent;
   box.flags = flags;
   black_box_.Push(box);
+}
+
+void HapticLoop::TakeInput(const DeviceSample& sample) noexcept {
+  // Arrived before the newest taken (still in the ring after an overflow took the newest): gone.
+  if (sample.received_ns < last_input_.received_ns) return;
+  if (sample.seq != last_input_.seq) {
+    tip_.Add(sample.seq, sample.received_ns, sample.position_m);
+    if (first_taken_seq_ < 0) {
+      first_taken_seq_ = sample.seq;
+    } else if (sample.seq != last_input_.seq + 1) {
+      taken_in_sequence_ = false;  // one lost between, or a restarted driver
+    }
+  }
+  last_input_ = sample;  // the same seq again: the rejected-input flag may have changed
 }
 
 void HapticLoop::UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept {

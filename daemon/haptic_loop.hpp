@@ -30,7 +30,11 @@ struct DeviceSample {
 /** One primary period's answer, as the primary thread hands it to the I/O thread. */
 struct ForceRecord {
   std::int64_t period = -1;         ///< the primary period, counting every one since the start
-  std::int64_t seq = -1;            ///< the input it answers
+  std::int64_t seq = -1;            ///< the newest input it answers
+  /// The oldest input it answers: every seq from first_seq to seq reached the primary since the
+  /// last answer and was used (the tip is resampled from all of them); first_seq = seq when one
+  /// did, or none (the same seq answered again).
+  std::int64_t first_seq = -1;
   std::int64_t utime_us = 0;        ///< CLOCK_MONOTONIC, µs
   std::array<double, 3> force_n{};  ///< on the user
   double error_percent = -1;
@@ -139,7 +143,11 @@ class HapticLoop {
   std::int64_t last_contact_ns() const { return last_contact_ns_.load(std::memory_order_relaxed); }
   bool running() const { return running_.load(); }
 
-  /** I/O thread: hands the newest accepted input to the primary (and wakes it if it waits). */
+  /**
+   * I/O thread: hands an accepted input to the primary (and wakes it if it waits). Every input
+   * offered reaches the primary in order (a ring; when the ring is full, the newest still does),
+   * and the period's answer names every input it took (ForceRecord::first_seq … seq).
+   */
   void OfferInput(const DeviceSample& sample) noexcept;
   /** True while the regions sleep at rest (not stepped; the secondary threads parked). */
   bool asleep() const { return asleep_.load(std::memory_order_relaxed); }
@@ -246,6 +254,8 @@ class HapticLoop {
   void WaitForInput() noexcept;
   // Primary thread: a newly latched fault counted, a latched one re-armed when it may be.
   void UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept;
+  // Primary thread: an input from the I/O thread (the resampler, the answers, the newest).
+  void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
   void ForgetSleep();
 
@@ -256,7 +266,8 @@ class HapticLoop {
   // [0] the primary's (kept across reconfigurations: its period never changes), then one per
   // secondary region of the installed regions.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
-  SeqlockSlot<DeviceSample> input_;
+  SpscRing<DeviceSample, 256> inputs_;  // every input offered, in order
+  SeqlockSlot<DeviceSample> input_;      // the newest, for when the ring was full
   ForceRing forces_;
   BlackBoxRing black_box_;
   std::atomic<double> error_percent_{-1};
@@ -316,6 +327,11 @@ class HapticLoop {
   PortGuard guard_;
   bool restarted_since_fault_ = false;  // the regions restarted from rest after the latch
   InputResampler tip_{1e-3, kMaxPredictedPeriods * 1e-3};  // re-made for the primary's period
+  // The inputs taken since the last answer: the oldest, and whether they came one seq after
+  // another (only then does an answer cover first_seq … seq).
+  std::int64_t first_taken_seq_ = -1;
+  bool taken_in_sequence_ = true;
+  std::size_t inputs_dropped_seen_ = 0;  // inputs_.dropped() when the primary last looked
   std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
   DeviceSample last_input_;
 };

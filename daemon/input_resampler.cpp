@@ -13,6 +13,7 @@ void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
   const double device_ns = static_cast<double>(seq) * period_ns_;
   const double latency_ns = static_cast<double>(received_ns) - device_ns;
   if (count_ > 0 && latency_ns > latency_floor_ns_ + kRelock_ns) Reset();
+  if (count_ > 1) oldest_ = before_;
   if (count_ > 0) before_ = newest_;
   latencies_ns_[next_latency_] = latency_ns;
   next_latency_ = (next_latency_ + 1) % kLatencyWindow;
@@ -20,7 +21,7 @@ void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
   latency_floor_ns_ = LatencyFloor();
   newest_ = {device_ns, position_m};
   newest_seq_ = seq;
-  count_ = std::min(count_ + 1, 2);
+  count_ = std::min(count_ + 1, 3);
 }
 
 double InputResampler::LatencyFloor() const noexcept {
@@ -47,15 +48,17 @@ double InputResampler::LatencyFloor() const noexcept {
 
 std::array<double, 3> InputResampler::TipAt(std::int64_t at_ns) const noexcept {
   if (count_ < 2) return newest_.position_m;
-  // On the device's timeline, one device period back; never before the older input, never
-  // further past the newest than the prediction may go.
+  // On the device's timeline, one device period back; never before the oldest input held, never
+  // further past the newest than the prediction may go. Between the two inputs around it.
+  const Input& first = count_ == 3 ? oldest_ : before_;
   const double t = std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
-                              before_.device_ns, newest_.device_ns + max_ahead_ns_);
-  const double u = (t - before_.device_ns) / (newest_.device_ns - before_.device_ns);
+                              first.device_ns, newest_.device_ns + max_ahead_ns_);
+  const bool early = t < before_.device_ns;
+  const Input& a = early ? oldest_ : before_;
+  const Input& b = early ? before_ : newest_;
+  const double u = (t - a.device_ns) / (b.device_ns - a.device_ns);
   std::array<double, 3> tip{};
-  for (int c = 0; c < 3; ++c) {
-    tip[c] = before_.position_m[c] + u * (newest_.position_m[c] - before_.position_m[c]);
-  }
+  for (int c = 0; c < 3; ++c) tip[c] = a.position_m[c] + u * (b.position_m[c] - a.position_m[c]);
   return tip;
 }
 

@@ -67,9 +67,11 @@ class InputResampler {
 
   double period_ns_;
   double max_ahead_ns_;
-  int count_ = 0;  // inputs held: 0, 1 (newest_ only) or 2
+  // Inputs held: 0, 1 (newest_ only), 2 or 3. Three, because two inputs that arrive together (a
+  // driver catching up) must not push out the one the tip one period back lies after.
+  int count_ = 0;
   std::int64_t newest_seq_ = 0;
-  Input newest_, before_;
+  Input newest_, before_, oldest_;
   std::array<double, kLatencyWindow> latencies_ns_{};  // received − device time, a ring
   int latencies_ = 0;                                  // how many the ring holds
   int next_latency_ = 0;                               // where the next one goes

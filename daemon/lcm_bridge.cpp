@@ -49,6 +49,7 @@ void LcmBridge::Publish(const ForceRecord& record) {
   out.utime = record.utime_us;
   out.period = record.period;
   out.seq = record.seq;
+  out.first_seq = record.first_seq;
   for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
   out.error_percent = record.error_percent;
   out.flags = record.flags;

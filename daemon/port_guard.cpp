@@ -36,6 +36,7 @@ void PortGuard::Latch(Fault fault, Output* out) noexcept {
 
 void PortGuard::Rearm() noexcept {
   latched_ = false;
+  rendering_before_ = false;
   engaging_ = false;
   energy_j_ = 0;
 }
@@ -73,6 +74,8 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
       const Vec moved{in.position_m[0] - last[0], in.position_m[1] - last[1],
                       in.position_m[2] - last[2]};
       energy_j_ -= Dot(sent_, moved);
+      // What the controller's correction kept from the user over the same motion: dissipated.
+      dissipated_j_ += Dot(correction_, moved);
     }
     positions_[next_position_] = in.position_m;
     next_position_ = (next_position_ + 1) % (kVelocityPeriods + 1);
@@ -96,7 +99,7 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
       for (double& f : target) f *= settings_.max_force_n / magnitude;
       out.limited = true;
     }
-    if (!sending && !engaging_) {
+    if (!rendering_before_ && !sending && !engaging_) {
       energy_j_ = 0;  // a new engagement: the port starts with nothing stored
       engaging_ = Norm(target) > ramp_step;
     }
@@ -116,18 +119,36 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
     }
   }
 
+  correction_ = {0, 0, 0};
   // 5. Passivity: the energy the force would give the user over the next period stays within what
-  //    the port has absorbed.
+  //    the port has absorbed. Only the force along the predicted motion changes: down to what the
+  //    budget allows, and with a deficit (E < 0) into damping — at most max_damping, so a short
+  //    predicted step cannot call for an unbounded force.
   if (rendering && settings_.passivity) {
     const Vec step = PredictedStep();
-    const double step2 = Dot(step, step);
-    const double excess = Dot(force, step) - energy_j_;
-    if (step2 > 1e-18 && excess > 0) {
-      for (int c = 0; c < 3; ++c) force[c] -= excess / step2 * step[c];
-      dissipated_j_ += excess;
-      out.dissipating = true;
+    const double length = Norm(step);
+    if (length > 1e-9) {
+      const Vec along{step[0] / length, step[1] / length, step[2] / length};
+      const double current = Dot(force, along);
+      if (current * length > energy_j_) {
+        const double damping_floor = -settings_.max_damping_n_s_per_m * length / (period_ms_ * 1e-3);
+        const double allowed = std::max(energy_j_ / length, damping_floor);
+        if (allowed < current) {
+          const Vec before = force;
+          for (int c = 0; c < 3; ++c) force[c] += (allowed - current) * along[c];
+          out.dissipating = true;
+          // Damping never pulls the tool into the surface either.
+          const double pull = Dot(force, in.inward_normal);
+          if (pull > 0) {
+            for (int c = 0; c < 3; ++c) force[c] -= pull * in.inward_normal[c];
+          }
+          for (int c = 0; c < 3; ++c) correction_[c] = before[c] - force[c];
+        }
+      }
     }
   }
+
+  rendering_before_ = rendering;
 
   // 6. Slew.
   bool within = false;

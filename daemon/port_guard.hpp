@@ -16,6 +16,7 @@ struct PortGuardSettings {
   double fault_force_n = 50.0;            ///< a simulated force above this is a divergence: fault
   double watchdog_s = 0.1;                ///< a primary gap this long while sending force: fault
   bool passivity = true;                  ///< time-domain passivity observer and controller
+  double max_damping_n_s_per_m = 10.0;    ///< the most damping the controller may add
 };
 
 /**
@@ -43,11 +44,13 @@ struct PortGuardSettings {
  *  5. Passivity (Hannaford and Ryu's time-domain passivity observer and controller, in
  *     impedance form). The observer sums the energy the port has absorbed since the engagement,
  *     E = −Σ F_sent(k−1) · (p(k) − p(k−1)), the exact work a force held over each period does on
- *     a device moving from p(k−1) to p(k). A passive environment keeps E ≥ 0. Before sending F,
- *     the controller predicts the next period's motion Δp from the last kVelocityPeriods periods;
- *     if F · Δp (the energy F would give the user) exceeds E, it adds damping along Δp that takes
- *     away exactly the excess: F ← F − ((F·Δp − E) / |Δp|²) Δp. With E < 0 (the prediction was
- *     short) the excess includes the deficit, so the observed energy returns to zero.
+ *     a contact point moving from p(k−1) to p(k). A passive environment keeps E ≥ 0. Before
+ *     sending F, the controller predicts the next period's motion Δp from the last
+ *     kVelocityPeriods periods; if F · Δp (the energy F would give the user) exceeds E, it lowers
+ *     the force along Δp so that F · Δp = E, taking away exactly the excess. With E < 0 (the
+ *     prediction was short) that is damping, bounded by max_damping_n_s_per_m: the deficit is
+ *     taken back over the next periods rather than by one unbounded force. The force it leaves
+ *     never pulls the tool into the surface.
  *  6. Slew. The change from the last force sent is at most max_force_rate_n_per_ms per period.
  *
  * Every period where 2–6 changed the force is counted as limited; dissipation by 5 is summed in
@@ -84,8 +87,12 @@ class PortGuard {
   void Rearm() noexcept;
 
   /** The simulation restarted under the force being sent (new regions, a reset): move to its new
-   * force at the engage rate, as after any engagement. */
-  void Reengage() noexcept { engaging_ = true; }
+   * force at the engage rate, as after any engagement. The contact point's path starts afresh
+   * (its jump to where the restart put it is no motion of the port). */
+  void Reengage() noexcept {
+    engaging_ = true;
+    positions_held_ = 0;
+  }
 
   bool latched() const noexcept { return latched_; }
   /** Energy the port has absorbed since the current engagement began, J (the observer's E). */
@@ -105,7 +112,9 @@ class PortGuard {
   double period_ms_;
   bool latched_ = false;
   std::array<double, 3> sent_{};       // the force sent last period
+  std::array<double, 3> correction_{};  // what the controller took off it (its damping)
   bool engaging_ = false;              // ramping towards the target at the engage rate
+  bool rendering_before_ = false;      // the last period rendered the simulated force
   double energy_j_ = 0;                // the observer's E since the engagement began
   double dissipated_j_ = 0;
   std::int64_t last_now_ns_ = 0;

@@ -9,18 +9,18 @@ ShmServer::ShmServer(const std::string& name, const std::string& group, const Me
       intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input) {}
 
 void ShmServer::PollInput() {
-  shm::ShmDeviceInput input;
-  // No consistent value (nothing written yet, or a writer died mid-write): nothing new; the
-  // primary thread sees the last input age and flags it stale.
-  if (!mapping_.segment().input.Read(&input) || input.seq == last_seq_seen_) return;
-  last_seq_seen_ = input.seq;
-  intake_.Offer(input.seq, {input.position_m[0], input.position_m[1], input.position_m[2]});
+  // Every input written since the last poll, in order. Nothing new (nothing written, or a writer
+  // that died mid-write): the primary thread sees the last input age and flags it stale.
+  inputs_.ReadNew(mapping_.segment(), [this](const shm::ShmDeviceInput& input) {
+    intake_.Offer(input.seq, {input.position_m[0], input.position_m[1], input.position_m[2]});
+  });
 }
 
 void ShmServer::Publish(const ForceRecord& record) {
   shm::ShmForceOutput out;
   out.period = record.period;
   out.seq = record.seq;
+  out.first_seq = record.first_seq;
   out.utime = record.utime_us;
   for (int c = 0; c < 3; ++c) out.force_n[c] = record.force_n[c];
   out.error_percent = record.error_percent;

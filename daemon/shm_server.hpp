@@ -26,7 +26,7 @@ class ShmServer {
  private:
   shm::MappedSegment mapping_;
   InputIntake intake_;
-  std::int64_t last_seq_seen_ = -1;
+  shm::ShmInputReader inputs_;
 };
 
 }  // namespace hapticsim

@@ -75,7 +75,8 @@ class LcmLink final : public DeviceLink {
              MonotonicNowNs(),
              {f->force[0], f->force[1], f->force[2]},
              f->error_percent,
-             f->flags};
+             f->flags,
+             f->first_seq};
     std::lock_guard lock(mutex_);
     pending_.push_back(a);
   }
@@ -114,7 +115,8 @@ class ShmLink final : public DeviceLink {
                             now,
                             {f.force_n[0], f.force_n[1], f.force_n[2]},
                             f.error_percent,
-                            f.flags});
+                            f.flags,
+                            f.first_seq});
     });
   }
   bool needs_polling() const override { return true; }

@@ -15,12 +15,13 @@ namespace hapticsim::device {
 /** One force as the device received it. */
 struct Answer {
   std::int64_t period = -1;          ///< the daemon's primary period (a gap: a lost answer)
-  std::int64_t seq = -1;             ///< the input it answers
+  std::int64_t seq = -1;             ///< the newest input it answers
   std::int64_t daemon_utime_us = 0;  ///< when the daemon computed it
   std::int64_t received_ns = 0;      ///< CLOCK_MONOTONIC at the device
   std::array<double, 3> force_n{};
   double error_percent = -1;
   std::int32_t flags = 0;
+  std::int64_t first_seq = -1;  ///< the oldest input it answers (all from first_seq to seq)
 };
 
 /** How the simulated device reaches hapticsimd: LCM or shared memory. */

@@ -125,10 +125,14 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     }
     previous = a;
     if (last_burst_end >= 0 && a.seq > last_burst_end) ++report.answers_after_last_burst;
-    if (a.seq >= 1 && a.seq < static_cast<std::int64_t>(sent_ns.size()) && !bad[a.seq] &&
-        sent_ns[a.seq] > 0 && !answered[a.seq]) {
-      answered[a.seq] = 1;
-      const double latency_us = (a.received_ns - sent_ns[a.seq]) * 1e-3;
+    // Every input the answer names (first_seq … seq: those the daemon's period took), each with
+    // its own round trip.
+    const std::int64_t first = a.first_seq >= 1 && a.first_seq <= a.seq ? a.first_seq : a.seq;
+    for (std::int64_t seq = std::max<std::int64_t>(first, 1);
+         seq <= a.seq && seq < static_cast<std::int64_t>(sent_ns.size()); ++seq) {
+      if (bad[seq] || sent_ns[seq] <= 0 || answered[seq]) continue;
+      answered[seq] = 1;
+      const double latency_us = (a.received_ns - sent_ns[seq]) * 1e-3;
       latencies_us.push_back(latency_us);
       second_latencies_us.push_back(latency_us);
       if (latency_us > period_ns * 1e-3) ++report.late_answers;

@@ -92,9 +92,13 @@ int main(int argc, char** argv) {
   shm::ShmDeviceInput slot_value;
   slot_value.seq = 3;
   slot_value.position_m[0] = slot_value.position_m[1] = 0.125;
+  // The ring's newest write is number 0, and slot 0 holds it.
   std::string input_slot(2, '\0');
-  const size_t offset = offsetof(shm::ShmSegment, input);
+  const size_t offset = offsetof(shm::ShmSegment, newest_input);
   input_slot[0] = static_cast<char>(offset >> 8), input_slot[1] = static_cast<char>(offset & 255);
+  const std::int64_t newest = 0;
+  input_slot.append(reinterpret_cast<const char*>(&newest), sizeof newest);
+  input_slot.resize(2 + offsetof(shm::ShmSegment, inputs) - offset, '\0');
   const std::uint64_t sequence = 2;  // even: a complete write
   input_slot.append(reinterpret_cast<const char*>(&sequence), sizeof sequence);
   input_slot.append(reinterpret_cast<const char*>(&slot_value), sizeof slot_value);

@@ -61,15 +61,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   close(fd);
   try {
     shm::MappedSegment mapping = shm::MappedSegment::Open(name);
-    shm::ShmDeviceInput input;
-    if (mapping.segment().input.Read(&input)) {
-      hapticsim::InputGuard guard(hapticsim::MeshSettings{}, 0.05, 5.0);
+    // The input ring read as the daemon reads it: at most kInputSlots, whatever the index says.
+    hapticsim::InputGuard guard(hapticsim::MeshSettings{}, 0.05, 5.0);
+    shm::ShmInputReader reader;
+    const int read = reader.ReadNew(mapping.segment(), [&](const shm::ShmDeviceInput& input) {
       const auto verdict = guard.Check(
           input.seq, {input.position_m[0], input.position_m[1], input.position_m[2]}, 1'000'000);
       if (verdict == hapticsim::InputRejection::kAccepted && !std::isfinite(input.position_m[0])) {
         __builtin_trap();
       }
-    }
+    });
+    if (read > shm::kInputSlots) __builtin_trap();
   } catch (const hapticsim::Error&) {
   }
   shm_unlink(name.c_str());

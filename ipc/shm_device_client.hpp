@@ -25,14 +25,22 @@ class ShmDeviceClient {
   explicit ShmDeviceClient(const std::string& name = kDefaultName)
       : mapping_(MappedSegment::Open(name)) {}
 
-  /** The tool tip (object frame, m). Only one process may write: this is a single-writer slot. */
+  /**
+   * The tool tip (object frame, m), once per device period. Only one process may write: this is a
+   * single-writer ring. Two writes in quick succession (a driver catching up) both reach the
+   * daemon, up to the ring's kInputSlots.
+   */
   void WriteInput(std::int64_t seq, std::int64_t utime_us,
                   const std::array<double, 3>& position_m) {
     ShmDeviceInput input;
     input.seq = seq;
     input.utime = utime_us;
     for (int c = 0; c < 3; ++c) input.position_m[c] = position_m[c];
-    mapping_.segment().input.Write(input);
+    ShmSegment& s = mapping_.segment();
+    const std::int64_t next = std::max<std::int64_t>(
+        0, s.newest_input.load(std::memory_order_relaxed) + 1);  // a restarted writer goes on
+    s.inputs[next % kInputSlots].Write(input);
+    s.newest_input.store(next, std::memory_order_release);
   }
   /** The newest force; false when none is available consistently yet. */
   bool ReadForce(ShmForceOutput* out) const {

@@ -6,12 +6,16 @@
 // One POSIX shared-memory object (default name "/hapticsim", in /dev/shm), created by the daemon
 // with mode 0660 (owner and the configured group; other users get nothing). Layout:
 //
-//   ShmHeader | SeqlockSlot<ShmDeviceInput> (driver writes) | SeqlockSlot<ShmForceOutput> (daemon)
+//   ShmHeader | newest_input, kInputSlots × SeqlockSlot<ShmDeviceInput> (the driver writes)
+//             | newest_output, kOutputSlots × SeqlockSlot<ShmForceOutput> (the daemon writes)
 //
-// Each slot has a single writer and holds the newest value: a seqlock over relaxed atomic words
-// (lock-free and address-free, so it works across processes). A reader that races a writer
-// retries; a writer that dies mid-write leaves an odd sequence, which readers see as "no
-// consistent value" — the daemon then treats the input as stale.
+// Both directions are rings with a single writer: write number w goes to slot w % slots, then w
+// is published as the newest. Each slot is a seqlock over relaxed atomic words (lock-free and
+// address-free, so it works across processes). A reader that races a writer retries; a writer
+// that dies mid-write leaves an odd sequence and does not publish that write, which readers see
+// as "nothing new" — the daemon then treats the input as stale. The input ring lets a driver
+// that was held up write two inputs within one of the daemon's polls without losing the first
+// (every input gets its answer); the output ring does the same for the driver.
 
 #include <atomic>
 #include <cstdint>
@@ -21,7 +25,7 @@
 namespace hapticsim::shm {
 
 inline constexpr char kMagic[8] = {'H', 'S', 'I', 'M', 'S', 'H', 'M', '1'};
-inline constexpr std::uint32_t kLayoutVersion = 2;
+inline constexpr std::uint32_t kLayoutVersion = 3;
 inline constexpr const char* kDefaultName = "/hapticsim";
 
 /** The tool tip, written by the driver every device period. Object frame, as in LCM. */
@@ -34,7 +38,8 @@ struct ShmDeviceInput {
 /** The force, written by the daemon every primary period. */
 struct ShmForceOutput {
   std::int64_t period = -1;   ///< the daemon's primary period, counting every one from 0
-  std::int64_t seq = -1;      ///< the input it answers (-1: none yet)
+  std::int64_t seq = -1;      ///< the newest input it answers (-1: none yet)
+  std::int64_t first_seq = -1;  ///< the oldest it answers: all from first_seq to seq were used
   std::int64_t utime = 0;     ///< daemon's CLOCK_MONOTONIC, µs
   double force_n[3] = {};     ///< force on the user, N
   double error_percent = -1;  ///< looked-up error, % (-1: no map)
@@ -43,6 +48,8 @@ struct ShmForceOutput {
 
 /** Answers the ring keeps: 64 ms at 1 kHz. */
 inline constexpr int kOutputSlots = 64;
+/** Inputs the ring keeps until the daemon reads them: 64 ms at 1 kHz. */
+inline constexpr int kInputSlots = 64;
 
 struct ShmHeader {
   char magic[8];
@@ -57,12 +64,45 @@ struct ShmHeader {
 
 struct ShmSegment {
   ShmHeader header;
-  alignas(64) SeqlockSlot<ShmDeviceInput> input;
+  // The driver's inputs, in a ring: its write number w goes to inputs[w % kInputSlots], then w is
+  // published as newest_input (ShmDeviceClient::WriteInput; the daemon reads with
+  // ShmInputReader).
+  alignas(64) std::atomic<std::int64_t> newest_input{-1};
+  alignas(64) SeqlockSlot<ShmDeviceInput> inputs[kInputSlots];
   // The answers, in a ring: period p's answer goes to outputs[p % kOutputSlots], then p is
   // published as newest_output. A driver descheduled for a few periods reads what it missed
   // (up to kOutputSlots periods back) instead of losing it.
   alignas(64) std::atomic<std::int64_t> newest_output{-1};
   alignas(64) SeqlockSlot<ShmForceOutput> outputs[kOutputSlots];
+};
+
+/**
+ * The daemon's side of the input ring: each call hands every input written since the last one to
+ * `each`, oldest first — at most kInputSlots (older ones were overwritten, and a ring index that
+ * a writer set wild reads no more than that either). A slot being written or torn is skipped.
+ */
+class ShmInputReader {
+ public:
+  template <typename Each>
+  int ReadNew(const ShmSegment& segment, Each each) {
+    const std::int64_t newest = segment.newest_input.load(std::memory_order_acquire);
+    // The index went back (a writer that started over, or one that had set it wild): from its
+    // newest write on.
+    if (newest < last_) last_ = newest < 0 ? -1 : newest - 1;
+    if (newest == last_) return 0;
+    const std::int64_t from =
+        last_ + 1 > newest - kInputSlots + 1 ? last_ + 1 : newest - kInputSlots + 1;
+    int read = 0;
+    for (std::int64_t w = from; w <= newest; ++w) {
+      ShmDeviceInput input;
+      if (segment.inputs[w % kInputSlots].Read(&input)) each(input), ++read;
+    }
+    last_ = newest;
+    return read;
+  }
+
+ private:
+  std::int64_t last_ = -1;
 };
 
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&

@@ -109,7 +109,7 @@ TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
       1000);
   ASSERT_EQ(played.force_z.size(), played.simulated_z.size());
   int limited = 0, pulling = 0;
-  double peak = 0, simulated_peak = 0;
+  double peak = 0, simulated_peak = 0, largest_pull = 0;
   for (size_t n = 0; n < played.force_z.size(); ++n) {
     const bool acted =
         played.flags[n] & (force_flags::kForceLimited | force_flags::kPortDissipating);
@@ -120,6 +120,7 @@ TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
     if (acted) {
       ++limited;
       pulling += played.simulated_z[n] > 0;  // the tissue would pull the tool in: cut to zero
+      largest_pull = std::max(largest_pull, played.simulated_z[n]);
       EXPECT_EQ(played.force_z[n], 0.0) << n;
     }
   }
@@ -128,6 +129,7 @@ TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
   EXPECT_GT(peak, 1.3);
   ExpectSmooth(played, "quiet press");
   RecordProperty("periods_cut_as_pulling", limited);
+  RecordProperty("largest_pull_mN", static_cast<int>(std::lround(largest_pull * 1e3)));
 }
 
 class StaleGap : public ::testing::TestWithParam<int> {};

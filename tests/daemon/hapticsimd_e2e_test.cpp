@@ -590,10 +590,13 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
   EXPECT_TRUE(pressed.flags & force_feedback_t::FLAG_IN_CONTACT) << pressed.flags;
   EXPECT_LT(pressed.force_n[2], -0.5);
 
-  // It dies between the two sequence stores of a write. (The slot's sequence is its first word,
-  // core/seqlock_slot.hpp: this store leaves it exactly as such a death does.)
+  // It dies between the two sequence stores of its next write, before publishing it. (The slot's
+  // sequence is its first word, core/seqlock_slot.hpp: this store leaves it exactly as such a
+  // death does.)
   shm::MappedSegment view = shm::MappedSegment::Open(name);
-  auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(&view.segment().input);
+  const std::int64_t next = view.segment().newest_input.load() + 1;
+  auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(
+      &view.segment().inputs[next % shm::kInputSlots]);
   sequence.store(sequence.load() + 1);
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // > stale_after_s, > a session
   shm::ShmForceOutput expired;

@@ -102,6 +102,7 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
         {"error_percent", r.status->error_percent},
         {"error_target_percent", r.status->error_target_percent},
         {"target_met", r.status->target_met},
+        {"inputs_received", r.status->inputs_received},
         {"inputs_rejected", r.status->inputs_rejected},
         {"decode_errors", r.status->decode_errors},
         {"reconfigurations", r.status->reconfigurations},

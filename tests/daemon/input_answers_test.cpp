@@ -1,0 +1,77 @@
+// Every device input gets its answer: the shared-memory input ring loses nothing a driver writes
+// in quick succession (real POSIX shared memory), and a primary period that took several inputs
+// names them all in its answer.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+#include "daemon/haptic_loop.hpp"
+#include "ipc/shm_device_client.hpp"
+
+namespace hapticsim {
+namespace {
+
+TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
+  const std::string name = "/hapticsim-ring-" + std::to_string(getpid());
+  shm::MappedSegment daemon = shm::MappedSegment::Create(name, "");
+  shm::ShmDeviceClient driver(name);
+  shm::ShmInputReader reader;
+  std::vector<std::int64_t> seen;
+  auto read = [&] {
+    return reader.ReadNew(daemon.segment(), [&](const shm::ShmDeviceInput& in) {
+      seen.push_back(in.seq);
+    });
+  };
+  EXPECT_EQ(read(), 0);
+  for (int seq = 1; seq <= 5; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});  // one poll
+  EXPECT_EQ(read(), 5);
+  EXPECT_EQ(seen, (std::vector<std::int64_t>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(read(), 0);  // nothing new
+  // A daemon that did not poll for 100 writes reads the newest kInputSlots, in order.
+  seen.clear();
+  for (int seq = 6; seq <= 105; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
+  EXPECT_EQ(read(), shm::kInputSlots);
+  EXPECT_EQ(seen.front(), 106 - shm::kInputSlots);
+  EXPECT_EQ(seen.back(), 105);
+  // A wild index from a broken writer reads at most the ring, and the ring goes on after it.
+  daemon.segment().newest_input.store(std::int64_t{1} << 62);
+  EXPECT_LE(read(), shm::kInputSlots);
+  daemon.segment().newest_input.store(105);
+  seen.clear();
+  driver.WriteInput(106, 0, {0.1, 0.1, 0.0});
+  EXPECT_EQ(read(), 1);
+  EXPECT_EQ(seen, (std::vector<std::int64_t>{106}));
+}
+
+// Through the primary period: two inputs handed over within one period are both used and both
+// named by that period's answer (first_seq … seq); before, the older one was neither.
+TEST(InputAnswers, APeriodThatTookTwoInputsAnswersBoth) {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  HapticLoop loop(scene, HapticLoop::Options{});
+  std::int64_t now = 1'000'000'000;
+  ForceRecord record;
+  std::vector<std::pair<std::int64_t, std::int64_t>> answered;  // (first_seq, seq)
+  auto period = [&] {
+    loop.PrimaryPeriod(now, now);
+    while (loop.forces().Pop(&record)) answered.emplace_back(record.first_seq, record.seq);
+    now += 1'000'000;
+  };
+  loop.OfferInput(DeviceSample{1, now, {0.125, 0.125, -0.002}, false});
+  period();
+  loop.OfferInput(DeviceSample{2, now - 500'000, {0.125, 0.125, -0.002}, false});
+  loop.OfferInput(DeviceSample{3, now, {0.125, 0.125, -0.002}, false});
+  period();
+  period();  // no input: the same one answered again, naming no other
+  loop.OfferInput(DeviceSample{4, now, {0.125, 0.125, -0.002}, false});
+  loop.OfferInput(DeviceSample{6, now, {0.125, 0.125, -0.002}, false});  // 5 never came
+  period();
+  const std::vector<std::pair<std::int64_t, std::int64_t>> expected = {
+      {1, 1}, {2, 3}, {3, 3}, {6, 6}};
+  EXPECT_EQ(answered, expected);
+}
+
+}  // namespace
+}  // namespace hapticsim
