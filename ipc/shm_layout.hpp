@@ -46,10 +46,13 @@ struct ShmForceOutput {
   std::int32_t flags = 0;     ///< force_feedback_t::FLAG_* bits
 };
 
-/** Answers the ring keeps: 64 ms at 1 kHz. */
-inline constexpr int kOutputSlots = 64;
-/** Inputs the ring keeps until the daemon reads them: 64 ms at 1 kHz. */
-inline constexpr int kInputSlots = 64;
+/**
+ * Answers the ring keeps: 256 ms at 1 kHz. A desktop with two busy threads stalls a normal-priority
+ * process for up to 100 ms now and then (measured, docs/reliability.md); 64 lost answers then.
+ */
+inline constexpr int kOutputSlots = 256;
+/** Inputs the ring keeps until the daemon reads them: 256 ms at 1 kHz, for the same stalls. */
+inline constexpr int kInputSlots = 256;
 
 struct ShmHeader {
   char magic[8];

@@ -29,20 +29,20 @@ TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
   EXPECT_EQ(read(), 5);
   EXPECT_EQ(seen, (std::vector<std::int64_t>{1, 2, 3, 4, 5}));
   EXPECT_EQ(read(), 0);  // nothing new
-  // A daemon that did not poll for 100 writes reads the newest kInputSlots, in order.
+  // A daemon that did not poll for 300 writes reads the newest kInputSlots, in order.
   seen.clear();
-  for (int seq = 6; seq <= 105; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
+  for (int seq = 6; seq <= 305; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
   EXPECT_EQ(read(), shm::kInputSlots);
-  EXPECT_EQ(seen.front(), 106 - shm::kInputSlots);
-  EXPECT_EQ(seen.back(), 105);
+  EXPECT_EQ(seen.front(), 306 - shm::kInputSlots);
+  EXPECT_EQ(seen.back(), 305);
   // A wild index from a broken writer reads at most the ring, and the ring goes on after it.
   daemon.segment().newest_input.store(std::int64_t{1} << 62);
   EXPECT_LE(read(), shm::kInputSlots);
-  daemon.segment().newest_input.store(105);
+  daemon.segment().newest_input.store(305);
   seen.clear();
-  driver.WriteInput(106, 0, {0.1, 0.1, 0.0});
+  driver.WriteInput(306, 0, {0.1, 0.1, 0.0});
   EXPECT_EQ(read(), 1);
-  EXPECT_EQ(seen, (std::vector<std::int64_t>{106}));
+  EXPECT_EQ(seen, (std::vector<std::int64_t>{306}));
 }
 
 // Through the primary period: two inputs handed over within one period are both used and both
