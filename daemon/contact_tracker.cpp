@@ -43,7 +43,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
                                                std::int64_t now_ns,
                                                const std::optional<LatticeIndex>& centre) noexcept {
   tip_ = tip_m;
-  if (held_) last_tip_valid_ = false;  // a gap: its jump is the stale ramp's
+  if (held_) fresh_tips_ = 0;  // a gap: its jump is the stale ramp's
   const bool after_gap = held_;
   held_ = false;
   const double edge = mesh_.edge_m;
@@ -51,7 +51,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   for (double x : tip_m) inside = inside && x > 0 && x < edge;
   if (!inside) {
     state_ = State::kFree;
-    last_tip_valid_ = false;
+    fresh_tips_ = 0;
     std::array<double, 3> nearest = tip_m;
     for (double& x : nearest) x = std::clamp(x, 0.0, edge);
     wanted_ = NearestContactNode(nearest);
@@ -76,7 +76,9 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     const bool centred = centre && *centre == node_;
     state_ = centred ? State::kEngaged : State::kWaiting;
     ramping_ = false;
-    velocity_ = {0, 0, 0};
+    // The node starts at rest on the surface: no velocity from an earlier contact.
+    displacement_ = velocity_ = {0, 0, 0};
+    last_ns_ = 0;
     if (centred && depth > kDeepTouchDown_m) StartRamp({0, 0, 0}, {0, 0, 0}, ramp_ns_, now_ns);
   } else if (after_gap && state_ == State::kEngaged) {
     // Input back after a gap: from where the node was held, at rest.
@@ -93,9 +95,9 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
     StartRamp(here, velocity_, duration, now_ns);
   }
-  tip_step_ = last_tip_valid_ ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
+  tip_step_ = fresh_tips_ > 0 ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
   last_tip_ = tip_m;
-  last_tip_valid_ = true;
+  fresh_tips_ = std::min(fresh_tips_ + 1, 2);
   return Advance(now_ns, centre);
 }
 
@@ -107,7 +109,7 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
 }
 
 bool ContactTracker::TipJumped(const std::array<double, 3>& tip_m) const noexcept {
-  if (!last_tip_valid_) return false;
+  if (fresh_tips_ < 2) return false;  // a step to compare with needs two tips before this one
   for (int c = 0; c < 3; ++c) {
     if (std::abs(tip_m[c] - last_tip_[c] - tip_step_[c]) > kCatchUpJump_m) return true;
   }

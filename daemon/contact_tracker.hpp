@@ -75,8 +75,8 @@ class ContactTracker {
   static constexpr double kDeepTouchDown_m = 0.5e-3;
   /**
    * A tip whose step differs from its last step by more than this jumped (input late by more
-   * than the resampler continues over): the node catches up over kCatchUp_ns. A hand at 1 kHz
-   * changes its per-period motion by far less (a 1 cm, 1 Hz press: 0.2 µm).
+   * than the resampler continues over, then caught up): the node catches up over kCatchUp_ns. A
+   * hand at 1 kHz changes its per-period motion by far less (a 1 cm, 1 Hz press: 0.2 µm).
    */
   static constexpr double kCatchUpJump_m = 50e-6;
   static constexpr std::int64_t kCatchUp_ns = 20'000'000;
@@ -110,8 +110,9 @@ class ContactTracker {
   std::array<double, 3> velocity_{};      // of the displacement over the last period, m/s
   std::int64_t last_ns_ = 0;              // when displacement_ was set
   // The tip's last fresh position and its step before that: a jump is a step unlike the last.
+  // Counted while inside without a gap (0, 1, 2: enough for a step to compare with).
   std::array<double, 3> last_tip_{}, tip_step_{};
-  bool last_tip_valid_ = false;
+  int fresh_tips_ = 0;
   LatticeIndex node_{};
   std::optional<LatticeIndex> wanted_;
 };

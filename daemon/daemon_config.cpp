@@ -147,24 +147,38 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0,
           "input.workspace_margin_m must be >= 0 m");
   const PortGuardSettings& p = c.port;
+  auto value = [](double v) { return " (it is " + FormatReal(v) + ")"; };
   require(std::isfinite(p.max_force_n) && p.max_force_n > 0 && p.max_force_n <= 100,
-          "device.max_force_n must be in (0, 100] N (desktop devices: 3–9 N peak)");
-  require(std::isfinite(p.max_force_rate_n_per_ms) && p.max_force_rate_n_per_ms > 0 &&
+          "device.max_force_n must be in (0, 100] N; desktop devices are rated 3–9 N peak" +
+              value(p.max_force_n));
+  // A release from the ceiling to zero within a second: a fault must not hold force for longer.
+  require(std::isfinite(p.max_force_rate_n_per_ms) &&
+              p.max_force_rate_n_per_ms >= p.max_force_n / 1000 &&
               p.max_force_rate_n_per_ms <= 100,
-          "device.max_force_rate_n_per_ms must be in (0, 100] N per ms");
-  require(std::isfinite(p.engage_rate_n_per_ms) && p.engage_rate_n_per_ms > 0 &&
+          "device.max_force_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
+              FormatReal(p.max_force_n / 1000) + ") to 100 N per ms" +
+              value(p.max_force_rate_n_per_ms));
+  require(std::isfinite(p.engage_rate_n_per_ms) &&
+              p.engage_rate_n_per_ms >= p.max_force_n / 1000 &&
               p.engage_rate_n_per_ms <= p.max_force_rate_n_per_ms,
-          "device.engage_rate_n_per_ms must be > 0 and at most device.max_force_rate_n_per_ms");
+          "device.engage_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
+              FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
+              FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" +
+              value(p.engage_rate_n_per_ms));
   require(std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n &&
               p.fault_force_n <= 1000,
-          "device.fault_force_n must be from device.max_force_n to 1000 N");
-  require(std::isfinite(p.watchdog_s) && p.watchdog_s >= 0.005 && p.watchdog_s <= 10,
-          "device.watchdog_s must be from 0.005 to 10 s");
+          "device.fault_force_n must be from device.max_force_n (" + FormatReal(p.max_force_n) +
+              ") to 1000 N" + value(p.fault_force_n));
+  require(std::isfinite(p.watchdog_s) && p.watchdog_s >= 0.05 && p.watchdog_s <= 10,
+          "device.watchdog_s must be from 0.05 to 10 s (a loaded desktop stalls a process for "
+          "up to 0.1 s)" +
+              value(p.watchdog_s));
   require(std::isfinite(p.max_damping_n_s_per_m) && p.max_damping_n_s_per_m >= 0 &&
               p.max_damping_n_s_per_m <= 1000,
-          "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m");
+          "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m" +
+              value(p.max_damping_n_s_per_m));
   require(c.device_input.empty() || c.device_input == "lcm" || c.device_input == "shm",
-          "device.input must be \"lcm\" or \"shm\"");
+          "device.input must be \"lcm\" or \"shm\" (it is \"" + c.device_input + "\")");
   require(c.device_input != "shm" || c.shm_enabled,
           "device.input = \"shm\" needs shm.enabled = true");
   require(c.device_input != "lcm" || c.lcm_enabled,

@@ -149,8 +149,10 @@ void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcep
 }
 
 void HapticLoop::OfferInput(const DeviceSample& sample) noexcept {
-  inputs_.Push(sample);  // full (a primary stalled for 256 inputs): the slot below still has it
+  // The slot first: a primary that sees the ring's drop count move then finds this input (or a
+  // newer one) in it. A full ring (a primary stalled for 256 inputs) drops it; the slot has it.
   input_.Write(sample);
+  inputs_.Push(sample);
   // Sequentially consistent with the primary's waiting flag: either it sees this arrival before
   // it waits, or this sees it waiting and wakes it.
   input_arrivals_.fetch_add(1);
@@ -252,7 +254,8 @@ void HapticLoop::WaitForInput() noexcept {
 void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
   arrivals_seen_ = input_arrivals_.load();
   DeviceSample sample;
-  while (inputs_.Pop(&sample)) TakeInput(sample);
+  // At most the ring's worth: a producer pushing as fast as this pops cannot hold the period.
+  for (int n = 0; n < 256 && inputs_.Pop(&sample); ++n) TakeInput(sample);
   // The ring was full: the newest input still counts (the ones in between are lost).
   if (inputs_.dropped() != inputs_dropped_seen_ && input_.Read(&sample)) {
     inputs_dropped_seen_ = inputs_.dropped();
@@ -336,6 +339,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   port.now_ns = now_ns;
   port.simulated_n = {-reaction[0], -reaction[1], -reaction[2]};
   port.render = render;
+  port.engaged = contact.engaged;
   // The port's motion: in contact, the contact point's path — the positions received, resampled
   // on this period, and during an engagement ramp the ramp's, so that what the ramp stores in the
   // tissue counts as absorbed (else a tissue engaged at depth could never push back).

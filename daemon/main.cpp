@@ -189,7 +189,7 @@ int Serve(const Arguments& args) {
                  config.shm_group.empty() ? "" : ", group " + config.shm_group);
   }
   if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");
-  spdlog::info(
+  if (bridge || shm) spdlog::info(
       "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage "
       "ramp {} N/ms, fault above {} N or a {} s primary stall, passivity {}",
       DeviceInputOf(config) == "shm" ? "shared memory" : "LCM", config.port.max_force_n,

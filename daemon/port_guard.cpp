@@ -1,5 +1,6 @@
 #include "daemon/port_guard.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hapticsim {
@@ -41,6 +42,12 @@ void PortGuard::Rearm() noexcept {
   energy_j_ = 0;
 }
 
+void PortGuard::Reengage() noexcept {
+  engaging_ = true;
+  positions_held_ = 0;
+  energy_j_ = 0;  // the simulation restarted from rest: it stores nothing
+}
+
 Vec PortGuard::PredictedStep() const noexcept {
   if (positions_held_ <= kVelocityPeriods) return {0, 0, 0};
   const int newest = (next_position_ + kVelocityPeriods) % (kVelocityPeriods + 1);
@@ -52,108 +59,116 @@ Vec PortGuard::PredictedStep() const noexcept {
   return step;
 }
 
+void PortGuard::CheckFaults(const Input& in, Output* out) noexcept {
+  // A stalled primary (the device held the last force meanwhile), a simulated force no tissue
+  // gives.
+  if (Norm(sent_) > 0 && last_now_ns_ != 0 &&
+      static_cast<double>(in.now_ns - last_now_ns_) > settings_.watchdog_s * 1e9) {
+    Latch(Fault::kWatchdog, out);
+  }
+  if (in.render && !Finite(in.simulated_n)) Latch(Fault::kNonFinite, out);
+  if (in.render && Norm(in.simulated_n) > settings_.fault_force_n) Latch(Fault::kDivergence, out);
+}
+
+void PortGuard::Observe(const Input& in) noexcept {
+  if (in.engaged && !engaged_before_) energy_j_ = 0;  // a touch-down: nothing stored yet
+  engaged_before_ = in.engaged;
+  if (!in.have_position) return;
+  if (positions_held_ > 0) {
+    const Vec& last = positions_[(next_position_ + kVelocityPeriods) % (kVelocityPeriods + 1)];
+    const Vec moved{in.position_m[0] - last[0], in.position_m[1] - last[1],
+                    in.position_m[2] - last[2]};
+    energy_j_ -= Dot(sent_, moved);
+    // What the controller's correction kept from the user over the same motion: dissipated.
+    dissipated_j_ += Dot(correction_, moved);
+  }
+  positions_[next_position_] = in.position_m;
+  next_position_ = (next_position_ + 1) % (kVelocityPeriods + 1);
+  if (positions_held_ <= kVelocityPeriods) ++positions_held_;
+}
+
+bool PortGuard::Envelope(const Vec& normal, Vec* force) const noexcept {
+  bool limited = false;
+  const double pull = Dot(*force, normal);  // unilateral: no pull into the surface
+  if (pull > 0) {
+    for (int c = 0; c < 3; ++c) (*force)[c] -= pull * normal[c];
+    limited = true;
+  }
+  const double magnitude = Norm(*force);
+  if (magnitude > settings_.max_force_n) {
+    for (double& f : *force) f *= settings_.max_force_n / magnitude;
+    limited = true;
+  }
+  return limited;
+}
+
+bool PortGuard::Dissipate(const Vec& normal, double period_s, Vec* force) noexcept {
+  correction_ = {0, 0, 0};
+  const Vec step = PredictedStep();
+  const double length = Norm(step);
+  if (length <= 1e-9) return false;  // a tool held still takes no energy, whatever the force
+  const Vec along{step[0] / length, step[1] / length, step[2] / length};
+  const double current = Dot(*force, along);
+  if (current * length <= energy_j_) return false;
+  // Down to what the budget allows; with a deficit (E < 0) that is damping, at most max_damping:
+  // a short predicted step must not call for an unbounded force.
+  const double floor = -settings_.max_damping_n_s_per_m * length / period_s;
+  const double allowed = std::max(energy_j_ / length, floor);
+  if (allowed >= current) return false;
+  const Vec before = *force;
+  for (int c = 0; c < 3; ++c) (*force)[c] += (allowed - current) * along[c];
+  Envelope(normal, force);  // damping never pulls, and stays within the ceiling
+  for (int c = 0; c < 3; ++c) correction_[c] = before[c] - (*force)[c];
+  return true;
+}
+
 PortGuard::Output PortGuard::Period(const Input& in) noexcept {
   Output out;
-  const bool sending = Norm(sent_) > 0;
-  // 1. Faults: a stalled primary (the device held the last force meanwhile) or a simulated force
-  //    no tissue gives.
-  if (sending && last_now_ns_ != 0 &&
-      static_cast<double>(in.now_ns - last_now_ns_) > settings_.watchdog_s * 1e9) {
-    Latch(Fault::kWatchdog, &out);
-  }
+  CheckFaults(in, &out);
+  // Steps and ramps are per millisecond of wall time: missed periods run back to back (within
+  // microseconds) move the force by little, not by a period's allowance each.
+  const double elapsed_ms =
+      last_now_ns_ == 0 ? period_ms_
+                        : std::clamp(static_cast<double>(in.now_ns - last_now_ns_) * 1e-6, 0.0,
+                                     period_ms_);
   last_now_ns_ = in.now_ns;
-  if (in.render && !Finite(in.simulated_n)) Latch(Fault::kNonFinite, &out);
-  if (in.render && Norm(in.simulated_n) > settings_.fault_force_n) {
-    Latch(Fault::kDivergence, &out);
-  }
-
-  // The observer: the work the force sent last period did on the device since.
-  if (in.have_position) {
-    if (positions_held_ > 0) {
-      const Vec& last = positions_[(next_position_ + kVelocityPeriods) % (kVelocityPeriods + 1)];
-      const Vec moved{in.position_m[0] - last[0], in.position_m[1] - last[1],
-                      in.position_m[2] - last[2]};
-      energy_j_ -= Dot(sent_, moved);
-      // What the controller's correction kept from the user over the same motion: dissipated.
-      dissipated_j_ += Dot(correction_, moved);
-    }
-    positions_[next_position_] = in.position_m;
-    next_position_ = (next_position_ + 1) % (kVelocityPeriods + 1);
-    if (positions_held_ <= kVelocityPeriods) ++positions_held_;
-  }
+  Observe(in);
 
   const bool rendering = in.render && !latched_;
-  const double ramp_step = settings_.engage_rate_n_per_ms * period_ms_;
+  const double ramp_step = settings_.engage_rate_n_per_ms * elapsed_ms;
+  double release_step = ramp_step;
   Vec target{0, 0, 0};
   if (rendering) {
     target = in.simulated_n;
-    // 2. Unilateral: no pull into the surface along its normal.
-    const double pull = Dot(target, in.inward_normal);
-    if (pull > 0) {
-      for (int c = 0; c < 3; ++c) target[c] -= pull * in.inward_normal[c];
-      out.limited = true;
-    }
-    // 3. The magnitude ceiling.
-    const double magnitude = Norm(target);
-    if (magnitude > settings_.max_force_n) {
-      for (double& f : target) f *= settings_.max_force_n / magnitude;
-      out.limited = true;
-    }
-    if (!rendering_before_ && !sending && !engaging_) {
-      energy_j_ = 0;  // a new engagement: the port starts with nothing stored
+    out.limited = Envelope(in.inward_normal, &target);
+    // Rendering again after a release that ran out: ramp in unless the force is within a step.
+    if (!rendering_before_ && Norm(sent_) == 0 && !engaging_) {
       engaging_ = Norm(target) > ramp_step;
     }
-  } else if (sending) {
-    engaging_ = true;  // releasing: to zero at the same rate
+  } else if (Norm(sent_) > 0) {
+    engaging_ = true;  // releasing: to zero
+    // Lift-off (the tool left the object) releases as fast as the slew allows; a fault, stale
+    // input or paused regions at the engage rate, since the tool may still be pressing.
+    if (!in.engaged && !latched_) release_step = settings_.max_force_rate_n_per_ms * elapsed_ms;
   }
+  rendering_before_ = rendering;
 
-  // 4. Engagement and release ramps.
   Vec force = target;
   if (engaging_) {
     bool reached = false;
-    force = StepTowards(sent_, target, ramp_step, &reached);
-    if (reached) {
-      engaging_ = false;
-    } else {
-      out.limited = true;
-    }
+    force = StepTowards(sent_, target, rendering ? ramp_step : release_step, &reached);
+    engaging_ = !reached;
+    out.limited = out.limited || !reached;
   }
-
-  correction_ = {0, 0, 0};
-  // 5. Passivity: the energy the force would give the user over the next period stays within what
-  //    the port has absorbed. Only the force along the predicted motion changes: down to what the
-  //    budget allows, and with a deficit (E < 0) into damping — at most max_damping, so a short
-  //    predicted step cannot call for an unbounded force.
   if (rendering && settings_.passivity) {
-    const Vec step = PredictedStep();
-    const double length = Norm(step);
-    if (length > 1e-9) {
-      const Vec along{step[0] / length, step[1] / length, step[2] / length};
-      const double current = Dot(force, along);
-      if (current * length > energy_j_) {
-        const double damping_floor = -settings_.max_damping_n_s_per_m * length / (period_ms_ * 1e-3);
-        const double allowed = std::max(energy_j_ / length, damping_floor);
-        if (allowed < current) {
-          const Vec before = force;
-          for (int c = 0; c < 3; ++c) force[c] += (allowed - current) * along[c];
-          out.dissipating = true;
-          // Damping never pulls the tool into the surface either.
-          const double pull = Dot(force, in.inward_normal);
-          if (pull > 0) {
-            for (int c = 0; c < 3; ++c) force[c] -= pull * in.inward_normal[c];
-          }
-          for (int c = 0; c < 3; ++c) correction_[c] = before[c] - force[c];
-        }
-      }
-    }
+    out.dissipating = Dissipate(in.inward_normal, period_ms_ * 1e-3, &force);
+  } else {
+    correction_ = {0, 0, 0};
   }
 
-  rendering_before_ = rendering;
-
-  // 6. Slew.
   bool within = false;
   const Vec slewed =
-      StepTowards(sent_, force, settings_.max_force_rate_n_per_ms * period_ms_, &within);
+      StepTowards(sent_, force, settings_.max_force_rate_n_per_ms * elapsed_ms, &within);
   if (!within) out.limited = true;
   sent_ = Finite(slewed) ? slewed : Vec{0, 0, 0};
   out.force_n = sent_;

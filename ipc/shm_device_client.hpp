@@ -11,6 +11,7 @@
 // Both calls are wait-free: no locks, no allocation, no system calls. Link hapticsim_ipc.
 
 #include <algorithm>
+#include <climits>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -37,9 +38,10 @@ class ShmDeviceClient {
     input.utime = utime_us;
     for (int c = 0; c < 3; ++c) input.position_m[c] = position_m[c];
     ShmSegment& s = mapping_.segment();
-    const std::int64_t next = std::max<std::int64_t>(
-        0, s.newest_input.load(std::memory_order_relaxed) + 1);  // a restarted writer goes on
-    s.inputs[next % kInputSlots].Write(input);
+    // A restarted writer goes on from the ring's newest write (from 0 if that is nonsense).
+    const std::int64_t newest = s.newest_input.load(std::memory_order_relaxed);
+    const std::int64_t next = newest >= 0 && newest < INT64_MAX ? newest + 1 : 0;
+    s.inputs[static_cast<std::uint64_t>(next) % kInputSlots].Write(input);
     s.newest_input.store(next, std::memory_order_release);
   }
   /** The newest force; false when none is available consistently yet. */

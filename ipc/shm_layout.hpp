@@ -81,24 +81,34 @@ struct ShmSegment {
 
 /**
  * The daemon's side of the input ring: each call hands every input written since the last one to
- * `each`, oldest first — at most kInputSlots (older ones were overwritten, and a ring index that
- * a writer set wild reads no more than that either). A slot being written or torn is skipped.
+ * `each`, oldest first. At most kInputSlots − 1: older ones were overwritten, and the slot after
+ * the newest may be being written (a reader that far behind must not read it). Whatever a broken
+ * or hostile writer sets the index to (negative, huge, going back), it reads inside the ring and
+ * at most that many slots, and then follows the writer's newest write.
  */
 class ShmInputReader {
  public:
   template <typename Each>
   int ReadNew(const ShmSegment& segment, Each each) {
     const std::int64_t newest = segment.newest_input.load(std::memory_order_acquire);
-    // The index went back (a writer that started over, or one that had set it wild): from its
-    // newest write on.
-    if (newest < last_) last_ = newest < 0 ? -1 : newest - 1;
-    if (newest == last_) return 0;
-    const std::int64_t from =
-        last_ + 1 > newest - kInputSlots + 1 ? last_ + 1 : newest - kInputSlots + 1;
+    if (newest < 0) {  // nothing written yet (or nonsense): start from the next write
+      last_ = -1;
+      return 0;
+    }
+    if (newest <= last_) {
+      if (newest < last_) last_ = newest - 1;  // went back: a writer that started over
+      if (newest == last_) return 0;
+    }
+    // How many writes since the last read, in unsigned arithmetic (no overflow), at most the
+    // ring less the slot that may be being written.
+    const std::uint64_t behind = static_cast<std::uint64_t>(newest) -
+                                 static_cast<std::uint64_t>(last_ < 0 ? -1 : last_);
+    const std::uint64_t count = behind < kInputSlots - 1 ? behind : kInputSlots - 1;
     int read = 0;
-    for (std::int64_t w = from; w <= newest; ++w) {
+    for (std::uint64_t k = count; k > 0; --k) {
+      const std::uint64_t write = static_cast<std::uint64_t>(newest) - (k - 1);
       ShmDeviceInput input;
-      if (segment.inputs[w % kInputSlots].Read(&input)) each(input), ++read;
+      if (segment.inputs[write % kInputSlots].Read(&input)) each(input), ++read;
     }
     last_ = newest;
     return read;

@@ -168,6 +168,22 @@ TEST(ContactTracker, ATipThatJumpsIsCaughtUpWithFromTheNodesOwnPath) {
   EXPECT_LT(largest_change, 40e-6);
 }
 
+TEST(ContactTracker, AFastTouchDownAndATouchAgainFollowTheTipWithoutACatchUp) {
+  // 0.1 m/s, 100 µm per period, in and out and in again: a step that is steady is no jump, and
+  // a new touch starts from rest, not with the last contact's velocity.
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  std::int64_t t = 0;
+  for (int touch = 0; touch < 2; ++touch) {
+    for (int n = -2; n <= 4; ++n) {
+      const double z = 1e-4 * n + 0.5e-4;  // first inside at 50 µm
+      const auto c = tracker.Update({0.125, 0.125, z}, t += kMs, middle);
+      if (z > 0) EXPECT_NEAR(c.displacement_m[2], z, 1e-15) << touch << " " << n;
+    }
+    for (int n = 4; n >= -2; --n) tracker.Update({0.125, 0.125, 1e-4 * n - 0.5e-4}, t += kMs, middle);
+  }
+}
+
 TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
   // A session that begins with the tool 1 cm inside (or a tip that jumped in): no step.
   ContactTracker tracker(Mesh(), 0.1);

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <climits>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,20 +31,27 @@ TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
   EXPECT_EQ(read(), 5);
   EXPECT_EQ(seen, (std::vector<std::int64_t>{1, 2, 3, 4, 5}));
   EXPECT_EQ(read(), 0);  // nothing new
-  // A daemon that did not poll for 300 writes reads the newest kInputSlots, in order.
+  // A daemon that did not poll for 300 writes reads the newest kInputSlots − 1 (the slot after
+  // the newest may be being written), in order.
   seen.clear();
   for (int seq = 6; seq <= 305; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
-  EXPECT_EQ(read(), shm::kInputSlots);
-  EXPECT_EQ(seen.front(), 306 - shm::kInputSlots);
+  EXPECT_EQ(read(), shm::kInputSlots - 1);
+  EXPECT_EQ(seen.front(), 307 - shm::kInputSlots);
   EXPECT_EQ(seen.back(), 305);
-  // A wild index from a broken writer reads at most the ring, and the ring goes on after it.
-  daemon.segment().newest_input.store(std::int64_t{1} << 62);
-  EXPECT_LE(read(), shm::kInputSlots);
-  daemon.segment().newest_input.store(305);
-  seen.clear();
-  driver.WriteInput(306, 0, {0.1, 0.1, 0.0});
-  EXPECT_EQ(read(), 1);
-  EXPECT_EQ(seen, (std::vector<std::int64_t>{306}));
+  // Wild indexes from a broken or hostile writer: inside the ring, at most the ring, and the
+  // driver's next write is read after each.
+  const std::int64_t wild[] = {std::int64_t{1} << 62, INT64_MAX, -100, INT64_MIN, 3};
+  std::int64_t seq = 306;
+  for (const std::int64_t index : wild) {
+    daemon.segment().newest_input.store(index);
+    EXPECT_LE(read(), shm::kInputSlots - 1) << index;
+    seen.clear();
+    driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
+    EXPECT_GE(read(), 1) << index;
+    ASSERT_FALSE(seen.empty()) << index;
+    EXPECT_EQ(seen.back(), seq) << index;
+    ++seq;
+  }
 }
 
 // Through the primary period: two inputs handed over within one period are both used and both

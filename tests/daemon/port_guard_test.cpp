@@ -42,6 +42,7 @@ PortRun Drive(PortGuard& guard, int periods, double amplitude_m, double frequenc
     in.now_ns = n * kPeriodNs;
     in.simulated_n = environment(position, previous_position, n);
     in.render = true;
+    in.engaged = true;
     in.position_m = position;
     in.have_position = true;
     in.inward_normal = {0, 0, 1};
@@ -172,13 +173,23 @@ TEST(PortGuard, EngagingRampsFromZeroAndReleasingRampsToZero) {
     last = sent;
     ++periods;
   };
+  in.engaged = true;
   while (last > -1.5 && periods < 1000) period(true);
   EXPECT_LE(largest_step, 0.05 + 1e-12);
   EXPECT_NEAR(periods, 30, 1);  // 1.5 N at 0.05 N per ms
-  period(false);           // the input went stale: released, by the same ramp
+  period(false);  // the input went stale, the tool still in: released by the same ramp
   EXPECT_NEAR(last, -1.45, 1e-12);
   while (last < 0 && periods < 1000) period(false);
   EXPECT_LE(largest_step, 0.05 + 1e-12);
+  // Pressing again (a new ramp in), then the tool leaves the object: it is gone, so the release
+  // runs at the slew ceiling, 0.5 N per ms.
+  while (last > -1.5 && periods < 1000) period(true);
+  in.engaged = false;
+  period(false);
+  EXPECT_NEAR(last, -1.0, 1e-12);
+  period(false);
+  period(false);
+  EXPECT_EQ(last, 0.0);
   // A normal touch-down starts from almost nothing: no ramp, the simulated force is sent as is.
   in.simulated_n = {0, 0, -0.01};
   period(true);
@@ -228,14 +239,19 @@ TEST(PortGuard, ADivergingForceAndAStalledPrimaryAreFaults) {
   in.simulated_n = {0, 0, -0.01};
   std::int64_t now = kPeriodNs;
   for (int n = 0; n < 5; ++n) in.now_ns = now += kPeriodNs, stalled.Period(in);
-  in.now_ns = now += 50 * kPeriodNs;  // late, within the watchdog
+  in.now_ns = now += 150 * kPeriodNs;  // late (a loaded desktop), within the 0.2 s watchdog
   EXPECT_EQ(stalled.Period(in).new_fault, PortGuard::Fault::kNone);
-  in.now_ns = now += 150 * kPeriodNs;  // 150 ms with the device holding the last force
+  in.now_ns = now += 250 * kPeriodNs;  // 250 ms with the device holding the last force
   EXPECT_EQ(stalled.Period(in).new_fault, PortGuard::Fault::kWatchdog);
-  // Not sending anything, a long gap is no fault (an idle primary waits for input).
+  // A force sent and then released to zero: a long gap after is no fault (an idle primary waits
+  // for input while the regions sleep).
   PortGuard idle(PortGuardSettings{}, kPeriod_s);
+  in.simulated_n = {0, 0, -1.0};
+  for (int n = 0; n < 40; ++n) in.now_ns = now += kPeriodNs, idle.Period(in);
   in.render = false;
-  idle.Period(in);
+  PortGuard::Output released;
+  for (int n = 0; n < 40; ++n) in.now_ns = now += kPeriodNs, released = idle.Period(in);
+  ASSERT_EQ(released.force_n[2], 0.0);
   in.now_ns = now += 2'000 * kPeriodNs;
   EXPECT_EQ(idle.Period(in).new_fault, PortGuard::Fault::kNone);
 }
@@ -258,6 +274,49 @@ TEST(PortGuard, TheSlewCeilingBoundsEveryChange) {
     EXPECT_LE(out.force_n[2], 0.0);  // never pulling into the surface
     last = out.force_n[2];
   }
+}
+
+TEST(PortGuard, DampingStaysWithinTheCeilingAndNeverPulls) {
+  // A deficit (the port gave more than it took, as an active environment would) with the tool
+  // moving fast: the controller's damping is bounded by max_damping, and what it leaves by the
+  // ceiling and the surface.
+  PortGuardSettings settings;
+  settings.max_damping_n_s_per_m = 1000;  // the most the config allows
+  PortGuard guard(settings, kPeriod_s);
+  PortGuard::Input in;
+  in.render = in.engaged = in.have_position = true;
+  in.inward_normal = {0, 0, 1};
+  double z = 0.0;
+  PortGuard::Output out;
+  for (int n = 0; n < 200; ++n) {
+    in.now_ns = (n + 1) * kPeriodNs;
+    z += n < 100 ? 1e-4 : -1e-3;  // in at 0.1 m/s, out at 1 m/s
+    in.position_m = {0.1, 0.1, z};
+    in.simulated_n = {0.5, 0, n < 100 ? -0.5 : -7.9};  // pushing out hard on the way out
+    out = guard.Period(in);
+    EXPECT_LE(Norm(out.force_n), settings.max_force_n + 1e-12) << n;
+    EXPECT_LE(out.force_n[2], 1e-12) << n;
+  }
+  EXPECT_GT(guard.dissipated_j(), 0.0);
+}
+
+TEST(PortGuard, PeriodsRunBackToBackMoveTheForceByItsRatePerMillisecondOfWallTime) {
+  PortGuard guard(PortGuardSettings{}, kPeriod_s);
+  PortGuard::Input in;
+  in.render = in.engaged = true;
+  in.inward_normal = {0, 0, 1};
+  in.simulated_n = {0, 0, -0.01};
+  in.now_ns = kPeriodNs;
+  guard.Period(in);
+  // Five missed periods run within 50 µs of each other, the simulation jumping 3 N meanwhile:
+  // 0.5 N per ms of wall time allows 0.025 N over those 50 µs, not 2.5 N.
+  in.simulated_n = {0, 0, -3.0};
+  PortGuard::Output out;
+  for (int n = 0; n < 5; ++n) {
+    in.now_ns = 10 * kPeriodNs + n * 10'000;
+    out = guard.Period(in);
+  }
+  EXPECT_NEAR(out.force_n[2], -0.01 - 0.5 - 4 * 0.005, 1e-9);  // the first a whole period late
 }
 
 }  // namespace

@@ -102,6 +102,7 @@ TEST(ErrorLookup, NeverAllocates) {
 }  // namespace hapticsim
 
 #include "daemon/haptic_loop.hpp"
+#include "daemon/port_guard.hpp"
 
 namespace hapticsim {
 namespace {
@@ -170,6 +171,33 @@ TEST(DaemonPrimaryPeriod, NeverAllocatesWhileThePortGuardActs) {
   EXPECT_TRUE(flags & force_flags::kForceLimited);
   EXPECT_EQ(loop.force_faults(), 1);
   EXPECT_TRUE(flags & force_flags::kFaultLatched);
+}
+
+// The port guard on its own while its passivity controller acts (an active environment: a
+// negative damper) and its envelope limits: no allocation either.
+TEST(PortGuardPeriod, NeverAllocatesWhileDissipating) {
+  PortGuardSettings settings;
+  settings.max_force_n = 1.0;
+  PortGuard guard(settings, 1e-3);
+  PortGuard::Input in;
+  in.render = in.engaged = in.have_position = true;
+  in.inward_normal = {0, 0, 1};
+  int dissipating = 0, limited = 0;
+  double previous_z = 0;
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 2000; ++n) {
+    const double z = 0.005 * (1 - std::cos(2 * 3.141592653589793 * n / 1000.0));
+    in.now_ns = (n + 1) * 1'000'000;
+    in.position_m = {0.1, 0.1, z};
+    in.simulated_n = {0, 0, -150 * z + 20 * (z - previous_z) / 1e-3};
+    previous_z = z;
+    const PortGuard::Output out = guard.Period(in);
+    dissipating += out.dissipating;
+    limited += out.limited;
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_GT(dissipating, 0);
+  EXPECT_GT(limited, 0);
 }
 
 }  // namespace

@@ -401,10 +401,12 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
   CLI::App* app = parent.add_subcommand(
       "soak",
       "Soak test: start hapticsimd and the simulated device together in a private network "
-      "namespace, run for --duration, sample the daemon's memory and CPU, inject bad input, and "
-      "check: no non-finite force, no lost or duplicated answer on shared memory, LCM loss "
-      "within budget, memory flat after the warm-up, still answering after bad input, a clean "
-      "stop. Writes soak.json and soak.html. Exit status 4 when a check fails.");
+      "namespace, run for --duration (optionally beside --cpu-load busy threads), sample the "
+      "daemon's memory and CPU, inject bad input, and check: no non-finite force, no force step "
+      "in contact above --max-force-step, no force above the device's ceiling, at least "
+      "--min-answered-percent of the inputs answered, no lost or duplicated answer on shared "
+      "memory, LCM loss within budget, memory flat after the warm-up, still answering after bad "
+      "input, a clean stop. Writes soak.json and soak.html. Exit status 4 when a check fails.");
   app->add_option("--duration", options->duration_s, "Seconds to run")->capture_default_str();
   app->add_option("--warm-up", options->warm_up_s,
                   "Seconds before memory must stay flat (default: a tenth of the run, ≥ 5 s)");
