@@ -163,7 +163,6 @@ ContactTracker::Contact ContactTracker::Advance(
     const double own_path = ramp_from_[c] + ramp_velocity_[c] * since_s;
     contact.displacement_m[c] = (1 - weight) * own_path + weight * (tip_[c] - entry_[c]);
   }
-  if (!ramping_) ramp_from_ = ramp_velocity_ = {0, 0, 0};
   if (last_ns_ > 0 && now_ns > last_ns_) {
     const double dt = static_cast<double>(now_ns - last_ns_) * 1e-9;
     for (int c = 0; c < 3; ++c) velocity_[c] = (contact.displacement_m[c] - displacement_[c]) / dt;

@@ -255,7 +255,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   arrivals_seen_ = input_arrivals_.load();
   DeviceSample sample;
   // At most the ring's worth: a producer pushing as fast as this pops cannot hold the period.
-  for (int n = 0; n < 256 && inputs_.Pop(&sample); ++n) TakeInput(sample);
+  for (std::size_t n = 0; n < kInputRingSize && inputs_.Pop(&sample); ++n) TakeInput(sample);
   // The ring was full: the newest input still counts (the ones in between are lost).
   if (inputs_.dropped() != inputs_dropped_seen_ && input_.Read(&sample)) {
     inputs_dropped_seen_ = inputs_.dropped();
@@ -347,7 +347,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   port.have_position = have;
   port.inward_normal = contact.inward_normal;
   const PortGuard::Output sent = guard_.Period(port);
-  UpdateFaultState(sent, contact.engaged);
+  UpdateFaultState(sent);
   if (sent.limited) {
     flags |= force_flags::kForceLimited;
     limited_periods_.fetch_add(1, std::memory_order_relaxed);
@@ -398,7 +398,7 @@ void HapticLoop::TakeInput(const DeviceSample& sample) noexcept {
   last_input_ = sample;  // the same seq again: the rejected-input flag may have changed
 }
 
-void HapticLoop::UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept {
+void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
   if (sent.new_fault != PortGuard::Fault::kNone) {
     last_fault_.store(static_cast<int>(sent.new_fault), std::memory_order_relaxed);
     fault_latched_.store(true, std::memory_order_relaxed);
@@ -406,7 +406,7 @@ void HapticLoop::UpdateFaultState(const PortGuard::Output& sent, bool engaged) n
     force_faults_.fetch_add(1, std::memory_order_relaxed);  // the supervisor restarts the regions
   }
   // Re-armed only from rest with the tool out of the object: the next touch engages from zero.
-  if (guard_.latched() && restarted_since_fault_ && !engaged && contact_.outside()) {
+  if (guard_.latched() && restarted_since_fault_ && contact_.outside()) {
     guard_.Rearm();
     restarted_since_fault_ = false;
     fault_latched_.store(false, std::memory_order_relaxed);

@@ -253,7 +253,7 @@ class HapticLoop {
   void WakeSecondaries(std::int64_t origin_ns) noexcept;
   void WaitForInput() noexcept;
   // Primary thread: a newly latched fault counted, a latched one re-armed when it may be.
-  void UpdateFaultState(const PortGuard::Output& sent, bool engaged) noexcept;
+  void UpdateFaultState(const PortGuard::Output& sent) noexcept;
   // Primary thread: an input from the I/O thread (the resampler, the answers, the newest).
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
@@ -266,7 +266,8 @@ class HapticLoop {
   // [0] the primary's (kept across reconfigurations: its period never changes), then one per
   // secondary region of the installed regions.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
-  SpscRing<DeviceSample, 256> inputs_;  // every input offered, in order
+  static constexpr std::size_t kInputRingSize = 256;
+  SpscRing<DeviceSample, kInputRingSize> inputs_;  // every input offered, in order
   SeqlockSlot<DeviceSample> input_;      // the newest, for when the ring was full
   ForceRing forces_;
   BlackBoxRing black_box_;

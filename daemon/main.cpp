@@ -100,7 +100,8 @@ std::string FaultName(PortGuard::Fault fault, const PortGuardSettings& port) {
     case PortGuard::Fault::kNonFinite:
       return "the simulated force is not finite";
     case PortGuard::Fault::kDivergence:
-      return fmt::format("the simulated force exceeded device.fault_force_n = {} N", port.fault_force_n);
+      return fmt::format("the simulated force exceeded device.fault_force_n = {} N",
+                         port.fault_force_n);
     case PortGuard::Fault::kWatchdog:
       return fmt::format(
           "the primary thread was stalled for more than device.watchdog_s = {} s while force "
@@ -172,6 +173,9 @@ int Serve(const Arguments& args) {
                ContactNode(config.scene)[0], ContactNode(config.scene)[1],
                ContactNode(config.scene)[2]);
 
+  const bool shm_owns_input = DeviceInputOf(config) == "shm";
+  const char* owner_name = shm_owns_input ? "shared memory" : "LCM";
+  const char* other_name = shm_owns_input ? "LCM" : "shared memory";
   InputCounters counters;
   std::unique_ptr<LcmBridge> bridge;
   if (config.lcm_enabled) {
@@ -184,17 +188,19 @@ int Serve(const Arguments& args) {
   if (config.shm_enabled) {
     shm = std::make_unique<ShmServer>(config.shm_name, config.shm_group, config.scene.mesh,
                                       config.workspace_margin_m, config.max_speed_m_per_s, loop,
-                                      counters, DeviceInputOf(config) == "shm");
+                                      counters, shm_owns_input);
     spdlog::info("shared memory /dev/shm{} (mode 0660{})", config.shm_name,
                  config.shm_group.empty() ? "" : ", group " + config.shm_group);
   }
   if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");
-  if (bridge || shm) spdlog::info(
-      "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage "
-      "ramp {} N/ms, fault above {} N or a {} s primary stall, passivity {}",
-      DeviceInputOf(config) == "shm" ? "shared memory" : "LCM", config.port.max_force_n,
-      config.port.max_force_rate_n_per_ms, config.port.engage_rate_n_per_ms,
-      config.port.fault_force_n, config.port.watchdog_s, config.port.passivity ? "on" : "off");
+  if (bridge || shm) {
+    spdlog::info(
+        "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage "
+        "ramp {} N/ms, fault above {} N or a {} s primary stall, passivity {}",
+        owner_name, config.port.max_force_n, config.port.max_force_rate_n_per_ms,
+        config.port.engage_rate_n_per_ms, config.port.fault_force_n, config.port.watchdog_s,
+        config.port.passivity ? "on" : "off");
+  }
   const std::string refused = loop.Start();
   if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
   std::atomic<bool> stop_io{false};
@@ -450,8 +456,7 @@ int Serve(const Arguments& args) {
       last_rejection_line_ns = now;
       spdlog::warn(
           "device input on {} refused: {} owns the input (device.input); {} refused so far",
-          DeviceInputOf(config) == "shm" ? "LCM" : "shared memory",
-          DeviceInputOf(config) == "shm" ? "shared memory" : "LCM", wrong_transport);
+          other_name, owner_name, wrong_transport);
       wrong_transport_seen = wrong_transport;
     }
     if (rejection != InputRejection::kAccepted) {

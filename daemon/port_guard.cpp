@@ -102,7 +102,7 @@ bool PortGuard::Envelope(const Vec& normal, Vec* force) const noexcept {
   return limited;
 }
 
-bool PortGuard::Dissipate(const Vec& normal, double period_s, Vec* force) noexcept {
+bool PortGuard::Dissipate(const Vec& normal, Vec* force) noexcept {
   correction_ = {0, 0, 0};
   const Vec step = PredictedStep();
   const double length = Norm(step);
@@ -112,7 +112,7 @@ bool PortGuard::Dissipate(const Vec& normal, double period_s, Vec* force) noexce
   if (current * length <= energy_j_) return false;
   // Down to what the budget allows; with a deficit (E < 0) that is damping, at most max_damping:
   // a short predicted step must not call for an unbounded force.
-  const double floor = -settings_.max_damping_n_s_per_m * length / period_s;
+  const double floor = -settings_.max_damping_n_s_per_m * length / (period_ms_ * 1e-3);
   const double allowed = std::max(energy_j_ / length, floor);
   if (allowed >= current) return false;
   const Vec before = *force;
@@ -161,7 +161,7 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
     out.limited = out.limited || !reached;
   }
   if (rendering && settings_.passivity) {
-    out.dissipating = Dissipate(in.inward_normal, period_ms_ * 1e-3, &force);
+    out.dissipating = Dissipate(in.inward_normal, &force);
   } else {
     correction_ = {0, 0, 0};
   }

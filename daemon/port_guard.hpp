@@ -115,7 +115,7 @@ class PortGuard {
   // Unilateral contact and the magnitude ceiling; true when either changed the force.
   bool Envelope(const Vec& normal, Vec* force) const noexcept;
   // The passivity controller; true when it took energy out.
-  bool Dissipate(const Vec& normal, double period_s, Vec* force) noexcept;
+  bool Dissipate(const Vec& normal, Vec* force) noexcept;
   Vec PredictedStep() const noexcept;
 
   PortGuardSettings settings_;
