@@ -42,7 +42,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   const int count = regions_.num_regions();
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();
-  const double tick_ns = 1e9 / static_cast<double>(regions_.ticks_per_second());
+  const double tick_ns = stretch_ * 1e9 / static_cast<double>(regions_.ticks_per_second());
   const int primary_substeps = regions_.schedule(kPrimaryRegion).substeps;
   const std::int64_t primary_period_ticks =
       regions_.period_ticks(kPrimaryRegion) * primary_substeps;
@@ -131,7 +131,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   stats_.clear();
   for (int a = 0; a < count; ++a) {
     result.wall_time_s += regions_.compute_seconds(a);
-    stats_.push_back(records[a].Summarise(1.0 / regions_.schedule(a).rate_hz));
+    stats_.push_back(records[a].Summarise(stretch_ / regions_.schedule(a).rate_hz));
   }
   return result;
 }

@@ -838,8 +838,10 @@ TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
     EXPECT_NEAR(l, q, 0.1 * q) << "press " << k << "\nquiet " << quiet.dump()
                                << "\nloaded " << loaded.dump();
   }
-  // The load bit: the round trip's tail grew (3–7 ms against under 2 ms measured quiet).
-  EXPECT_GT(loaded["latency_us"]["p99"].get<double>(), quiet["latency_us"]["p99"].get<double>());
+  // The load was there: its two threads were given CPU time (about 17 s of the 20 s two cores had,
+  // measured; a run's latencies are no proof, since a noisy machine moves the quiet run's too).
+  EXPECT_GT(loaded["cpu_load"]["cpu_s"].get<double>(), 3.0) << loaded.dump();
+  EXPECT_EQ(quiet["cpu_load"]["cpu_s"].get<double>(), 0.0);
   EXPECT_EQ(loaded["nonfinite_forces"], 0);
   EXPECT_EQ(loaded["force_out_of_contact"], 0);
   daemon.Signal(SIGTERM);

@@ -21,8 +21,10 @@ Scene Adaptive(int primary_size, int lod, double rate_hz) {
 // before it, where the virtual schedule may use the state at that time exactly. Measured: 0.006 %
 // relative L2 for two regions, 0.18 % for three (800 / 500 Hz shells). The bound, 0.5 %, is 14×
 // below the 7 % JND and well below what the adaptivity itself costs on these configurations
-// (0.4–2.8 %). A run with a missed deadline reads older snapshots still, so it is retried (the
-// machine is shared) and must then be clean.
+// (0.4–2.8 %). A run with a missed deadline reads older snapshots still, so it is retried and must
+// then be clean. The clocks run at a third of real time: who reads which snapshot does not change,
+// and a shared CI machine (measured: up to 256 misses a second at real time, in every one of 15
+// attempts) then leaves each thread three periods of slack.
 #if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;  // slowed down many times: deadlines are not the point here
 #else
@@ -39,9 +41,9 @@ TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
     const TrialResult virtual_time = regions.RunTrial();
     bool clean = false;
     std::string misses;
-    // A VM loses the CPU now and then for a millisecond: up to 15 one-second attempts.
-    for (int attempt = 0; attempt < 15 && !clean; ++attempt) {
-      RealTimeSchedule dut(regions);
+    // A VM loses the CPU now and then for milliseconds: up to 10 three-second attempts.
+    for (int attempt = 0; attempt < 10 && !clean; ++attempt) {
+      RealTimeSchedule dut(regions, /*wall_seconds_per_second=*/3.0);
       const TrialResult threaded = dut.RunTrial();
       ASSERT_EQ(threaded.samples.size(), virtual_time.samples.size());
       bool missed = false;

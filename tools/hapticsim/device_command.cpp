@@ -60,7 +60,7 @@ int Run(DeviceOptions o) {
   if (o.motion.kind == "press") {
     settings.press_period_inputs = std::lround(settings.rate_hz / o.motion.frequency_hz);
   }
-  const device::CpuLoad load(o.cpu_load);
+  device::CpuLoad load(o.cpu_load);
   const bool terminal = isatty(STDERR_FILENO);
   const device::SessionReport report = device::RunSession(
       motion, *link, status_link.get(), settings, [&](const device::SessionReport& r) {
@@ -75,11 +75,13 @@ int Run(DeviceOptions o) {
             s.latency.p99_us, s.latency.max_us);
       });
   if (terminal) std::fprintf(stderr, "\n");
+  const double load_cpu_s = load.Stop();
   const std::vector<std::string> exceeded = ExceededLimits(report, o.limits);
   if (o.json) {
     nlohmann::json out = ReportJson(report);
     out["transport"] = o.transport;
     out["input"] = o.motion.kind;
+    out["cpu_load"] = {{"threads", o.cpu_load}, {"cpu_s", load_cpu_s}};
     out["limits_met"] = exceeded.empty();
     out["limits_exceeded"] = exceeded;
     std::cout << out.dump(2) << "\n";
@@ -87,6 +89,12 @@ int Run(DeviceOptions o) {
     std::cout << "Simulated device over " << o.transport << ", " << o.motion.kind << " input, "
               << o.duration_s << " s at 1 kHz:\n"
               << ReportText(report);
+    if (o.cpu_load > 0) {
+      char line[96];
+      std::snprintf(line, sizeof line, "  cpu load                   %d busy threads, given %.1f s of CPU\n",
+                    o.cpu_load, load_cpu_s);
+      std::cout << line;
+    }
     if (exceeded.empty()) {
       std::cout << "  limits                     met\n";
     } else {

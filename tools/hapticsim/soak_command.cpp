@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -258,7 +259,7 @@ int RunSoak(const SoakOptions& o) {
   if (terminal) std::fprintf(stderr, "\n");
   sampling = false;
   sampler.join();
-  load.reset();
+  const double load_cpu_s = load->Stop();
   int status = 0;
   const bool stopped_in_time = stop_daemon(&status);
   const bool clean_exit = stopped_in_time && WIFEXITED(status) && WEXITSTATUS(status) == 0;
@@ -335,6 +336,7 @@ int RunSoak(const SoakOptions& o) {
       {"deadline_misses", misses},
       {"largest_force_step_N", report.largest_force_step_n},
       {"cpu_load_threads", o.cpu_load},
+      {"cpu_load_cpu_s", load_cpu_s},
       {"max_force_step_in_contact_n", report.largest_force_step_n},
       {"max_force_step_any_n", report.largest_force_step_any_n},
       {"max_force_step_limit_n", o.max_force_step_n},
@@ -365,7 +367,9 @@ int RunSoak(const SoakOptions& o) {
   } else {
     std::cout << "hapticsimd soak, " << o.duration_s << " s (" << o.input << " input over shared "
               << "memory, forces also watched on LCM" << (o.cpu_load ? ", " : "")
-              << (o.cpu_load ? std::to_string(o.cpu_load) + " busy threads beside" : "")
+              << (o.cpu_load ? std::to_string(o.cpu_load) + " busy threads beside, given " +
+                                   std::to_string(std::lround(load_cpu_s)) + " s of CPU"
+                             : "")
               << "): " << (passed ? "passed" : "FAILED") << "\n"
               << ReportText(report);
     std::printf(
