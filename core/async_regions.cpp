@@ -38,6 +38,32 @@ BoundaryChannel::Snapshot SnapshotOf(int width) {
   return snapshot;
 }
 
+// K of a region's own elements plus the inner region's band, for the region's own limit: with
+// the displacement exchange the region evaluates the band's force on its Γ from its own current Γ,
+// so that stiffness acts on Γ within the step, unlagged, as its own does. Construction only.
+class RegionWithInnerBand final : public StiffnessOperator {
+ public:
+  RegionWithInnerBand(const StiffnessOperator& region, const StiffnessOperator& band)
+      : StiffnessOperator(region.num_dofs()),
+        region_(region),
+        band_(band),
+        scratch_(Eigen::VectorXd::Zero(region.num_dofs())) {}
+  void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+             Eigen::Ref<Eigen::VectorXd> ku) const override {
+    ku.setZero();
+    region_.Apply(u, ku);
+    scratch_.setZero();
+    band_.Apply(u, scratch_);
+    ku += scratch_;
+  }
+  Eigen::VectorXd Diagonal() const override { return region_.Diagonal() + band_.Diagonal(); }
+
+ private:
+  const StiffnessOperator& region_;
+  const StiffnessOperator& band_;
+  mutable Eigen::VectorXd scratch_;
+};
+
 }  // namespace
 
 // Everything one region's thread touches. The link to the next region outwards (if any) is
@@ -64,6 +90,23 @@ struct AsyncRegions::Region {
   BoundaryChannel::Snapshot inner_newer, inner_older;  // read by this region's thread
   std::vector<double> inward_values, load_values;
   Eigen::VectorXd band_u, band_ku;  // for evaluating the inner region's band
+
+  // The energy balance (docs/regions.md, "Passive by construction"), J since Reset. Written by
+  // this region's thread; the *_published copies for the neighbours' threads to read.
+  double input_work = 0;          // the contact's work (primary)
+  double damping_dissipated = 0;  // material damping
+  // As the inner side of the link outwards:
+  double outer_gamma_work = 0;  // work done on this region by moving its outer Γ
+  double outward_taken = 0;     // what its controller took out for that link
+  std::atomic<double> outer_gamma_work_published{0}, outward_taken_published{0};
+  // As the outer side of the link inwards, which keeps the link's observer:
+  double inner_gamma_load_work = 0;  // work done on this region by the inner region's load
+  double inward_taken = 0;           // what its controller took out for that link
+  double excess = 0;                 // the observer (ObserveInwardLink)
+  double inner_work_seen = 0, inner_taken_seen = 0;  // the inner side's, counted in it
+  double unmet = 0;  // what its last step was asked to take out and could not
+  std::atomic<double> unmet_published{0}, inner_taken_seen_published{0};
+  double asked_inward = 0, asked_outward = 0;  // this step's requests
 };
 
 AsyncRegions::~AsyncRegions() = default;
@@ -81,10 +124,11 @@ double AsyncRegions::compute_seconds(RegionIndex region) const {
   return regions_[region]->compute_s;
 }
 
-AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety)
+AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceControl control)
     : partition_(scene),
       coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement
-                                                       : Coupling::kForce) {
+                                                       : Coupling::kForce),
+      control_(control) {
   if (!(substep_safety > 0)) throw Error("substep safety must be positive");
   const RegionPartition& p = partition_;
   const int n = p.mesh().num_dofs();
@@ -97,7 +141,11 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety)
     rates.push_back(static_cast<std::int64_t>(std::llround(rate)));
   }
   // Each region's own limit with its boundary held (outer Γ, contact, supports prescribed; the
-  // inner Γ free, carrying the mass of both sides), and the substeps that keeps it inside.
+  // inner Γ free, carrying the mass of both sides, and — with the displacement exchange — the
+  // stiffness of the inner region's band on it too: the region applies that within its step,
+  // from its own current Γ), and the substeps that keeps it inside. Measured without the band: a
+  // shell at 1000 Hz outside one at 500 Hz grew fourfold per step, its Γ past the limit the band's
+  // stiffness sets (the stress test's case 318 of seed 1).
   // Substeps are whole steps of the schedule: every substep exchanges its interfaces, so equal
   // rates with equal substeps stay exactly monolithic.
   std::vector<RegionSchedule> schedules(static_cast<size_t>(count));
@@ -105,7 +153,20 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety)
   for (int a = 0; a < count; ++a) {
     RegionSchedule& schedule = schedules[a];
     schedule.rate_hz = static_cast<double>(rates[a]);
-    schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), MaskOf(n, p.dofs(a).owned));
+    const Eigen::VectorXd owned = MaskOf(n, p.dofs(a).owned);
+    if (a > 0 && coupling_ == Coupling::kDisplacement) {
+      const ElementSetStiffness inner_band(p.mesh(), scene.material, p.outer_band_elements(a - 1));
+      // Its top eigenvalues can crowd (a stress scene took 3,000 Lanczos steps without meeting
+      // 1e-9): 1e-6 is plenty for a step limit, and the residual bound it adds keeps the
+      // estimate on the safe side.
+      EigenIterationOptions options;
+      options.relative_tolerance = 1e-6;
+      options.max_iterations = 600;
+      schedule.alone = EstimateStability(RegionWithInnerBand(p.stiffness(a), inner_band),
+                                         p.dof_mass(), owned, options);
+    } else {
+      schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), owned);
+    }
     schedule.substeps =
         std::max(1, static_cast<int>(std::ceil(1.0 / schedule.rate_hz /
                                                (substep_safety * schedule.alone.critical_dt_s))));
@@ -131,6 +192,9 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety)
     region->integrator = std::make_unique<RegionIntegrator>(
         p.stiffness(a), p.dof_mass(), scene.material.damping_per_s, dofs.owned, prescribed,
         dofs.inner_interface, period / region->schedule.substeps);
+    // The outermost region's controller damps its inner Γ; one with a link outwards (the
+    // primary, a middle shell) all its DOFs (ObserveInwardLink).
+    if (a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
 
     if (a + 1 < count) {
       region->band =
@@ -202,6 +266,7 @@ void AsyncRegions::Reset() {
     region->state_ticks = 0;
     region->compute_s = 0;
   }
+  ResetEnergyAccount();
   primary_boundary_age_s_.store(0, std::memory_order_relaxed);
   PublishInitialSnapshots();
 }
@@ -224,6 +289,7 @@ void AsyncRegions::SetRandomState(unsigned seed) {
     if (region->inward) region->inward->Clear();
     if (region->outward) region->outward->Clear();
   }
+  ResetEnergyAccount();
   PublishInitialSnapshots();
 }
 
@@ -278,14 +344,123 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
         region.load_values[i] = -region.band_ku[inner_gamma[i]];
     }
   }
-  integrator.Step(region.prescribed_values, region.load_values);
+  region.asked_inward = region.asked_outward = 0;
+  if (control_ == InterfaceControl::kPassive) {
+    if (a > 0) region.asked_inward = ObserveInwardLink(a);
+    if (region.inward) region.asked_outward = OutwardLinkExcess(a);
+  }
+  integrator.Step(region.prescribed_values, region.load_values,
+                  region.asked_inward + region.asked_outward);
   if (reaction != nullptr) {
     for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
   }
+  AccountStep(a);
   region.state_ticks += region.period_ticks;
   if (a > 0) PublishInward(a);
   if (region.inward) PublishOutward(a);
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The interface controllers. Each link between region a − 1 (inner) and region a (outer, which
+// owns their Γ) has one observer, `excess`, kept by the outer side: the energy the exchange
+// created — the inner side's work through Γ as last published, the outer side's load work — less
+// what both sides' controllers took out and kDampingCredit of the outer region's material damping.
+// Whatever is above zero comes out of the outer side's next step, as extra damping on the DOFs it
+// controls (RegionIntegrator::Step: its Γ, or, a middle shell, all its DOFs). What one step
+// cannot take (a growing mode can live inside the inner region, where Γ barely moves) the inner
+// side takes out of all its DOFs at its next step. Both may act on the same excess before each
+// has seen the other's step: more damping, never less. Credit below zero is kept down to −kCreditMemory of the outer region's energy, so
+// an interface that dissipated for an hour cannot then create an hour's worth before the
+// controllers act. Since that floor only ever raises the observer, created − taken out ≤
+// kDampingCredit × damping whatever the floor and whatever the timing: the object's energy never
+// exceeds its initial energy plus the input's work (less half the damping).
+
+// The outer side, before its step: folds in what the inner side published and returns the excess.
+double AsyncRegions::ObserveInwardLink(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  const Region& inner = *regions_[a - 1];
+  const double work = inner.outer_gamma_work_published.load(std::memory_order_relaxed);
+  const double taken = inner.outward_taken_published.load(std::memory_order_relaxed);
+  region.excess += (work - region.inner_work_seen) - (taken - region.inner_taken_seen);
+  region.inner_work_seen = work;
+  region.inner_taken_seen = taken;
+  if (region.excess < 0) {
+    const double floor = -kCreditMemory * std::max(0.0, region.integrator->DiscreteEnergy());
+    region.excess = std::max(floor, region.excess);
+  }
+  return std::max(0.0, region.excess);
+}
+
+// The inner side, before its step: what the outer side's last step could not take out, less
+// what this side has taken since the outer side counted it.
+double AsyncRegions::OutwardLinkExcess(RegionIndex a) const noexcept {
+  const Region& region = *regions_[a];
+  const Region& outer = *regions_[a + 1];
+  const double excess =
+      outer.unmet_published.load(std::memory_order_relaxed) -
+      (region.outward_taken - outer.inner_taken_seen_published.load(std::memory_order_relaxed));
+  return std::max(0.0, excess);
+}
+
+void AsyncRegions::AccountStep(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  const RegionIntegrator& integrator = *region.integrator;
+  region.damping_dissipated += integrator.DampingDissipated();
+  // What the step took out, shared between the two links in proportion to what each asked.
+  const double asked = region.asked_inward + region.asked_outward;
+  const double taken = integrator.ControlledDissipated();
+  const double taken_inward = asked > 0 ? taken * region.asked_inward / asked : 0.0;
+  if (a == kPrimaryRegion) {
+    for (int c = 0; c < 3; ++c) region.input_work += integrator.PrescribedWork(c);
+  }
+  if (a > 0) {
+    region.inner_gamma_load_work += integrator.LoadWork();
+    region.inward_taken += taken_inward;
+    region.unmet = std::max(0.0, region.asked_inward - taken_inward);
+    region.excess += integrator.LoadWork() - taken_inward -
+                     kDampingCredit * integrator.DampingDissipated();
+    region.unmet_published.store(region.unmet, std::memory_order_relaxed);
+    region.inner_taken_seen_published.store(region.inner_taken_seen, std::memory_order_relaxed);
+  }
+  if (region.inward) {
+    const size_t end = region.outer_offset + region.dofs->outer_interface.size();
+    for (size_t k = region.outer_offset; k < end; ++k) {
+      region.outer_gamma_work += integrator.PrescribedWork(static_cast<int>(k));
+    }
+    region.outward_taken += taken - taken_inward;
+    region.outer_gamma_work_published.store(region.outer_gamma_work, std::memory_order_relaxed);
+    region.outward_taken_published.store(region.outward_taken, std::memory_order_relaxed);
+  }
+}
+
+void AsyncRegions::PublishEnergyAccount(Region& region) noexcept {
+  region.outer_gamma_work_published.store(region.outer_gamma_work, std::memory_order_relaxed);
+  region.outward_taken_published.store(region.outward_taken, std::memory_order_relaxed);
+  region.unmet_published.store(region.unmet, std::memory_order_relaxed);
+  region.inner_taken_seen_published.store(region.inner_taken_seen, std::memory_order_relaxed);
+}
+
+void AsyncRegions::ResetEnergyAccount() noexcept {
+  for (auto& region : regions_) {
+    region->input_work = region->damping_dissipated = 0;
+    region->outer_gamma_work = region->outward_taken = 0;
+    region->inner_gamma_load_work = region->inward_taken = region->excess = region->unmet = 0;
+    region->inner_work_seen = region->inner_taken_seen = 0;
+    PublishEnergyAccount(*region);
+  }
+}
+
+EnergyAccount AsyncRegions::Energies() noexcept {
+  EnergyAccount account;
+  for (int a = 0; a < num_regions(); ++a) {
+    Region& region = *regions_[a];
+    account.stored_j += region.integrator->DiscreteEnergy();
+    account.input_work_j += region.input_work;
+    account.damping_dissipated_j += region.damping_dissipated;
+    account.interface_created_j += region.outer_gamma_work + region.inner_gamma_load_work;
+    account.interface_dissipated_j += region.inward_taken + region.outward_taken;
+  }
+  return account;
 }
 
 std::array<double, 3> AsyncRegions::StepPrimary(
@@ -459,7 +634,18 @@ double AsyncRegions::OrbitNorm() noexcept {
 }
 
 void AsyncRegions::ScaleAll(double factor) {
+  // Energies scale with the square of the state: so scaled, the interface controller acts on the
+  // scaled state as it would have on the original, and the period map stays homogeneous.
+  const double squared = factor * factor;
   for (auto& region : regions_) {
+    for (double* energy : {&region->input_work, &region->damping_dissipated,
+                           &region->outer_gamma_work, &region->outward_taken,
+                           &region->inner_gamma_load_work, &region->inward_taken, &region->excess,
+                           &region->unmet,
+                           &region->inner_work_seen, &region->inner_taken_seen}) {
+      *energy *= squared;
+    }
+    PublishEnergyAccount(*region);
     region->integrator->ScaleState(factor);
     if (region->inward) region->inward->ScaleAll(factor);
     if (region->outward) region->outward->ScaleAll(factor);

@@ -35,6 +35,23 @@ struct CoupledStability {
 };
 
 /**
+ * The discrete energy balance of the coupled regions since Reset, J. Exactly (to round-off)
+ *
+ *   stored − stored at Reset = input work − damping dissipated + interface created
+ *                              − interface dissipated,
+ *
+ * and the interface controllers keep interface created − interface dissipated from staying above
+ * zero, so stored ≤ stored at Reset + input work (docs/regions.md, "Passive by construction").
+ */
+struct EnergyAccount {
+  double stored_j = 0;                ///< Σ over the regions of RegionIntegrator::DiscreteEnergy
+  double input_work_j = 0;            ///< work the contact did on the object
+  double damping_dissipated_j = 0;    ///< taken out by the material's damping (≥ 0)
+  double interface_created_j = 0;     ///< net work the exchanges across every Γ did (lag: > 0)
+  double interface_dissipated_j = 0;  ///< taken out by the interface controllers (≥ 0)
+};
+
+/**
  * The object solved as asynchronous regions (see RegionPartition): the primary at the primary
  * rate 1/solver.dt, the first secondary shell at adaptivity.secondary_rate, further shells at
  * adaptivity.outer_rate, each with the substeps its own stability limit requires. Neighbouring
@@ -70,16 +87,32 @@ class AsyncRegions {
   /** Substeps keep each region's step at most this fraction of its own critical step. */
   static constexpr double kSubstepSafety = 0.95;
 
+  /** Share of its outer region's material damping an interface may spend on the energy its
+   *  exchange creates before its controller dissipates (ObserveInwardLink). */
+  static constexpr double kDampingCredit = 0.5;
+  /** The most credit an interface keeps, as a share of its outer region's energy. */
+  static constexpr double kCreditMemory = 0.1;
+
+  /**
+   * kPassive: every interface's controller keeps the exchange from adding energy (always, in
+   * the daemon and the sweep). kOff: the bare exchange, for analysis only — what the controller
+   * costs in accuracy, and the lag's own instability (docs/regions.md); no configuration file
+   * can ask for it.
+   */
+  enum class InterfaceControl { kPassive, kOff };
+
   /** What an inner region sends the outer one for Γ. */
   enum class Coupling { kForce, kDisplacement };
 
   /**
+   * control: whether the interface controllers act (InterfaceControl).
    * substep_safety: each region takes the fewest substeps that keep its step at most this
    * fraction of its own critical step. Above 1 a region may run past its limit: only the stability
    * stress test asks for that, to watch divergence being detected.
    * @throws Error for invalid adaptivity settings or a substep_safety that is not positive.
    */
-  explicit AsyncRegions(const Scene& scene, double substep_safety = kSubstepSafety);
+  explicit AsyncRegions(const Scene& scene, double substep_safety = kSubstepSafety,
+                        InterfaceControl control = InterfaceControl::kPassive);
   ~AsyncRegions();
 
   const RegionPartition& partition() const { return partition_; }
@@ -135,6 +168,12 @@ class AsyncRegions {
    */
   bool RegionAtRest(RegionIndex region, double tolerance_m) const noexcept;
 
+  /** Switches the interface controllers on or off. One thread, while no steps run. */
+  void SetInterfaceControl(InterfaceControl control) { control_ = control; }
+
+  /** The energy balance since Reset. One thread, while no steps run. */
+  EnergyAccount Energies() noexcept;
+
   /** Positive-definite energy of the coupled state (all regions), J. */
   double Energy() noexcept;
   /** Its kinetic part, ½ Σ m v² over the owned DOFs (no K·u needed), J. */
@@ -184,6 +223,11 @@ class AsyncRegions {
   void PublishOutward(RegionIndex region) noexcept;
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction) noexcept;
+  double ObserveInwardLink(RegionIndex region) noexcept;
+  double OutwardLinkExcess(RegionIndex region) const noexcept;
+  void AccountStep(RegionIndex region) noexcept;
+  void PublishEnergyAccount(Region& region) noexcept;
+  void ResetEnergyAccount() noexcept;
   void AdvanceRegionTo(RegionIndex region, std::int64_t ticks) noexcept;
   void AdvancePrimaryTo(std::int64_t ticks) noexcept;
   void ScaleAll(double factor);
@@ -200,6 +244,7 @@ class AsyncRegions {
 
   RegionPartition partition_;
   Coupling coupling_;
+  InterfaceControl control_;
   std::vector<std::unique_ptr<Region>> regions_;
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};

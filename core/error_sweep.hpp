@@ -53,14 +53,15 @@ struct SweepStats {
   std::size_t tasks = 0;                     ///< (material, configuration) tasks in this shard
   std::size_t reference_trials = 0;          ///< full-resolution runs made
   std::size_t adaptive_trials = 0;           ///< adaptive runs made
-  std::size_t stability_estimates = 0;       ///< coupled spectral radii computed
+  std::size_t stability_estimates = 0;  ///< always 0: the sweep no longer estimates (scripts read it)
   std::size_t saved_by_reference_reuse = 0;  ///< reference runs not made: one per material+input
   std::size_t saved_by_similarity = 0;  ///< adaptive runs not made: a material of equal E/ρ, ν, d
   std::size_t saved_by_linearity = 0;   ///< adaptive runs not made: other amplitudes
   std::size_t saved_by_same_regions =
       0;                                ///< adaptive runs not made: a size giving the same regions
-  std::size_t saved_by_prediction = 0;  ///< adaptive runs not made: predicted unstable
-  double reference_seconds = 0, adaptive_seconds = 0, stability_seconds = 0;  ///< CPU time
+  std::size_t saved_by_prediction = 0;  ///< always 0: nothing is refused (scripts read it)
+  double reference_seconds = 0, adaptive_seconds = 0;  ///< CPU time
+  double stability_seconds = 0;  ///< always 0, as stability_estimates
   double wall_seconds = 0;
   bool interrupted = false;
 };

@@ -17,7 +17,9 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
       prescribed_(std::move(prescribed)),
       loaded_(std::move(loaded)),
       h_(substep_s),
-      prescribed_reaction_(prescribed_.size(), 0.0) {
+      prescribed_reaction_(prescribed_.size(), 0.0),
+      prescribed_work_(prescribed_.size(), 0.0),
+      controlled_(loaded_) {
   const Eigen::Index n = stiffness.num_dofs();
   for (auto& b : buffers_) b = Eigen::VectorXd::Zero(n);
   u_previous_ = &buffers_[0];
@@ -32,6 +34,8 @@ void RegionIntegrator::Reset() {
   ku_.setZero();
   ku_valid_ = true;  // K·0 = 0: no product needed (a region put to sleep is reset in 1 kHz time)
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
+  std::fill(prescribed_work_.begin(), prescribed_work_.end(), 0.0);
+  load_work_ = damping_dissipated_ = controlled_dissipated_ = 0;
 }
 
 const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
@@ -43,18 +47,29 @@ const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
 }
 
 void RegionIntegrator::Step(std::span<const double> prescribed_next,
-                            std::span<const double> load) noexcept {
+                            std::span<const double> load, double dissipate_j) noexcept {
   assert(prescribed_next.size() == prescribed_.size() && load.size() == loaded_.size());
   const Eigen::VectorXd& ku = Forces();
   for (size_t k = 0; k < loaded_.size(); ++k) external_[loaded_[k]] = load[k];
   const double minus = 1.0 - damping_ * h_ / 2.0;
-  const double inv_plus = 1.0 / (1.0 + damping_ * h_ / 2.0);
+  const double plus = 1.0 + damping_ * h_ / 2.0;
+  const double inv_plus = 1.0 / plus;
   const double h2 = h_ * h_;
   const double* u = u_->data();
   const double* up = u_previous_->data();
   double* next = u_next_->data();
+  double swept = 0;  // Σ m (u⁺ − u⁻)² over the owned DOFs
   for (int i : owned_) {
     next[i] = (h2 / mass_[i] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
+    swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
+  }
+  controlled_dissipated_ = 0;
+  if (dissipate_j > 0 && !controlled_.empty()) swept += DampControlled(dissipate_j, plus, next, up);
+  damping_dissipated_ = damping_ * swept / (4.0 * h_);
+  load_work_ = 0;
+  for (size_t k = 0; k < loaded_.size(); ++k) {
+    const int i = loaded_[k];
+    load_work_ += load[k] * (next[i] - up[i]) / 2.0;
   }
   for (size_t k = 0; k < prescribed_.size(); ++k) {
     const int i = prescribed_[k];
@@ -62,10 +77,47 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next,
     const double m = mass_[i];
     prescribed_reaction_[k] = ku[i] + m * (next[i] - 2.0 * u[i] + up[i]) / h2 +
                               damping_ * m * (next[i] - up[i]) / (2.0 * h_);
+    prescribed_work_[k] = ku[i] * (next[i] - up[i]) / 2.0;
   }
   std::swap(u_previous_, u_);
   std::swap(u_, u_next_);
   ku_valid_ = false;
+}
+
+// Extra damping β (1/s, on the mass) on the controlled DOFs takes β·S/(b + qβ)² out of the step, with
+// S = Σ m (u⁺ − u⁻)²/(4h) at β = 0 over them, b = 1 + d·h/2 and q = h/2 (the damped update scales
+// u⁺ − u⁻ by b/(b + qβ)). That rises with β up to β = b/q, where it is S/(4bq): the most one step
+// can take. The smaller root of β·S = E·(b + qβ)², in the form that stays accurate as E → 0.
+// Returns the change of Σ m (u⁺ − u⁻)² over those DOFs, for the material damping's share.
+double RegionIntegrator::DampControlled(double dissipate_j, double plus, double* next,
+                                        const double* up) noexcept {
+  double swept = 0;
+  for (int i : controlled_) swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
+  const double s = swept / (4.0 * h_), b = plus, q = h_ / 2.0;
+  if (!(s > 0)) return 0;
+  const double most = s / (4.0 * b * q);
+  double beta = b / q;
+  if (dissipate_j < most) {
+    const double e = dissipate_j;
+    beta = 2.0 * e * b * b / ((s - 2.0 * e * b * q) + std::sqrt(s * (s - 4.0 * e * b * q)));
+  }
+  const double scale = b / (b + q * beta);
+  for (int i : controlled_) next[i] = up[i] + scale * (next[i] - up[i]);
+  controlled_dissipated_ = beta * s * scale * scale;
+  return swept * (scale * scale - 1.0);
+}
+
+double RegionIntegrator::DiscreteEnergy() noexcept {
+  const Eigen::VectorXd& ku = Forces();
+  const Eigen::VectorXd& u = *u_;
+  const Eigen::VectorXd& up = *u_previous_;
+  double kinetic = 0, strain = 0;
+  for (int i : owned_) {
+    kinetic += mass_[i] * (u[i] - up[i]) * (u[i] - up[i]);
+    strain += up[i] * ku[i];
+  }
+  for (int i : prescribed_) strain += up[i] * ku[i];
+  return 0.5 * kinetic / (h_ * h_) + 0.5 * strain;
 }
 
 void RegionIntegrator::SetState(const Eigen::VectorXd& u, const Eigen::VectorXd& u_previous) {

@@ -46,8 +46,37 @@ class RegionIntegrator {
    * One substep from t to t + h.
    * @param prescribed_next values of the prescribed DOFs at t + h, in prescribed() order
    * @param load            external force on the loaded DOFs at t, N, in loaded() order
+   * @param dissipate_j     energy to take out of the controlled DOFs in this step, J: extra
+   *                        damping on them, as much of it as one step can take
+   *                        (ControlledDissipated() says how much it did). 0: none.
    */
-  void Step(std::span<const double> prescribed_next, std::span<const double> load) noexcept;
+  void Step(std::span<const double> prescribed_next, std::span<const double> load,
+            double dissipate_j = 0) noexcept;
+
+  /*
+   * The last step's terms of central difference's discrete energy balance. Multiplying the
+   * equation of motion by Δ = (u⁺ − u⁻)/2 gives, exactly,
+   *
+   *   DiscreteEnergy() after − before = Σ_loaded f·Δ + Σ_prescribed (K u)·Δ
+   *                                     − material damping − the extra damping,
+   *
+   * so a region's energy changes only through its load, its prescribed DOFs and its damping.
+   */
+  /** Σ over loaded DOFs of load·Δ, J. */
+  double LoadWork() const { return load_work_; }
+  /** (K u)·Δ at prescribed DOF index k, J: the work moving that DOF did on the region. */
+  double PrescribedWork(int k) const { return prescribed_work_[k]; }
+  /** Σ over owned DOFs of d·m·(u⁺ − u⁻)²/(4h), J (≥ 0). */
+  double DampingDissipated() const { return damping_dissipated_; }
+  /** What the step's dissipate_j actually took out, J (≥ 0; less when one step cannot). */
+  double ControlledDissipated() const { return controlled_dissipated_; }
+  /** The owned DOFs a dissipate_j damps (default: the loaded ones). */
+  void SetControlledDofs(std::vector<int> dofs) { controlled_ = std::move(dofs); }
+  /**
+   * ½ Σ_owned m ((u − u⁻)/h)² + ½ u⁻ᵀ K u, J: the energy central difference conserves without
+   * damping and load (positive while the step is within the region's own limit).
+   */
+  double DiscreteEnergy() noexcept;
 
   /**
    * Residual of the equation of motion at prescribed DOF index `k` at the start of the last
@@ -72,6 +101,8 @@ class RegionIntegrator {
   double OwnedStateMaxAbs() const noexcept;
 
  private:
+  double DampControlled(double dissipate_j, double plus, double* next, const double* up) noexcept;
+
   const StiffnessOperator& stiffness_;
   const Eigen::VectorXd& mass_;
   double damping_;
@@ -85,6 +116,9 @@ class RegionIntegrator {
   bool ku_valid_ = false;
   Eigen::VectorXd external_;  // load per DOF (zero except loaded DOFs)
   std::vector<double> prescribed_reaction_;
+  std::vector<double> prescribed_work_;
+  std::vector<int> controlled_;
+  double load_work_ = 0, damping_dissipated_ = 0, controlled_dissipated_ = 0;
 };
 
 }  // namespace hapticsim

@@ -140,20 +140,22 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
   StressOutcome out;
   out.stress_case = stress_case;
   const Scene& scene = stress_case.scene;
-  AsyncRegions regions(scene, stress_case.substep_safety);
-  out.regions = regions.num_regions();
-  for (int r = 0; r < regions.num_regions(); ++r) {
-    const RegionSchedule& schedule = regions.schedule(r);
+  // Predicted on the bare exchange, as the daemon's supervisor verifies; a case predicted stable
+  // runs as the daemon runs it, interface controllers on, and one predicted unstable runs bare,
+  // so that what grows is what the prediction says grows.
+  AsyncRegions bare(scene, stress_case.substep_safety, AsyncRegions::InterfaceControl::kOff);
+  out.regions = bare.num_regions();
+  for (int r = 0; r < bare.num_regions(); ++r) {
+    const RegionSchedule& schedule = bare.schedule(r);
     const double step = 1.0 / schedule.rate_hz / schedule.substeps;
     out.step_over_limit.push_back(step / schedule.alone.critical_dt_s);
     if (out.step_over_limit.back() >= 1) out.past_limit = true;
   }
-  const CoupledStability coupled = regions.EstimateCoupledStability();
+  const CoupledStability coupled = bare.EstimateCoupledStability();
   out.spectral_radius = coupled.spectral_radius;
   out.common_period_s = coupled.common_period_s;
   out.coupling_only_unstable = !out.past_limit && !coupled.stable;
   out.predicted_stable = !out.past_limit && coupled.stable;
-
   double run_s = ranges.stable_run_s;
   if (!out.predicted_stable) {
     out.bound_periods =
@@ -164,7 +166,19 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
   }
   InputSettings input = scene.input;
   input.periods = run_s * input.frequency_hz;
+  AsyncRegions& regions = bare;
+  if (out.predicted_stable) regions.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
+  regions.SetRandomState(stress_case.state_seed);
+  const double start_energy = regions.Energies().stored_j;
   const TrialResult trial = regions.RunTrialFromRandomState(input, stress_case.state_seed);
+  if (out.predicted_stable && !trial.diverged()) {
+    // The object may hold no more than its start and the input's work (less the damping's share
+    // the controllers do not spend); the tolerance is the one step the observer lags.
+    const EnergyAccount e = regions.Energies();
+    out.energy_gain_j = e.stored_j - start_energy - e.input_work_j +
+                        (1 - AsyncRegions::kDampingCredit) * e.damping_dissipated_j;
+    out.energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
+  }
   out.outcome = trial.outcome;
   out.periods_run = trial.steps;
   out.peak_force_n = trial.peak_force_n;

@@ -11,14 +11,17 @@ namespace hapticsim {
 
 /**
  * The numerical-stability stress test: random scenes and region configurations, each predicted
- * (every region's step against its own limit, then the coupled spectral radius) and then run,
- * to check the prediction against what the run does.
+ * (every region's step against its own limit, then the coupled spectral radius of the bare
+ * exchange, as the daemon verifies it) and then run, to check the prediction against what the
+ * run does.
  *
- *  - predicted stable    → must stay bounded over a long run from a random state under an
- *                          extreme input (the divergence detector of every trial must stay quiet);
- *  - predicted unstable  → run anyway; divergence must be detected within the number of steps
- *                          its predicted growth needs (DetectionBoundPeriods), and the region
- *                          reported for it recorded.
+ *  - predicted stable    → run with the interface controllers on, as the daemon runs it: must
+ *                          stay bounded over a long run from a random state under an extreme
+ *                          input (the divergence detector of every trial must stay quiet), and
+ *                          hold no more energy than its start plus the input's work;
+ *  - predicted unstable  → run anyway, bare; divergence must be detected within the number of
+ *                          steps its predicted growth needs
+ *                          (DetectionBoundPeriods), and the region reported for it recorded.
  *
  * One case is a pure function of (seed, index): results never depend on the job count.
  */
@@ -51,8 +54,10 @@ struct StressOutcome {
   int regions = 0;
   /** Each region's step over its own critical step (≥ 1: that region alone is past its limit). */
   std::vector<double> step_over_limit;
-  double spectral_radius = 0;  ///< coupled, per common period
+  double spectral_radius = 0;  ///< coupled (bare exchange), per common period
   double common_period_s = 0;
+  double energy_gain_j = 0;   ///< predicted stable: stored − (start + input work − ½ damping)
+  double energy_scale_j = 0;  ///< the largest of those energies, for a relative tolerance
   bool past_limit = false;              ///< some region's step is at or past its own limit
   bool coupling_only_unstable = false;  ///< every region stable alone, the coupling not
   bool predicted_stable = false;        ///< no region past its limit and the coupling stable
@@ -67,6 +72,10 @@ struct StressOutcome {
 
   bool diverged() const {
     return outcome == TrialOutcome::kDivergedEnergy || outcome == TrialOutcome::kDivergedNonFinite;
+  }
+  /** A predicted-stable case that gained energy beyond the observer's one-step lag. */
+  bool energy_balance_violated() const {
+    return predicted_stable && energy_gain_j > 1e-6 * energy_scale_j;
   }
   /** A predicted-stable case that diverged: the prediction failed. */
   bool stable_but_diverged() const { return predicted_stable && diverged(); }

@@ -112,7 +112,7 @@ TEST(ErrorSweep, AMaterialOfTheSameWaveSpeedIsTheEarlierOneScaledByItsDensity) {
   EXPECT_EQ(run_all_stats.saved_by_similarity, 0u);
   EXPECT_EQ(derived_stats.adaptive_trials, 6u);
   EXPECT_EQ(run_all_stats.adaptive_trials, 8u);
-  EXPECT_EQ(derived_stats.stability_estimates, 6u);
+  EXPECT_EQ(derived_stats.stability_estimates, 0u);  // passive by construction: none needed
   EXPECT_EQ(derived_stats.reference_trials, 3u);
   EXPECT_EQ(run_all_stats.reference_trials, 4u);
   auto at = [&](const ErrorMap& map, double density, double youngs, double amplitude,
@@ -140,7 +140,7 @@ TEST(ErrorSweep, AMaterialOfTheSameWaveSpeedIsTheEarlierOneScaledByItsDensity) {
       EXPECT_NEAR(dense.max_direction_deg, light.max_direction_deg, 1e-6);
       EXPECT_NEAR(dense.reference_peak_n, 1.5 * light.reference_peak_n,
                   1e-9 * dense.reference_peak_n);
-      EXPECT_NEAR(dense.spectral_radius, light.spectral_radius, 1e-12);
+      EXPECT_TRUE(std::isnan(dense.spectral_radius));  // not estimated
       // Derived: the same as running it.
       ASSERT_EQ(derived_dense.status, dense.status);
       EXPECT_NEAR(derived_dense.l2_percent, dense.l2_percent, 1e-9 * dense.l2_percent);

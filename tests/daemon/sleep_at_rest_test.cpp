@@ -115,7 +115,10 @@ TEST(SleepAtRest, APressFeelsTheSameWhetherTheRegionsSleptBeforeItOrNot) {
     EXPECT_NE(slept.forces[touch].force_n[2], 0.0) << "the press is felt from the start";
   }
   // Over both whole presses: the first from exact rest in both runs, the second from rest (asleep)
-  // against a rung-down object within 0.1 µm of it (awake).
+  // against a rung-down object within 0.1 µm of it (awake). The interface controllers' observer
+  // is state too (the energy the exchange created, the credit the damping earned): sleeping
+  // resets it with the regions, the awake run carries it into the second press. Measured:
+  // 1.9e-5 of the peak (7e-6 before the controllers); bound 1e-4 of it, 0.07 mN here.
   double largest_difference = 0;
   for (size_t i = 0; i < awake.forces.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
@@ -123,7 +126,7 @@ TEST(SleepAtRest, APressFeelsTheSameWhetherTheRegionsSleptBeforeItOrNot) {
           largest_difference, std::abs(slept.forces[i].force_n[c] - awake.forces[i].force_n[c]));
     }
   }
-  EXPECT_LT(largest_difference, 1e-5 * peak);
+  EXPECT_LT(largest_difference, 1e-4 * peak);
   RecordProperty("largest_difference_n", std::to_string(largest_difference));
   std::printf("largest force difference over both presses: %.3g N (peak %.3f N)\n",
               largest_difference, peak);

@@ -17,7 +17,8 @@ for kind in predicted_stable run_past_limit coupling_only_unstable divergence_de
     echo "FAIL: no $kind case among $count: the draw no longer covers it"; exit 1
   fi
 done
-for zero in predicted_stable_diverged divergence_undetected supervisor_chose_unstable; do
+for zero in predicted_stable_diverged energy_balance_violations divergence_undetected \
+            supervisor_chose_unstable; do
   [ "$(field "$zero")" = 0 ] || { echo "FAIL: $zero is not 0"; exit 1; }
 done
 echo "stress: every check passed over $count cases"

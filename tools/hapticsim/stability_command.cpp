@@ -13,9 +13,13 @@
 namespace hapticsim::cli {
 namespace {
 
+// The bare exchange's estimate is what the daemon verifies before it runs a configuration; the
+// one as run (interface controllers on) shows what the controllers hold.
 int RunAdaptive(const SceneOptions& options, const Scene& scene) {
-  AsyncRegions regions(scene);
+  AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
   const CoupledStability coupled = regions.EstimateCoupledStability();
+  AsyncRegions as_run(scene);
+  const CoupledStability controlled = as_run.EstimateCoupledStability();
   const auto& p = regions.partition();
   if (options.json) {
     nlohmann::json out;
@@ -23,6 +27,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
     out["stable"] = coupled.stable;
     out["critical_dt_s"] = regions.schedule(kPrimaryRegion).alone.critical_dt_s;
     out["coupled_spectral_radius"] = coupled.spectral_radius;
+    out["controlled_spectral_radius"] = controlled.spectral_radius;
     out["common_period_s"] = coupled.common_period_s;
     out["power_iteration_periods"] = coupled.periods;
     out["power_iteration_norm"] = coupled.orbit_norm ? "orbit" : "euclidean";
@@ -51,8 +56,11 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene) {
               << " periods of power iteration, "
               << (coupled.orbit_norm ? "orbit norm"
                                      : "Euclidean norm: the orbit energy is indefinite")
-              << "): " << (coupled.stable ? "stable" : "UNSTABLE — this configuration is refused")
-              << "\n";
+              << "): " << (coupled.stable ? "stable" : "UNSTABLE — the daemon refuses it")
+              << " (bare exchange)\n"
+              << "  as run, with the interface controllers: "
+              << Quantity(controlled.spectral_radius, "")
+              << (controlled.stable ? "(held)" : "(NOT held)") << "\n";
   }
   return kExitOk;
 }
@@ -85,7 +93,8 @@ int RunAllConfigurations(const SceneOptions& options, const Scene& base) {
           if (!options.json) std::cout << "        n/a";
           continue;
         }
-        AsyncRegions regions(scene);
+        AsyncRegions regions(scene, AsyncRegions::kSubstepSafety,
+                             AsyncRegions::InterfaceControl::kOff);
         const CoupledStability coupled = regions.EstimateCoupledStability();
         ++total;
         stable_count += coupled.stable ? 1 : 0;

@@ -49,10 +49,12 @@ struct SupervisorCheck {
 // Not the supervisor's estimate: one fixed iteration of 3 × its base length (1800 + 900 common
 // periods), no early stop, from another random start — a slowly growing mode the supervisor's
 // estimate took for decaying shows here as a failure. (The same orbit norm: the Euclidean one
-// swings by up to ±0.004 per period and would accuse stable configurations.)
+// swings by up to ±0.004 per period and would accuse stable configurations.) Both estimate the
+// bare exchange, as the supervisor does.
 bool IndependentlyStable(const Scene& scene) {
   try {
-    AsyncRegions regions(scene);
+    AsyncRegions regions(scene, AsyncRegions::kSubstepSafety,
+                         AsyncRegions::InterfaceControl::kOff);
     return regions.EstimateCoupledStability(1800, 900, 1, /*seed=*/11).stable;
   } catch (const Error&) {
     return false;
@@ -132,6 +134,7 @@ Json CaseJson(const StressOutcome& o) {
       {"description", DescribeStressCase(o.stress_case)},
       {"step_over_limit", o.step_over_limit},
       {"spectral_radius", std::isfinite(o.spectral_radius) ? Json(o.spectral_radius) : Json("inf")},
+      {"energy_gain_j", o.energy_gain_j},
       {"predicted_stable", o.predicted_stable},
       {"bound_periods", o.bound_periods},
       {"outcome", std::string(TrialOutcomeName(o.outcome))},
@@ -188,7 +191,9 @@ int Run(const StressOptions& o) {
 
   long predicted_stable = 0, stable_diverged = 0, past_limit = 0, coupling_only = 0, unstable = 0,
        detected = 0, undetected = 0, marginal = 0, marginal_detected = 0, region_is_past_limit = 0,
-       past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0;
+       past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0,
+       energy_violations = 0;
+  double worst_energy_gain = -INFINITY;  // relative to the case's energy scale
   double worst_detection_fraction = 0, slowest_case_s = 0, cases_s = 0, supervisor_s = 0;
   Json failures = Json::array();
   for (int i = 0; i < count; ++i) {
@@ -203,6 +208,10 @@ int Run(const StressOptions& o) {
     if (out.predicted_stable) {
       ++predicted_stable;
       if (out.diverged()) ++stable_diverged;
+      if (out.energy_balance_violated()) ++energy_violations;
+      if (out.energy_scale_j > 0) {
+        worst_energy_gain = std::max(worst_energy_gain, out.energy_gain_j / out.energy_scale_j);
+      }
     } else {
       ++unstable;
       if (out.past_limit) ++past_limit;
@@ -224,21 +233,23 @@ int Run(const StressOptions& o) {
         }
       }
     }
-    if (out.stable_but_diverged() || out.divergence_undetected() || check.chose_unstable ||
-        check.stable_pinned_refused) {
+    if (out.stable_but_diverged() || out.divergence_undetected() ||
+        out.energy_balance_violated() || check.chose_unstable || check.stable_pinned_refused) {
       Json entry = CaseJson(out);
       if (!check.problem.empty()) entry["supervisor"] = check.problem;
       failures.push_back(entry);
     }
   }
-  const bool passed =
-      stable_diverged == 0 && undetected == 0 && chose_unstable == 0 && pinned_refused == 0;
+  const bool passed = stable_diverged == 0 && undetected == 0 && energy_violations == 0 &&
+                      chose_unstable == 0 && pinned_refused == 0;
   const double seconds = elapsed();
   if (o.json) {
     Json out = {{"count", count},
                 {"seed", o.seed},
                 {"predicted_stable", predicted_stable},
                 {"predicted_stable_diverged", stable_diverged},
+                {"energy_balance_violations", energy_violations},
+                {"worst_energy_gain_fraction", worst_energy_gain},
                 {"predicted_unstable", unstable},
                 {"run_past_limit", past_limit},
                 {"coupling_only_unstable", coupling_only},
@@ -278,7 +289,9 @@ int Run(const StressOptions& o) {
               << " s (CPU: predictions and runs " << cases_s << " s, supervisor checks "
               << supervisor_s << " s; slowest case " << slowest_case_s << " s)\n"
               << "  predicted stable            " << predicted_stable << ", of which diverged "
-              << stable_diverged << "\n"
+              << stable_diverged << ", gained energy " << energy_violations
+              << " (worst: stored − start − input work + ½ damping = " << worst_energy_gain
+              << " of the case's energy)\n"
               << "  predicted unstable          " << unstable << " (a region past its own limit "
               << past_limit << ", only the coupling " << coupling_only << ")\n"
               << "    divergence detected       " << detected << " (at most "

@@ -115,11 +115,10 @@ int Run(const SweepCommandOptions& o) {
   std::cout << "Error map " << o.out << ": " << stats.samples << " samples (grid " << grid.name
             << ", shard " << map.provenance.shard << ") in " << ShortDuration(stats.wall_seconds)
             << " on " << o.jobs << " jobs\n"
-            << "  ok " << map.CountStatus(SampleStatus::kOk) << ", predicted unstable "
-            << map.CountStatus(SampleStatus::kPredictedUnstable) << " (not simulated), diverged "
+            << "  ok " << map.CountStatus(SampleStatus::kOk) << ", diverged "
             << map.CountStatus(SampleStatus::kDiverged) << "\n"
             << "  runs made: " << stats.reference_trials << " references, " << stats.adaptive_trials
-            << " adaptive trials, " << stats.stability_estimates << " coupled-stability estimates"
+            << " adaptive trials"
             << (stats.samples_resumed ? ", " + std::to_string(stats.samples_resumed) +
                                             " samples resumed from the journal"
                                       : "")
@@ -127,11 +126,9 @@ int Run(const SweepCommandOptions& o) {
             << "  runs saved: " << stats.saved_by_reference_reuse << " references (reuse), "
             << stats.saved_by_similarity << " adaptive (materials of equal E/ρ, ν, d), "
             << stats.saved_by_linearity << " adaptive (linearity in amplitude), "
-            << stats.saved_by_same_regions << " adaptive (sizes giving the same regions), "
-            << stats.saved_by_prediction << " adaptive (predicted unstable)\n"
+            << stats.saved_by_same_regions << " adaptive (sizes giving the same regions)\n"
             << "  CPU time: references " << Duration(stats.reference_seconds) << ", adaptive "
-            << Duration(stats.adaptive_seconds) << ", stability "
-            << Duration(stats.stability_seconds) << "\n";
+            << Duration(stats.adaptive_seconds) << "\n";
   return kExitOk;
 }
 
