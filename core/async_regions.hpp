@@ -38,17 +38,25 @@ struct CoupledStability {
  * The discrete energy balance of the coupled regions since Reset, J. Exactly (to round-off)
  *
  *   stored − stored at Reset = input work − damping dissipated + interface created
- *                              − interface dissipated,
+ *                              − interface dissipated.
  *
- * and the interface controllers keep interface created − interface dissipated from staying above
- * zero, so stored ≤ stored at Reset + input work (docs/regions.md, "Passive by construction").
+ * The interface controllers keep interface created − interface dissipated at most
+ * kDampingCredit × credited damping, plus what they have not yet managed to take out, so then
+ * stored ≤ stored at Reset + input work − damping + kDampingCredit × credited damping
+ * (docs/regions.md, "Passive interfaces").
  */
 struct EnergyAccount {
   double stored_j = 0;                ///< Σ over the regions of RegionIntegrator::DiscreteEnergy
   double input_work_j = 0;            ///< work the contact did on the object
   double damping_dissipated_j = 0;    ///< taken out by the material's damping (≥ 0)
+  double credited_damping_j = 0;      ///< of which in the secondary regions (each credits its link)
   double interface_created_j = 0;     ///< net work the exchanges across every Γ did (lag: > 0)
   double interface_dissipated_j = 0;  ///< taken out by the interface controllers (≥ 0)
+  /**
+   * What the observers hold now, the inner sides' work they have not yet seen included: the
+   * controllers' backlog. EnergyAboveBound ≤ this (equal but for credit the floors forgot).
+   */
+  double pending_excess_j = 0;
 };
 
 /**
@@ -168,8 +176,14 @@ class AsyncRegions {
    */
   bool RegionAtRest(RegionIndex region, double tolerance_m) const noexcept;
 
-  /** Switches the interface controllers on or off. One thread, while no steps run. */
-  void SetInterfaceControl(InterfaceControl control) { control_ = control; }
+  /**
+   * Switches the interface controllers on or off, and starts the energy balance afresh (off,
+   * the observers drift with nothing to hold them). One thread, while no steps run.
+   */
+  void SetInterfaceControl(InterfaceControl control) {
+    control_ = control;
+    ResetEnergyAccount();
+  }
 
   /** The energy balance since Reset. One thread, while no steps run. */
   EnergyAccount Energies() noexcept;
@@ -249,5 +263,15 @@ class AsyncRegions {
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};
 };
+
+/**
+ * How far the stored energy is above what the interface controllers guarantee,
+ * stored at start + input work − damping + kDampingCredit × credited damping, J: ≤ 0 (to the
+ * observer's one-step lag) while the controllers keep up.
+ */
+inline double EnergyAboveBound(const EnergyAccount& e, double stored_at_start) {
+  return e.stored_j - stored_at_start - e.input_work_j + e.damping_dissipated_j -
+         AsyncRegions::kDampingCredit * e.credited_damping_j;
+}
 
 }  // namespace hapticsim

@@ -511,9 +511,10 @@ ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& 
       [&](std::size_t i) {
         const Task& task = all_tasks[todo[i]];
         std::vector<std::pair<std::size_t, MapSample>> results;
-        // No stability estimate: the interface controllers keep every configuration whose
-        // regions meet their own limits from gaining energy, and what their dissipation costs is
-        // in the error this trial measures (docs/regions.md, "Passive by construction").
+        // No stability estimate: the interface controllers hold most lagged exchanges, what their
+        // dissipation costs is in the error this trial measures, and a trial that diverges anyway
+        // is recorded as diverged (docs/regions.md, "Passive interfaces"). The daemon verifies a
+        // configuration before it runs it.
         AsyncRegions regions(SceneAtPoint(base, task.point));
         double adaptive_s = 0;
         std::size_t trials = 0;

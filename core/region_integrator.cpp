@@ -84,10 +84,11 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next,
   ku_valid_ = false;
 }
 
-// Extra damping β (1/s, on the mass) on the controlled DOFs takes β·S/(b + qβ)² out of the step, with
-// S = Σ m (u⁺ − u⁻)²/(4h) at β = 0 over them, b = 1 + d·h/2 and q = h/2 (the damped update scales
-// u⁺ − u⁻ by b/(b + qβ)). That rises with β up to β = b/q, where it is S/(4bq): the most one step
-// can take. The smaller root of β·S = E·(b + qβ)², in the form that stays accurate as E → 0.
+// Extra damping β (1/s, on the mass) on the controlled DOFs scales their u⁺ − u⁻ by
+// b/(b + qβ), b = 1 + d·h/2, q = h/2, and so takes β·S·b²/(b + qβ)² out of the step, with
+// S = Σ m (u⁺ − u⁻)²/(4h) at β = 0 over them. That rises with β up to β = b/q, where it is
+// S·b/(4q): the most one step can take. β for E is the smaller root of β·S = e·(b + qβ)² with
+// e = E/b², in the form that stays accurate as E → 0.
 // Returns the change of Σ m (u⁺ − u⁻)² over those DOFs, for the material damping's share.
 double RegionIntegrator::DampControlled(double dissipate_j, double plus, double* next,
                                         const double* up) noexcept {
@@ -95,11 +96,12 @@ double RegionIntegrator::DampControlled(double dissipate_j, double plus, double*
   for (int i : controlled_) swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
   const double s = swept / (4.0 * h_), b = plus, q = h_ / 2.0;
   if (!(s > 0)) return 0;
-  const double most = s / (4.0 * b * q);
+  const double e = dissipate_j / (b * b);
+  // The same expression decides and goes under the root: rounding can never make it negative.
+  const double discriminant = s * (s - 4.0 * e * b * q);
   double beta = b / q;
-  if (dissipate_j < most) {
-    const double e = dissipate_j;
-    beta = 2.0 * e * b * b / ((s - 2.0 * e * b * q) + std::sqrt(s * (s - 4.0 * e * b * q)));
+  if (discriminant > 0) {
+    beta = 2.0 * e * b * b / ((s - 2.0 * e * b * q) + std::sqrt(discriminant));
   }
   const double scale = b / (b + q * beta);
   for (int i : controlled_) next[i] = up[i] + scale * (next[i] - up[i]);

@@ -15,10 +15,10 @@ namespace hapticsim {
  * exchange, as the daemon verifies it) and then run, to check the prediction against what the
  * run does.
  *
- *  - predicted stable    → run with the interface controllers on, as the daemon runs it: must
- *                          stay bounded over a long run from a random state under an extreme
- *                          input (the divergence detector of every trial must stay quiet), and
- *                          hold no more energy than its start plus the input's work;
+ *  - predicted stable    → must stay bounded over a long run from a random state under an
+ *                          extreme input (the divergence detector of every trial must stay
+ *                          quiet), bare and again as the daemon runs it, interface controllers
+ *                          on; as run it must also keep the controllers' energy bound;
  *  - predicted unstable  → run anyway, bare; divergence must be detected within the number of
  *                          steps its predicted growth needs
  *                          (DetectionBoundPeriods), and the region reported for it recorded.
@@ -64,7 +64,8 @@ struct StressOutcome {
   long bound_periods = 0;               ///< predicted unstable: primary periods detection may take
   bool marginal = false;  ///< predicted unstable but growing too slowly to detect by max_run_s
 
-  TrialOutcome outcome = TrialOutcome::kCompleted;
+  TrialOutcome outcome = TrialOutcome::kCompleted;  ///< the bare exchange's run
+  TrialOutcome controlled_outcome = TrialOutcome::kCompleted;  ///< predicted stable: as run
   long periods_run = 0;      ///< primary periods simulated
   int diverged_region = -1;  ///< the region whose state was largest when divergence was seen
   double peak_force_n = 0;   ///< over the run, N
@@ -77,8 +78,12 @@ struct StressOutcome {
   bool energy_balance_violated() const {
     return predicted_stable && energy_gain_j > 1e-6 * energy_scale_j;
   }
-  /** A predicted-stable case that diverged: the prediction failed. */
-  bool stable_but_diverged() const { return predicted_stable && diverged(); }
+  /** A predicted-stable case that diverged, bare or as run: the prediction failed. */
+  bool stable_but_diverged() const {
+    const bool as_run_diverged = controlled_outcome == TrialOutcome::kDivergedEnergy ||
+                                 controlled_outcome == TrialOutcome::kDivergedNonFinite;
+    return predicted_stable && (diverged() || as_run_diverged);
+  }
   /** A predicted-unstable, non-marginal case whose divergence was not seen within its bound. */
   bool divergence_undetected() const { return !predicted_stable && !marginal && !diverged(); }
 };

@@ -550,7 +550,10 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
   // so an input that arrives just after another within one period is superseded. Measured:
   // 1961 of 2000 on an idle machine, about 1600 with both cores busy.
   EXPECT_GE(number("distinct_seqs_answered"), 1400) << json;  // of 2000 periods
-  EXPECT_LE(number("max_lag_periods"), 20) << json;
+  // The answer's lag behind the newest input: a few periods, but a shared machine stalls a
+  // process for 30–100 ms now and then (measured here and in CI), so the bound is 150 periods; a
+  // daemon that stopped answering or fell behind for good is seconds behind by the end.
+  EXPECT_LE(number("max_lag_periods"), 150) << json;
   EXPECT_EQ(number("out_of_order"), 0) << json;
   EXPECT_EQ(number("nonfinite_forces"), 0) << json;
   EXPECT_GT(number("in_contact_periods"), 1000) << json;

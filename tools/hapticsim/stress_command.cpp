@@ -207,7 +207,7 @@ int Run(const StressOptions& o) {
     pinned_refused += check.stable_pinned_refused;
     if (out.predicted_stable) {
       ++predicted_stable;
-      if (out.diverged()) ++stable_diverged;
+      if (out.stable_but_diverged()) ++stable_diverged;  // bare or as run
       if (out.energy_balance_violated()) ++energy_violations;
       if (out.energy_scale_j > 0) {
         worst_energy_gain = std::max(worst_energy_gain, out.energy_gain_j / out.energy_scale_j);
@@ -290,7 +290,7 @@ int Run(const StressOptions& o) {
               << supervisor_s << " s; slowest case " << slowest_case_s << " s)\n"
               << "  predicted stable            " << predicted_stable << ", of which diverged "
               << stable_diverged << ", gained energy " << energy_violations
-              << " (worst: stored − start − input work + ½ damping = " << worst_energy_gain
+              << " (worst: above the controllers' bound by " << worst_energy_gain
               << " of the case's energy)\n"
               << "  predicted unstable          " << unstable << " (a region past its own limit "
               << past_limit << ", only the coupling " << coupling_only << ")\n"
