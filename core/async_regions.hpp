@@ -239,7 +239,7 @@ class AsyncRegions {
                     std::array<double, 3>* reaction) noexcept;
   double ObserveInwardLink(RegionIndex region) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
-  void AccountStep(RegionIndex region) noexcept;
+  void AccountStep(RegionIndex region, double asked_inward, double asked_outward) noexcept;
   void PublishEnergyAccount(Region& region) noexcept;
   void ResetEnergyAccount() noexcept;
   void AdvanceRegionTo(RegionIndex region, std::int64_t ticks) noexcept;

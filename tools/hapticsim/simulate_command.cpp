@@ -76,10 +76,9 @@ nlohmann::json ErrorJson(const ForceError& e) {
 // controllers keep the exchange from adding energy (docs/regions.md). The bare exchange's
 // estimate is reported: the daemon runs only what is stable without the controllers.
 TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report) {
-  report->coupled =
-      AsyncRegions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff)
-          .EstimateCoupledStability();
-  AsyncRegions regions(scene);
+  AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
+  report->coupled = regions.EstimateCoupledStability();
+  regions.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
   TrialResult result;
   if (threads) {
     const TrialResult virtual_time = regions.RunTrial();

@@ -18,8 +18,8 @@ namespace {
 int RunAdaptive(const SceneOptions& options, const Scene& scene) {
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
   const CoupledStability coupled = regions.EstimateCoupledStability();
-  AsyncRegions as_run(scene);
-  const CoupledStability controlled = as_run.EstimateCoupledStability();
+  regions.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
+  const CoupledStability controlled = regions.EstimateCoupledStability();
   const auto& p = regions.partition();
   if (options.json) {
     nlohmann::json out;
