@@ -197,8 +197,8 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
         p.stiffness(a), p.dof_mass(), scene.material.damping_per_s, dofs.owned, prescribed,
         dofs.inner_interface, period / region->schedule.substeps);
     // The outermost region's controller damps its inner Γ; a middle shell, with links on both
-    // sides, all its DOFs (ObserveInwardLink). The primary's controller never acts.
-    if (a > 0 && a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
+    // sides, and the primary (its last resort only), all their DOFs (ObserveInwardLink).
+    if (a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
 
     if (a + 1 < count) {
       region->band = std::move(bands[a]);
@@ -350,9 +350,13 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   double asked_inward = 0, asked_outward = 0;
   if (control_ == InterfaceControl::kPassive) {
     if (a > 0) asked_inward = ObserveInwardLink(a);
-    // Not the primary: damping its DOFs is a viscous force at the contact, which the user feels
-    // (measured: a loaded press peaked 14 % high). A middle shell takes its inner link's backlog.
-    if (region.inward && a != kPrimaryRegion) asked_outward = OutwardLinkExcess(a);
+    if (region.inward) asked_outward = OutwardLinkExcess(a);
+    // The primary keeps kPrimaryReserve of its energy in reserve: damping its DOFs is a viscous
+    // force at the contact the user feels (measured: a loaded press peaked 14 % high when it took
+    // every step's backlog), so it acts only on a backlog the shells have let grow past that.
+    if (a == kPrimaryRegion) {
+      asked_outward = std::max(0.0, asked_outward - PrimaryReserve(integrator));
+    }
   }
   integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward);
   if (reaction != nullptr) {
@@ -400,6 +404,10 @@ double AsyncRegions::ObserveInwardLink(RegionIndex a) noexcept {
     region.excess = std::max(floor, region.excess);
   }
   return std::max(0.0, region.excess);
+}
+
+double AsyncRegions::PrimaryReserve(RegionIntegrator& primary) noexcept {
+  return kPrimaryReserve * std::max(0.0, primary.DiscreteEnergy());
 }
 
 // The inner side, before its step: what the outer side's last step could not take out, less
@@ -460,6 +468,9 @@ void AsyncRegions::ResetEnergyAccount() noexcept {
 
 EnergyAccount AsyncRegions::Energies() noexcept {
   EnergyAccount account;
+  if (control_ == InterfaceControl::kPassive && num_regions() > 1) {
+    account.primary_reserve_j = PrimaryReserve(*regions_[kPrimaryRegion]->integrator);
+  }
   for (int a = 0; a < num_regions(); ++a) {
     Region& region = *regions_[a];
     account.stored_j += region.integrator->DiscreteEnergy();

@@ -57,6 +57,8 @@ struct EnergyAccount {
    * controllers' backlog. EnergyAboveBound ≤ this (equal but for credit the floors forgot).
    */
   double pending_excess_j = 0;
+  /** The backlog the primary leaves to the shells now (kPrimaryReserve of its energy). */
+  double primary_reserve_j = 0;
 };
 
 /**
@@ -100,6 +102,9 @@ class AsyncRegions {
   static constexpr double kDampingCredit = 0.5;
   /** The most credit an interface keeps, as a share of its outer region's energy. */
   static constexpr double kCreditMemory = 0.1;
+  /** The backlog the primary's controller leaves to the shells, as a share of its own energy:
+   *  beyond it, the primary damps too (its last resort; OutwardLinkExcess). */
+  static constexpr double kPrimaryReserve = 0.1;
 
   /**
    * kPassive: every interface's controller keeps the exchange from adding energy (always, in
@@ -239,6 +244,7 @@ class AsyncRegions {
                     std::array<double, 3>* reaction) noexcept;
   double ObserveInwardLink(RegionIndex region) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
+  static double PrimaryReserve(RegionIntegrator& primary) noexcept;
   void AccountStep(RegionIndex region, double asked_inward, double asked_outward) noexcept;
   void PublishEnergyAccount(Region& region) noexcept;
   void ResetEnergyAccount() noexcept;
@@ -266,12 +272,12 @@ class AsyncRegions {
 
 /**
  * How far the stored energy is above what the interface controllers guarantee,
- * stored at start + input work − damping + kDampingCredit × credited damping, J: ≤ 0 (to the
- * observer's one-step lag) while the controllers keep up.
+ * stored at start + input work − damping + kDampingCredit × credited damping + the primary's
+ * reserve, J: ≤ 0 (to the observer's one-step lag) while the controllers keep up.
  */
 inline double EnergyAboveBound(const EnergyAccount& e, double stored_at_start) {
   return e.stored_j - stored_at_start - e.input_work_j + e.damping_dissipated_j -
-         AsyncRegions::kDampingCredit * e.credited_damping_j;
+         AsyncRegions::kDampingCredit * e.credited_damping_j - e.primary_reserve_j;
 }
 
 }  // namespace hapticsim

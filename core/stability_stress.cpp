@@ -140,9 +140,9 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
   StressOutcome out;
   out.stress_case = stress_case;
   const Scene& scene = stress_case.scene;
-  // Predicted on the bare exchange, as the daemon's supervisor verifies; a case predicted stable
-  // runs as the daemon runs it, interface controllers on, and one predicted unstable runs bare,
-  // so that what grows is what the prediction says grows.
+  // Predicted on the bare exchange, and run bare, so that what grows is what the prediction says
+  // grows; a case whose regions meet their own limits runs again as the daemon runs it,
+  // interface controllers on.
   AsyncRegions bare(scene, stress_case.substep_safety, AsyncRegions::InterfaceControl::kOff);
   out.regions = bare.num_regions();
   for (int r = 0; r < bare.num_regions(); ++r) {
@@ -172,7 +172,11 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
   out.periods_run = trial.steps;
   out.peak_force_n = trial.peak_force_n;
   if (trial.diverged()) out.diverged_region = bare.LargestStateRegion();
-  if (out.predicted_stable) {
+  out.passive_expected = !out.past_limit &&
+                         stress_case.substep_safety <= AsyncRegions::kSubstepSafety &&
+                         scene.adaptivity.displacement_coupling;
+  out.controlled_run = !out.past_limit;
+  if (out.controlled_run) {
     // As the daemon runs it, interface controllers on: bounded too, and the object may hold no
     // more than the controllers guarantee (the tolerance is the one step the observer lags).
     bare.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);

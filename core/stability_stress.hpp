@@ -19,6 +19,10 @@ namespace hapticsim {
  *                          extreme input (the divergence detector of every trial must stay
  *                          quiet), bare and again as the daemon runs it, interface controllers
  *                          on; as run it must also keep the controllers' energy bound;
+ *  - every region within its own limit → run as the daemon runs it too; where the regions keep
+ *                          the production margin and the displacement exchange links them
+ *                          (passive_expected), bounded and within the controllers' energy bound
+ *                          whatever the bare exchange's prediction;
  *  - predicted unstable  → run anyway, bare; divergence must be detected within the number of
  *                          steps its predicted growth needs
  *                          (DetectionBoundPeriods), and the region reported for it recorded.
@@ -64,8 +68,16 @@ struct StressOutcome {
   long bound_periods = 0;               ///< predicted unstable: primary periods detection may take
   bool marginal = false;  ///< predicted unstable but growing too slowly to detect by max_run_s
 
+  /**
+   * The regions built as production builds them (each step within kSubstepSafety of its own
+   * limit) and linked by the displacement exchange: the interface controllers must hold such a
+   * case as run, whatever the bare exchange does (docs/regions.md, "Passive interfaces").
+   */
+  bool passive_expected = false;
+  bool controlled_run = false;  ///< run as the daemon runs it too: every region within its limit
+
   TrialOutcome outcome = TrialOutcome::kCompleted;  ///< the bare exchange's run
-  TrialOutcome controlled_outcome = TrialOutcome::kCompleted;  ///< predicted stable: as run
+  TrialOutcome controlled_outcome = TrialOutcome::kCompleted;  ///< as run (controlled_run)
   long periods_run = 0;      ///< primary periods simulated
   int diverged_region = -1;  ///< the region whose state was largest when divergence was seen
   double peak_force_n = 0;   ///< over the run, N
@@ -74,15 +86,26 @@ struct StressOutcome {
   bool diverged() const {
     return outcome == TrialOutcome::kDivergedEnergy || outcome == TrialOutcome::kDivergedNonFinite;
   }
-  /** A predicted-stable case that gained energy beyond the observer's one-step lag. */
-  bool energy_balance_violated() const {
-    return predicted_stable && energy_gain_j > 1e-6 * energy_scale_j;
+  bool controlled_diverged() const {
+    return controlled_run && (controlled_outcome == TrialOutcome::kDivergedEnergy ||
+                              controlled_outcome == TrialOutcome::kDivergedNonFinite);
   }
+  /** A case the controllers must hold that diverged as run. */
+  bool passive_but_diverged() const { return passive_expected && controlled_diverged(); }
+  /**
+   * A case the controllers must hold, or one predicted stable, that ended with more energy than
+   * their bound (EnergyAboveBound) by more than their backlog may hold: the observer's one step
+   * where the bare exchange decays, kGrowingBacklog of the case's energy where it grows (measured
+   * up to 0.11 %, seeds 1–4).
+   */
+  bool energy_balance_violated() const {
+    const double tolerance = predicted_stable ? 1e-6 : kGrowingBacklog;
+    return (predicted_stable || passive_expected) && energy_gain_j > tolerance * energy_scale_j;
+  }
+  static constexpr double kGrowingBacklog = 0.01;
   /** A predicted-stable case that diverged, bare or as run: the prediction failed. */
   bool stable_but_diverged() const {
-    const bool as_run_diverged = controlled_outcome == TrialOutcome::kDivergedEnergy ||
-                                 controlled_outcome == TrialOutcome::kDivergedNonFinite;
-    return predicted_stable && (diverged() || as_run_diverged);
+    return predicted_stable && (diverged() || controlled_diverged());
   }
   /** A predicted-unstable, non-marginal case whose divergence was not seen within its bound. */
   bool divergence_undetected() const { return !predicted_stable && !marginal && !diverged(); }

@@ -11,6 +11,7 @@ if [ "$status" -ne 0 ]; then echo "FAIL: hapticsim stress exited $status"; exit 
 field() { grep -o "\"$1\": [0-9.e+-]*" "$out" | head -1 | awk '{print $2}'; }
 [ "$(field count)" = "$count" ] || { echo "FAIL: count is not $count"; exit 1; }
 for kind in predicted_stable run_past_limit coupling_only_unstable divergence_detected \
+            passive_expected passive_expected_bare_unstable \
             supervisor_choices; do
   value=$(field "$kind")
   if [ -z "$value" ] || [ "$value" = 0 ]; then
@@ -18,6 +19,7 @@ for kind in predicted_stable run_past_limit coupling_only_unstable divergence_de
   fi
 done
 for zero in predicted_stable_diverged energy_balance_violations divergence_undetected \
+            passive_expected_diverged \
             supervisor_chose_unstable; do
   [ "$(field "$zero")" = 0 ] || { echo "FAIL: $zero is not 0"; exit 1; }
 done

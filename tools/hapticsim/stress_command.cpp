@@ -135,6 +135,8 @@ Json CaseJson(const StressOutcome& o) {
       {"step_over_limit", o.step_over_limit},
       {"spectral_radius", std::isfinite(o.spectral_radius) ? Json(o.spectral_radius) : Json("inf")},
       {"energy_gain_j", o.energy_gain_j},
+      {"energy_scale_j", o.energy_scale_j},
+      {"controlled_outcome", std::string(TrialOutcomeName(o.controlled_outcome))},
       {"predicted_stable", o.predicted_stable},
       {"bound_periods", o.bound_periods},
       {"outcome", std::string(TrialOutcomeName(o.outcome))},
@@ -192,7 +194,8 @@ int Run(const StressOptions& o) {
   long predicted_stable = 0, stable_diverged = 0, past_limit = 0, coupling_only = 0, unstable = 0,
        detected = 0, undetected = 0, marginal = 0, marginal_detected = 0, region_is_past_limit = 0,
        past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0,
-       energy_violations = 0;
+       energy_violations = 0, passive = 0, passive_refused_today = 0, passive_diverged = 0,
+       other_controlled = 0, other_controlled_diverged = 0;
   double worst_energy_gain = -INFINITY;  // relative to the case's energy scale
   double worst_detection_fraction = 0, slowest_case_s = 0, cases_s = 0, supervisor_s = 0;
   Json failures = Json::array();
@@ -205,13 +208,21 @@ int Run(const StressOptions& o) {
     choices += check.choices;
     chose_unstable += check.chose_unstable;
     pinned_refused += check.stable_pinned_refused;
+    if (out.energy_balance_violated()) ++energy_violations;
+    if ((out.predicted_stable || out.passive_expected) && out.energy_scale_j > 0) {
+      worst_energy_gain = std::max(worst_energy_gain, out.energy_gain_j / out.energy_scale_j);
+    }
+    if (out.passive_expected) {
+      ++passive;
+      if (!out.predicted_stable) ++passive_refused_today;
+      if (out.passive_but_diverged()) ++passive_diverged;
+    } else if (out.controlled_run) {
+      ++other_controlled;
+      if (out.controlled_diverged()) ++other_controlled_diverged;
+    }
     if (out.predicted_stable) {
       ++predicted_stable;
       if (out.stable_but_diverged()) ++stable_diverged;  // bare or as run
-      if (out.energy_balance_violated()) ++energy_violations;
-      if (out.energy_scale_j > 0) {
-        worst_energy_gain = std::max(worst_energy_gain, out.energy_gain_j / out.energy_scale_j);
-      }
     } else {
       ++unstable;
       if (out.past_limit) ++past_limit;
@@ -233,7 +244,7 @@ int Run(const StressOptions& o) {
         }
       }
     }
-    if (out.stable_but_diverged() || out.divergence_undetected() ||
+    if (out.stable_but_diverged() || out.divergence_undetected() || out.passive_but_diverged() ||
         out.energy_balance_violated() || check.chose_unstable || check.stable_pinned_refused) {
       Json entry = CaseJson(out);
       if (!check.problem.empty()) entry["supervisor"] = check.problem;
@@ -241,6 +252,7 @@ int Run(const StressOptions& o) {
     }
   }
   const bool passed = stable_diverged == 0 && undetected == 0 && energy_violations == 0 &&
+                      passive_diverged == 0 &&
                       chose_unstable == 0 && pinned_refused == 0;
   const double seconds = elapsed();
   if (o.json) {
@@ -250,6 +262,11 @@ int Run(const StressOptions& o) {
                 {"predicted_stable_diverged", stable_diverged},
                 {"energy_balance_violations", energy_violations},
                 {"worst_energy_gain_fraction", worst_energy_gain},
+                {"passive_expected", passive},
+                {"passive_expected_bare_unstable", passive_refused_today},
+                {"passive_expected_diverged", passive_diverged},
+                {"other_controlled_runs", other_controlled},
+                {"other_controlled_diverged", other_controlled_diverged},
                 {"predicted_unstable", unstable},
                 {"run_past_limit", past_limit},
                 {"coupling_only_unstable", coupling_only},
@@ -292,6 +309,13 @@ int Run(const StressOptions& o) {
               << stable_diverged << ", gained energy " << energy_violations
               << " (worst: above the controllers' bound by " << worst_energy_gain
               << " of the case's energy)\n"
+              << "  held by the controllers     " << passive
+              << " (production margin, displacement exchange; bare exchange unstable "
+              << passive_refused_today << "), of which diverged as run " << passive_diverged
+              << "\n"
+              << "  other runs as the daemon    " << other_controlled
+              << " (near a region's limit or the force exchange: not guaranteed), diverged "
+              << other_controlled_diverged << "\n"
               << "  predicted unstable          " << unstable << " (a region past its own limit "
               << past_limit << ", only the coupling " << coupling_only << ")\n"
               << "    divergence detected       " << detected << " (at most "
