@@ -161,6 +161,9 @@ class AsyncRegions {
    * not assume, and one that diverges (docs/reliability.md).
    */
   void SkipRegion(RegionIndex region, std::int64_t steps) noexcept;
+  /** A secondary region woken more of its periods late than this skips them (SkipRegion)
+   *  instead of stepping them: the daemon's threads and RealTimeSchedule alike. */
+  static constexpr int kSkipAfterLatePeriods = 3;
   /**
    * How far the primary's newest boundary from region 1 was behind the primary's step time at
    * its last step, s (0 with no secondary region). Any thread (relaxed atomic).

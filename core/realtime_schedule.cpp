@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <random>
 #include <thread>
 
 #include "core/monotonic_clock.hpp"
@@ -32,6 +33,24 @@ struct LoopRecord {
     }
     return stats;
   }
+};
+
+// One thread's injected faults (TimingFaults): a stream of its own, drawn once per wake.
+class FaultDraw {
+ public:
+  FaultDraw(unsigned seed, int thread) {
+    std::seed_seq sequence{seed, static_cast<unsigned>(thread), 0xfa17u};
+    rng_.seed(sequence);
+  }
+  // Whether a fault at `per_s` a second happens at a wake `period_s` after the last.
+  bool Happens(double per_s, double period_s) {
+    return per_s > 0 && std::uniform_real_distribution<double>(0, 1)(rng_) < per_s * period_s;
+  }
+  int Periods(int most) { return std::uniform_int_distribution<int>(1, std::max(1, most))(rng_); }
+  double Seconds(double most) { return std::uniform_real_distribution<double>(0, most)(rng_); }
+
+ private:
+  std::mt19937_64 rng_;
 };
 
 }  // namespace
@@ -69,10 +88,13 @@ TrialResult RealTimeSchedule::RunTrial() {
   const std::int64_t origin_ns = MonotonicNowNs() + 20'000'000 + lead_ns.back();
   std::atomic<bool> primary_done{false};
 
+  std::vector<FaultCounts> counts(static_cast<size_t>(count));
   std::vector<std::thread> threads;
   for (int a = 1; a < count; ++a) {
     threads.emplace_back([&, a] {
       LoopRecord& record = records[a];
+      FaultCounts& faulted = counts[a];
+      FaultDraw draw(faults_.seed, a);
       const std::int64_t period = nominal_ticks[a];
       const int substeps = regions_.schedule(a).substeps;
       const double period_ns = period * tick_ns;
@@ -81,7 +103,22 @@ TrialResult RealTimeSchedule::RunTrial() {
         if (state >= end_ticks + period) break;
         const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns[a];
         SleepUntilMonotonicNs(release);
+        std::int64_t held_ns = 0;
+        if (draw.Happens(faults_.secondary_lags_per_s, period_ns * 1e-9)) {
+          held_ns = static_cast<std::int64_t>(draw.Periods(faults_.max_lag_periods) * period_ns);
+          ++faulted.secondary_lags;
+        } else if (draw.Happens(faults_.secondary_stalls_per_s, period_ns * 1e-9)) {
+          held_ns = static_cast<std::int64_t>(draw.Seconds(faults_.max_stall_s) * 1e9);
+          ++faulted.secondary_stalls;
+        }
+        if (held_ns > 0) SleepUntilMonotonicNs(MonotonicNowNs() + held_ns);
         const std::int64_t woke = MonotonicNowNs();
+        // Woken far too late: hold the state over the missed periods, as the daemon does.
+        const auto missed = static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
+        if (missed > AsyncRegions::kSkipAfterLatePeriods) {
+          regions_.SkipRegion(a, missed * substeps);
+          ++faulted.skips;
+        }
         for (int q = 0; q < substeps; ++q) regions_.StepRegion(a);
         const std::int64_t done = MonotonicNowNs();
         record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
@@ -94,11 +131,19 @@ TrialResult RealTimeSchedule::RunTrial() {
   }
 
   LoopRecord& record = records[kPrimaryRegion];
+  FaultDraw draw(faults_.seed, kPrimaryRegion);
   const double period_ns = primary_period_ticks * tick_ns;
   for (long n = 0; n <= steps; ++n) {
     const std::int64_t release =
         origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
     SleepUntilMonotonicNs(release);
+    if (draw.Happens(faults_.primary_late_wakes_per_s, period_ns * 1e-9)) {
+      // Late: the periods it missed are then stepped back to back, as their releases have passed.
+      SleepUntilMonotonicNs(
+          MonotonicNowNs() +
+          static_cast<std::int64_t>(draw.Periods(faults_.max_late_periods) * period_ns));
+      ++counts[kPrimaryRegion].primary_late_wakes;
+    }
     const std::int64_t woke = MonotonicNowNs();
     const double t = n * dt;
     std::array<double, 3> r{};
@@ -129,6 +174,13 @@ TrialResult RealTimeSchedule::RunTrial() {
   for (std::thread& thread : threads) thread.join();
   result.samples.resize(static_cast<size_t>(result.steps));
   stats_.clear();
+  counts_ = {};
+  for (const FaultCounts& c : counts) {
+    counts_.secondary_lags += c.secondary_lags;
+    counts_.secondary_stalls += c.secondary_stalls;
+    counts_.primary_late_wakes += c.primary_late_wakes;
+    counts_.skips += c.skips;
+  }
   for (int a = 0; a < count; ++a) {
     result.wall_time_s += regions_.compute_seconds(a);
     stats_.push_back(records[a].Summarise(stretch_ / regions_.schedule(a).rate_hz));

@@ -192,6 +192,56 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
   return out;
 }
 
+TimingFaults StressTimingFaults(unsigned seed) {
+  TimingFaults faults;
+  faults.seed = seed;
+  faults.secondary_lags_per_s = 2;
+  faults.max_lag_periods = 10;
+  faults.secondary_stalls_per_s = 0.5;
+  faults.max_stall_s = 0.3;
+  faults.primary_late_wakes_per_s = 2;
+  faults.max_late_periods = 10;
+  return faults;
+}
+
+namespace {
+double LargestForceStep(const TrialResult& trial) {
+  double largest = 0;
+  for (size_t i = 1; i < trial.samples.size(); ++i) {
+    const auto& f = trial.samples[i].feedback_force_n;
+    const auto& g = trial.samples[i - 1].feedback_force_n;
+    largest = std::max(largest, std::hypot(f[0] - g[0], f[1] - g[1], f[2] - g[2]));
+  }
+  return largest;
+}
+}  // namespace
+
+FaultOutcome RunFaultCase(const StressOutcome& outcome, double run_s, const TimingFaults& faults) {
+  FaultOutcome out;
+  const bool production = outcome.stress_case.substep_safety <= AsyncRegions::kSubstepSafety;
+  if (!production || !(outcome.predicted_stable || outcome.passive_expected)) return out;
+  out.ran = true;
+  Scene scene = outcome.stress_case.scene;
+  scene.input.periods = run_s * scene.input.frequency_hz;
+  AsyncRegions nominal(scene, outcome.stress_case.substep_safety);
+  out.nominal_force_step_n = LargestForceStep(nominal.RunTrial());
+  // The scale from the nominal run: a diverged run's own input work diverges with it.
+  const EnergyAccount expected = nominal.Energies();
+  out.energy_scale_j = std::max(
+      {std::abs(expected.input_work_j), expected.damping_dissipated_j, expected.stored_j, 1e-12});
+  AsyncRegions regions(scene, outcome.stress_case.substep_safety);
+  RealTimeSchedule schedule(regions, 1.0, faults);
+  const TrialResult trial = schedule.RunTrial();  // from rest
+  out.outcome = trial.outcome;
+  out.faults = schedule.faults();
+  out.max_force_step_n = LargestForceStep(trial);
+  const EnergyAccount e = regions.Energies();
+  out.energy_gain_j = EnergyAboveBound(e, 0.0);
+  out.diverged = trial.diverged() || !std::isfinite(e.stored_j) ||
+                 e.stored_j > AsyncRegions::kEnergyGrowthFactor * out.energy_scale_j;
+  return out;
+}
+
 std::string DescribeStressCase(const StressCase& c) {
   const Scene& s = c.scene;
   const AdaptivitySettings& a = s.adaptivity;

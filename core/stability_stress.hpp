@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/realtime_schedule.hpp"
 #include "core/reference_trial.hpp"
 #include "core/scene.hpp"
 
@@ -70,8 +71,10 @@ struct StressOutcome {
 
   /**
    * The regions built as production builds them (each step within kSubstepSafety of its own
-   * limit) and linked by the displacement exchange: the interface controllers must hold such a
-   * case as run, whatever the bare exchange does (docs/regions.md, "Passive interfaces").
+   * limit) and linked by the displacement exchange: the stress test checks that the interface
+   * controllers hold such a case as run, whatever the bare exchange does. (Not every such
+   * configuration: docs/regions.md, "Passive interfaces", names two they do not hold, which is
+   * why the daemon still verifies.)
    */
   bool passive_expected = false;
   bool controlled_run = false;  ///< run as the daemon runs it too: every region within its limit
@@ -122,6 +125,37 @@ long DetectionBoundPeriods(double spectral_radius, double common_period_s, doubl
 
 /** Predicts and runs one case. */
 StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& ranges);
+
+/**
+ * The timing faults `hapticsim stress --faults` injects: a secondary lagging 1–10 of its periods
+ * twice a second, stalling for up to 0.3 s once every two seconds, and the primary waking
+ * 1–10 periods late twice a second — on top of what the shared machine does.
+ */
+TimingFaults StressTimingFaults(unsigned seed);
+
+/** One case run on real threads with injected timing faults, as the daemon runs it. */
+struct FaultOutcome {
+  bool ran = false;
+  TrialOutcome outcome = TrialOutcome::kCompleted;
+  bool diverged = false;          ///< non-finite, or its energy past kEnergyGrowthFactor × scale
+  double energy_gain_j = 0;       ///< EnergyAboveBound at the end (from rest)
+  double energy_scale_j = 0;  ///< the largest energy of the nominal run, for a relative tolerance
+  double max_force_step_n = 0;    ///< largest force change between primary periods, N
+  double nominal_force_step_n = 0;  ///< the same input on the virtual-time schedule, N
+  FaultCounts faults;
+  bool energy_balance_violated() const {
+    return energy_gain_j > StressOutcome::kGrowingBacklog * energy_scale_j;
+  }
+};
+
+/**
+ * Runs `outcome`'s case for `run_s` seconds of wall time on RealTimeSchedule with `faults`,
+ * controllers on, from rest under its input — when its regions are built as production builds
+ * them and the daemon would run it or the controllers are expected to hold it (predicted stable,
+ * or passive_expected; else ran = false). The near-limit cases (one step per period at up to
+ * 1.3 of a region's limit) are never what the daemon runs, and are left out.
+ */
+FaultOutcome RunFaultCase(const StressOutcome& outcome, double run_s, const TimingFaults& faults);
 
 /** One line describing a case's scene and configuration, for reports. */
 std::string DescribeStressCase(const StressCase& stress_case);

@@ -207,7 +207,7 @@ class HapticLoop {
     return skipped_periods_[region].load(std::memory_order_relaxed);
   }
   /** A secondary region woken more periods late than this skips them instead of stepping them. */
-  static constexpr int kSkipAfterLatePeriods = 3;
+  static constexpr int kSkipAfterLatePeriods = AsyncRegions::kSkipAfterLatePeriods;
   /**
    * The primary's boundary from region 1 older than this means the secondary thread is not
    * running: every answer is flagged kBoundaryStale (the supervisor logs it too).

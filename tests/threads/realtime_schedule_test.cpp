@@ -69,9 +69,9 @@ TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
 // region's state is held, never extrapolated — forwards past one period or backwards at all —
 // but a secondary that lags for many periods couples with a delay the stability estimate did not
 // assume, and that coupling is not stable: measured under ThreadSanitizer on 2 cores, peaks of
-// 1.3 N (on time) to 3,500 N (2.5·10⁵⁷ N before backward extrapolation was clamped). The daemon
-// never sends such a force (input.max_force_n) and restarts the regions; holding a lagging
-// region safely is the reliability issue's work.
+// 1.3 N (on time) to 3,500 N (2.5·10⁵⁷ N before backward extrapolation was clamped), before
+// the interface controllers and the skipping of long lags; the daemon's port guard bounds what
+// is sent whatever happens. The faults test below measures the run under injected lags.
 TEST(RealTimeSchedule, CompletesWithFiniteForcesWhateverTheTiming) {
   AsyncRegions regions(Adaptive(2, 2, 600));
   RealTimeSchedule dut(regions);
@@ -90,6 +90,39 @@ TEST(RealTimeSchedule, CompletesWithFiniteForcesWhateverTheTiming) {
     std::printf("%ld deadline misses: peak force %.3g N (on time: 1.3 N)\n", misses,
                 threaded.peak_force_n);
   }
+}
+
+// Injected timing faults (what `hapticsim stress --faults` runs): lags, stalls and late primary
+// wakes several times a second are really injected and counted, a stall long enough is skipped
+// as the daemon skips it, and the run stays bounded with its energy balance intact: above the
+// controllers' bound by no more than their backlog, to round-off.
+TEST(RealTimeSchedule, InjectedTimingFaultsAreCountedAndTheRunStaysBounded) {
+  AsyncRegions regions(Adaptive(2, 2, 600));
+  TimingFaults faults;
+  faults.seed = 3;
+  faults.secondary_lags_per_s = 20;
+  faults.secondary_stalls_per_s = 8;
+  faults.max_stall_s = 0.05;
+  faults.primary_late_wakes_per_s = 20;
+  RealTimeSchedule dut(regions, 1.0, faults);
+  const TrialResult threaded = dut.RunTrial();
+  EXPECT_EQ(threaded.outcome, TrialOutcome::kCompleted);
+  const FaultCounts& counts = dut.faults();
+  EXPECT_GT(counts.secondary_lags, 0);
+  EXPECT_GT(counts.secondary_stalls, 0);
+  EXPECT_GT(counts.primary_late_wakes, 0);
+  EXPECT_GT(counts.skips, 0);
+  const EnergyAccount e = regions.Energies();
+  ASSERT_TRUE(std::isfinite(e.stored_j));
+  EXPECT_GT(e.input_work_j, 0);
+  EXPECT_LE(EnergyAboveBound(e, 0.0), e.pending_excess_j + 1e-9 * e.input_work_j);
+  std::printf("faults: %lld lags, %lld stalls, %lld late wakes, %lld skips; peak %.3g N, stored "
+              "%.3g J above the bound by %.3g J (backlog %.3g J)\n",
+              static_cast<long long>(counts.secondary_lags),
+              static_cast<long long>(counts.secondary_stalls),
+              static_cast<long long>(counts.primary_late_wakes),
+              static_cast<long long>(counts.skips), threaded.peak_force_n, e.stored_j,
+              EnergyAboveBound(e, 0.0), e.pending_excess_j);
 }
 
 }  // namespace

@@ -34,6 +34,8 @@ struct StressOptions {
   int only_case = -1;
   int supervisor_every = 1;
   StressRanges ranges;
+  bool faults = false;
+  double fault_run_s = 1.0;
   bool json = false;
 };
 
@@ -156,6 +158,7 @@ int Run(const StressOptions& o) {
                                                    1u, std::thread::hardware_concurrency()))));
   std::vector<StressOutcome> outcomes(static_cast<size_t>(count));
   std::vector<SupervisorCheck> checks(static_cast<size_t>(count));
+  std::vector<FaultOutcome> fault_outcomes(static_cast<size_t>(count));
   std::atomic<int> next{0}, done{0};
   std::mutex error_mutex;
   std::string first_error;
@@ -166,6 +169,10 @@ int Run(const StressOptions& o) {
         const StressCase c = DrawStressCase(o.seed, first + i, o.ranges);
         outcomes[i] = RunStressCase(c, o.ranges);
         if ((first + i) % o.supervisor_every == 0) checks[i] = CheckSupervisor(outcomes[i]);
+        if (o.faults) {
+          fault_outcomes[i] = RunFaultCase(outcomes[i], o.fault_run_s,
+                                           StressTimingFaults(c.state_seed));
+        }
       } catch (const std::exception& e) {
         std::lock_guard lock(error_mutex);
         if (first_error.empty())
@@ -198,7 +205,12 @@ int Run(const StressOptions& o) {
        other_controlled = 0, other_controlled_diverged = 0;
   double worst_energy_gain = -INFINITY;  // relative to the case's energy scale
   double worst_detection_fraction = 0, slowest_case_s = 0, cases_s = 0, supervisor_s = 0;
+  long fault_runs = 0, fault_diverged = 0, fault_violations = 0;
+  FaultCounts injected;
+  double max_force_step = 0, max_step_nominal = 0, worst_fault_gain = -INFINITY;
+  int max_step_case = -1;
   Json failures = Json::array();
+  Json fault_violating = Json::array();  // reported, not yet a failure (docs/reliability.md)
   for (int i = 0; i < count; ++i) {
     const StressOutcome& out = outcomes[i];
     const SupervisorCheck& check = checks[i];
@@ -209,6 +221,28 @@ int Run(const StressOptions& o) {
     chose_unstable += check.chose_unstable;
     pinned_refused += check.stable_pinned_refused;
     if (out.energy_balance_violated()) ++energy_violations;
+    const FaultOutcome& fault = fault_outcomes[i];
+    if (fault.ran) {
+      ++fault_runs;
+      if (fault.diverged) ++fault_diverged;
+      if (fault.energy_balance_violated()) {
+        ++fault_violations;
+        fault_violating.push_back({{"index", out.stress_case.index},
+                                   {"energy_gain_j", fault.energy_gain_j},
+                                   {"energy_scale_j", fault.energy_scale_j},
+                                   {"description", DescribeStressCase(out.stress_case)}});
+      }
+      worst_fault_gain = std::max(worst_fault_gain, fault.energy_gain_j / fault.energy_scale_j);
+      injected.secondary_lags += fault.faults.secondary_lags;
+      injected.secondary_stalls += fault.faults.secondary_stalls;
+      injected.primary_late_wakes += fault.faults.primary_late_wakes;
+      injected.skips += fault.faults.skips;
+      if (!fault.diverged && fault.max_force_step_n > max_force_step) {
+        max_force_step = fault.max_force_step_n;
+        max_step_nominal = fault.nominal_force_step_n;
+        max_step_case = out.stress_case.index;
+      }
+    }
     if ((out.predicted_stable || out.passive_expected) && out.energy_scale_j > 0) {
       worst_energy_gain = std::max(worst_energy_gain, out.energy_gain_j / out.energy_scale_j);
     }
@@ -245,14 +279,21 @@ int Run(const StressOptions& o) {
       }
     }
     if (out.stable_but_diverged() || out.divergence_undetected() || out.passive_but_diverged() ||
-        out.energy_balance_violated() || check.chose_unstable || check.stable_pinned_refused) {
+        out.energy_balance_violated() || check.chose_unstable || check.stable_pinned_refused ||
+        fault.diverged) {
       Json entry = CaseJson(out);
       if (!check.problem.empty()) entry["supervisor"] = check.problem;
+      if (fault.ran) {
+        entry["under_faults"] = {{"outcome", std::string(TrialOutcomeName(fault.outcome))},
+                                 {"diverged", fault.diverged},
+                                 {"energy_gain_j", fault.energy_gain_j},
+                                 {"energy_scale_j", fault.energy_scale_j}};
+      }
       failures.push_back(entry);
     }
   }
   const bool passed = stable_diverged == 0 && undetected == 0 && energy_violations == 0 &&
-                      passive_diverged == 0 &&
+                      passive_diverged == 0 && fault_diverged == 0 &&
                       chose_unstable == 0 && pinned_refused == 0;
   const double seconds = elapsed();
   if (o.json) {
@@ -286,6 +327,21 @@ int Run(const StressOptions& o) {
                 {"supervisor_checks_s", supervisor_s},
                 {"passed", passed},
                 {"failures", failures}};
+    if (o.faults) {
+      out["fault_runs"] = fault_runs;
+      out["diverged_under_faults"] = fault_diverged;
+      out["fault_energy_balance_violations"] = fault_violations;
+      out["fault_energy_balance_violating_cases"] = fault_violating;
+      out["worst_fault_energy_gain_fraction"] = worst_fault_gain;
+      out["max_force_step_n"] = max_force_step;
+      out["max_force_step_case"] = max_step_case;
+      out["max_force_step_without_faults_n"] = max_step_nominal;
+      out["faults_injected"] = {{"secondary_lags", injected.secondary_lags},
+                                {"secondary_stalls", injected.secondary_stalls},
+                                {"primary_late_wakes", injected.primary_late_wakes},
+                                {"secondary_skips", injected.skips}};
+      out["fault_run_s"] = o.fault_run_s;
+    }
     if (o.only_case >= 0) out["case"] = CaseJson(outcomes[0]);
     std::cout << out.dump(2) << "\n";
   } else {
@@ -327,6 +383,16 @@ int Run(const StressOptions& o) {
               << past_limit_diverged << "\n"
               << "  supervisor decisions        " << choices << ", unstable chosen "
               << chose_unstable << ", stable pinned refused " << pinned_refused << "\n";
+    if (o.faults) {
+      std::cout << "  under timing faults         " << fault_runs << " runs of " << o.fault_run_s
+                << " s on real threads (" << injected.secondary_lags << " secondary lags, "
+                << injected.secondary_stalls << " stalls, " << injected.primary_late_wakes
+                << " late primary wakes, " << injected.skips << " skips), diverged "
+                << fault_diverged << ", above the energy bound by more than 1 % "
+                << fault_violations << " (reported, not yet checked)"
+                << "\n    largest force step " << max_force_step << " N (case " << max_step_case
+                << "; " << max_step_nominal << " N on the nominal schedule)\n";
+    }
     for (const Json& failure : failures) std::cout << "FAILED " << failure.dump() << "\n";
     std::cout << (passed ? "passed\n" : "FAILED\n");
   }
@@ -367,6 +433,14 @@ Command AddStressCommand(CLI::App& parent) {
                   "stability estimates each)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app->add_flag("--faults", options->faults,
+                "Also run every case the daemon would run (or the controllers should hold) on real "
+                "threads with injected timing faults: secondary lags of 1-10 periods, stalls up to "
+                "0.3 s, late primary wakes; counts divergence and energy-bound violations");
+  app->add_option("--fault-run", options->fault_run_s,
+                  "Wall time of each run under faults, s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.05, 60.0));
   app->add_flag("--json", options->json, "One JSON object on stdout");
   return {app, [options] { return Run(*options); }};
 }
