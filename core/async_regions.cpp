@@ -354,7 +354,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     // The primary keeps kPrimaryReserve of its energy in reserve: damping its DOFs is a viscous
     // force at the contact the user feels (measured: a loaded press peaked 14 % high when it took
     // every step's backlog), so it acts only on a backlog the shells have let grow past that.
-    if (a == kPrimaryRegion) {
+    // (Its energy is an O(n) pass: only worked out when there is a backlog at all.)
+    if (a == kPrimaryRegion && asked_outward > 0) {
       asked_outward = std::max(0.0, asked_outward - PrimaryReserve(integrator));
     }
   }

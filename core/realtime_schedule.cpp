@@ -175,12 +175,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   result.samples.resize(static_cast<size_t>(result.steps));
   stats_.clear();
   counts_ = {};
-  for (const FaultCounts& c : counts) {
-    counts_.secondary_lags += c.secondary_lags;
-    counts_.secondary_stalls += c.secondary_stalls;
-    counts_.primary_late_wakes += c.primary_late_wakes;
-    counts_.skips += c.skips;
-  }
+  for (const FaultCounts& c : counts) counts_ += c;
   for (int a = 0; a < count; ++a) {
     result.wall_time_s += regions_.compute_seconds(a);
     stats_.push_back(records[a].Summarise(stretch_ / regions_.schedule(a).rate_hz));

@@ -37,6 +37,14 @@ struct TimingFaults {
 struct FaultCounts {
   std::int64_t secondary_lags = 0, secondary_stalls = 0, primary_late_wakes = 0;
   std::int64_t skips = 0;  ///< secondary wakes so late that it held its state (SkipRegion)
+
+  FaultCounts& operator+=(const FaultCounts& more) {
+    secondary_lags += more.secondary_lags;
+    secondary_stalls += more.secondary_stalls;
+    primary_late_wakes += more.primary_late_wakes;
+    skips += more.skips;
+    return *this;
+  }
 };
 
 /**

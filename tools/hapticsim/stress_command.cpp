@@ -233,10 +233,7 @@ int Run(const StressOptions& o) {
                                    {"description", DescribeStressCase(out.stress_case)}});
       }
       worst_fault_gain = std::max(worst_fault_gain, fault.energy_gain_j / fault.energy_scale_j);
-      injected.secondary_lags += fault.faults.secondary_lags;
-      injected.secondary_stalls += fault.faults.secondary_stalls;
-      injected.primary_late_wakes += fault.faults.primary_late_wakes;
-      injected.skips += fault.faults.skips;
+      injected += fault.faults;
       if (!fault.diverged && fault.max_force_step_n > max_force_step) {
         max_force_step = fault.max_force_step_n;
         max_step_nominal = fault.nominal_force_step_n;
