@@ -79,8 +79,15 @@ TEST(LcmTypes, TheDaemonsForceFlagsAreTheMessageConstants) {
   EXPECT_EQ(force_flags::kFaultLatched, force_feedback_t::FLAG_FAULT_LATCHED);
 }
 
+// A config file of this test's own: CTest runs the tests of this binary in parallel, and two
+// writing one file made each other's errors.
+std::string ConfigTestPath() {
+  return ::testing::TempDir() + "hapticsimd_config_" +
+         ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".toml";
+}
+
 std::string ConfigError(const std::string& text) {
-  const std::string path = ::testing::TempDir() + "hapticsimd_config_test.toml";
+  const std::string path = ConfigTestPath();
   std::ofstream(path) << text;
   try {
     LoadDaemonConfig(path);
@@ -131,7 +138,7 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       << ConfigError("[realtime]\nfifo_priority = 4294967306\n");
   EXPECT_NE(ConfigError("[realtime]\ncpus = [4294967297]\n").find("realtime.cpus"),
             std::string::npos);
-  EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find("hapticsimd_config_test.toml:1"), std::string::npos)
+  EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find(ConfigTestPath() + ":1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
 }
 
