@@ -321,7 +321,7 @@ class HapticLoop {
   // Input arrives with jitter: the tip the primary drives is the device's, resampled at each
   // release on the device's own timeline (one seq per primary period), continued for at most
   // this many periods past the newest input and then held.
-  static constexpr int kMaxPredictedPeriods = 3;
+  static constexpr int kMaxPredictedPeriods = 10;
 
   // Primary thread state.
   ContactTracker contact_;

@@ -13,15 +13,14 @@ void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
   const double device_ns = static_cast<double>(seq) * period_ns_;
   const double latency_ns = static_cast<double>(received_ns) - device_ns;
   if (count_ > 0 && latency_ns > latency_floor_ns_ + kRelock_ns) Reset();
-  if (count_ > 1) oldest_ = before_;
-  if (count_ > 0) before_ = newest_;
   latencies_ns_[next_latency_] = latency_ns;
   next_latency_ = (next_latency_ + 1) % kLatencyWindow;
   latencies_ = std::min(latencies_ + 1, kLatencyWindow);
   latency_floor_ns_ = LatencyFloor();
-  newest_ = {device_ns, position_m};
+  newest_ = (newest_ + 1) % kHistory;
+  history_[newest_] = {device_ns, position_m};
   newest_seq_ = seq;
-  count_ = std::min(count_ + 1, 3);
+  count_ = std::min(count_ + 1, kHistory);
 }
 
 double InputResampler::LatencyFloor() const noexcept {
@@ -47,15 +46,18 @@ double InputResampler::LatencyFloor() const noexcept {
 }
 
 std::array<double, 3> InputResampler::TipAt(std::int64_t at_ns) const noexcept {
-  if (count_ < 2) return newest_.position_m;
+  if (count_ == 0) return {};
+  if (count_ == 1) return Newest(0).position_m;
   // On the device's timeline, one device period back; never before the oldest input held, never
-  // further past the newest than the prediction may go. Between the two inputs around it.
-  const Input& first = count_ == 3 ? oldest_ : before_;
-  const double t = std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
-                              first.device_ns, newest_.device_ns + max_ahead_ns_);
-  const bool early = t < before_.device_ns;
-  const Input& a = early ? oldest_ : before_;
-  const Input& b = early ? before_ : newest_;
+  // further past the newest than the prediction may go. Between the two inputs around it (past
+  // the newest: on the line through the newest two).
+  const double t =
+      std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
+                 Newest(count_ - 1).device_ns, Newest(0).device_ns + max_ahead_ns_);
+  int i = 0;  // t lies between Newest(i + 1) and Newest(i), or past the newest
+  while (i + 2 < count_ && Newest(i + 1).device_ns > t) ++i;
+  const Input& a = Newest(i + 1);
+  const Input& b = Newest(i);
   const double u = (t - a.device_ns) / (b.device_ns - a.device_ns);
   std::array<double, 3> tip{};
   for (int c = 0; c < 3; ++c) tip[c] = a.position_m[c] + u * (b.position_m[c] - a.position_m[c]);

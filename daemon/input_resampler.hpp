@@ -54,6 +54,17 @@ class InputResampler {
   /** Forgets every input. */
   void Reset() noexcept { count_ = 0, latencies_ = 0, next_latency_ = 0; }
 
+  /**
+   * Inputs held. A device and a primary held up together (a loaded machine) send their missed
+   * inputs and run their missed periods back to back: every late period's tip must still lie
+   * between two inputs held, or it is clamped to the oldest one and the contact node jumps.
+   * With three held, a 4-period burst put the tip 34 µm ahead in one period (a 0.11 N spike on
+   * a 1.4 N press) and held it there for three. 256 device periods at 1 kHz cover a stall up to
+   * the port guard's default watchdog (device.watchdog_s, 0.2 s), beyond which the force is
+   * released anyway; a period further back than the history is clamped to its oldest input.
+   */
+  static constexpr int kHistory = 256;
+
   /** How many of the newest inputs' latencies the timeline's mapping takes the minimum of. */
   static constexpr int kLatencyWindow = 16;
   /** A latency this much above the window's minimum is a new timeline, not a late input. */
@@ -67,17 +78,20 @@ class InputResampler {
 
   double period_ns_;
   double max_ahead_ns_;
-  // Inputs held: 0, 1 (newest_ only), 2 or 3. Three, because two inputs that arrive together (a
-  // driver catching up) must not push out the one the tip one period back lies after.
-  int count_ = 0;
+  std::array<Input, kHistory> history_{};  // a ring, in seq order
+  int count_ = 0;                          // inputs it holds
+  int newest_ = -1;                        // where the newest is
   std::int64_t newest_seq_ = 0;
-  Input newest_, before_, oldest_;
   std::array<double, kLatencyWindow> latencies_ns_{};  // received − device time, a ring
   int latencies_ = 0;                                  // how many the ring holds
   int next_latency_ = 0;                               // where the next one goes
   double latency_floor_ns_ = 0;                        // LatencyFloor() after the last Add
 
   double LatencyFloor() const noexcept;
+  /** The i-th newest input held (0: the newest), i < count_. */
+  const Input& Newest(int i) const noexcept {
+    return history_[(newest_ - i + kHistory) % kHistory];
+  }
 };
 
 }  // namespace hapticsim

@@ -726,9 +726,8 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
       Temp("logger.log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   // A limit with room for a busy host: a quarter of the inputs may be superseded before the
-  // daemon's period reads them (two free-running 1 kHz clocks). The force-step limit is left
-  // out: an LCM input late by more than the 3 periods the daemon predicts moves the tip in one
-  // step (0.48 N measured once on a loaded host, under 0.2 N usually).
+  // daemon's period reads them (two free-running 1 kHz clocks). The force step is checked under
+  // load by HapticsimdUnderLoad, where the load is known to be there.
   const auto lcm = testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--input", "press",
                                         "--duration", "2", "--json", "--max-unanswered", "500"});
   logger.Signal(SIGINT);
@@ -821,7 +820,7 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
 // machine, then with two busy threads at normal priority beside the daemon (no real-time
 // privileges). Every press's peak stays within 10 % of the same press's quiet peak — a guard that
 // clamped the force to zero, or a coupling that ran away, would fail — and the force never steps
-// by more than the device's slew ceiling.
+// by more than half the device's slew ceiling.
 TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH}, Temp("load.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
@@ -847,6 +846,15 @@ TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
   EXPECT_EQ(quiet["cpu_load"]["cpu_s"].get<double>(), 0.0);
   EXPECT_EQ(loaded["nonfinite_forces"], 0);
   EXPECT_EQ(loaded["force_out_of_contact"], 0);
+  // No step either: late input and late periods are placed on the device's timeline and a tip
+  // that still jumps is caught up with (0.04–0.11 N measured in 8 loaded runs, most of it the
+  // touch-down itself, which steps 0.10–0.12 N on a quiet machine too; 0.18–0.40 N when a burst
+  // of late inputs could push the tip ahead and a 48 µm jump went through).
+  EXPECT_LT(loaded["max_force_step_in_contact_n"].get<double>(), 0.25) << loaded.dump();
+  std::printf("loaded press peaks (N):");
+  for (const auto& peak : loaded["press_peaks_n"]) std::printf(" %.3f", peak.get<double>());
+  std::printf("; largest step in contact %.3f N\n",
+              loaded["max_force_step_in_contact_n"].get<double>());
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
