@@ -16,12 +16,15 @@ std::string_view InputRejectionName(InputRejection rejection) {
       return "jump faster than input.max_speed_m_per_s";
     case InputRejection::kOldSequence:
       return "seq not newer than the last accepted";
+    case InputRejection::kSeqOutOfRange:
+      return "seq outside 0 to 2^53 (input.seq counts device periods)";
   }
   return "unknown";
 }
 
 InputRejection InputGuard::Check(std::int64_t seq, const std::array<double, 3>& p,
                                  std::int64_t received_ns) noexcept {
+  if (seq < 0 || seq > kMaxSeq) return InputRejection::kSeqOutOfRange;
   for (double x : p) {
     if (!std::isfinite(x)) return InputRejection::kNonFinite;
   }

@@ -15,8 +15,9 @@ enum class InputRejection : int {
   kOutsideWorkspace,  ///< beyond the object's box grown by the workspace margin
   kJump,              ///< faster than max_speed since the last accepted input (no hand moves so)
   kOldSequence,       ///< seq not newer than the last accepted one (duplicate or reordered)
+  kSeqOutOfRange,     ///< seq below 0 or above InputGuard::kMaxSeq
 };
-inline constexpr int kNumInputRejections = 5;
+inline constexpr int kNumInputRejections = 6;
 std::string_view InputRejectionName(InputRejection rejection);
 
 /**
@@ -28,6 +29,9 @@ class InputGuard {
  public:
   /** Silence after which the next input starts a new session (any seq, any position), s. */
   static constexpr double kNewSessionAfter_s = 0.5;
+  /** The largest seq accepted: 2⁵³, up to which a double (the resampler's timeline) holds
+   *  every integer; at 1 kHz, 285,000 years of device periods. */
+  static constexpr std::int64_t kMaxSeq = std::int64_t{1} << 53;
 
   InputGuard(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s)
       : edge_m_(mesh.edge_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}

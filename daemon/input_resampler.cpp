@@ -10,7 +10,15 @@ InputResampler::InputResampler(double device_period_s, double max_ahead_s) noexc
 void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
                          const std::array<double, 3>& position_m) noexcept {
   if (count_ > 0 && seq <= newest_seq_) Reset();  // a restarted driver: its own new timeline
-  const double device_ns = static_cast<double>(seq) * period_ns_;
+  // The timeline counts from its first seq: device times stay small enough for a double to hold
+  // every period exactly (s · T near 2⁶² lost whole seconds, and two inputs shared one time).
+  std::int64_t periods = 0;
+  if (count_ > 0 &&
+      (__builtin_sub_overflow(seq, base_seq_, &periods) || periods > kMaxTimelinePeriods)) {
+    Reset();  // a leap no device makes: a new timeline
+  }
+  if (count_ == 0) base_seq_ = seq, periods = 0;
+  const double device_ns = static_cast<double>(periods) * period_ns_;
   const double latency_ns = static_cast<double>(received_ns) - device_ns;
   if (count_ > 0 && latency_ns > latency_floor_ns_ + kRelock_ns) Reset();
   latencies_ns_[next_latency_] = latency_ns;
@@ -58,6 +66,7 @@ std::array<double, 3> InputResampler::TipAt(std::int64_t at_ns) const noexcept {
   while (i + 2 < count_ && Newest(i + 1).device_ns > t) ++i;
   const Input& a = Newest(i + 1);
   const Input& b = Newest(i);
+  if (!(b.device_ns > a.device_ns)) return b.position_m;  // never 0 / 0
   const double u = (t - a.device_ns) / (b.device_ns - a.device_ns);
   std::array<double, 3> tip{};
   for (int c = 0; c < 3; ++c) tip[c] = a.position_m[c] + u * (b.position_m[c] - a.position_m[c]);

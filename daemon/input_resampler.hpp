@@ -64,6 +64,8 @@ class InputResampler {
    * released anyway; a period further back than the history is clamped to its oldest input.
    */
   static constexpr int kHistory = 256;
+  /** The longest timeline, device periods from its first seq: 2⁵³, every one exact in a double. */
+  static constexpr std::int64_t kMaxTimelinePeriods = std::int64_t{1} << 53;
 
   /** How many of the newest inputs' latencies the timeline's mapping takes the minimum of. */
   static constexpr int kLatencyWindow = 16;
@@ -82,6 +84,7 @@ class InputResampler {
   int count_ = 0;                          // inputs it holds
   int newest_ = -1;                        // where the newest is
   std::int64_t newest_seq_ = 0;
+  std::int64_t base_seq_ = 0;  // the timeline's first seq: device time 0
   std::array<double, kLatencyWindow> latencies_ns_{};  // received − device time, a ring
   int latencies_ = 0;                                  // how many the ring holds
   int next_latency_ = 0;                               // where the next one goes

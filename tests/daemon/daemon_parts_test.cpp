@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <tuple>
 
 #include "core/error.hpp"
@@ -197,6 +198,18 @@ TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {
   EXPECT_EQ(guard.Check(1, {0.125, 0.145, 0.002}, 1400 * ms), InputRejection::kOldSequence);
   EXPECT_EQ(guard.Check(1, {0.2, 0.1, -0.01}, 1501 * ms), InputRejection::kAccepted);
   EXPECT_EQ(guard.Check(2, {0.2, 0.1, -0.01}, 1502 * ms), InputRejection::kAccepted);
+  // seq from 0 to 2⁵³ (a double holds every one of them: 285,000 years at 1 kHz), at the edges
+  // and beyond.
+  EXPECT_EQ(guard.Check(-1, {0.2, 0.1, -0.01}, 3000 * ms), InputRejection::kSeqOutOfRange);
+  EXPECT_EQ(guard.Check(0, {0.2, 0.1, -0.01}, 3001 * ms), InputRejection::kAccepted);
+  EXPECT_EQ(guard.Check(InputGuard::kMaxSeq, {0.2, 0.1, -0.01}, 3002 * ms),
+            InputRejection::kAccepted);
+  EXPECT_EQ(guard.Check(InputGuard::kMaxSeq + 1, {0.2, 0.1, -0.01}, 4000 * ms),
+            InputRejection::kSeqOutOfRange);
+  EXPECT_EQ(guard.Check(std::numeric_limits<std::int64_t>::max(), {0.2, 0.1, -0.01}, 5000 * ms),
+            InputRejection::kSeqOutOfRange);
+  EXPECT_EQ(InputRejectionName(InputRejection::kSeqOutOfRange),
+            "seq outside 0 to 2^53 (input.seq counts device periods)");
 }
 
 TEST(DeadlineMonitor, CountsMissesAndReportsExecutionPercentiles) {

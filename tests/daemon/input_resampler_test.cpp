@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -102,6 +103,29 @@ TEST(InputResampler, ABurstOfInputsAfterAStallIsPlacedOnTheTimeline) {
     const double want = Press(static_cast<double>(k * kT - latency - kT))[2];
     EXPECT_NEAR(tip.TipAt(k * kT)[2], want, 1e-12) << "release " << k;
   }
+}
+
+TEST(InputResampler, AHugeSeqKeepsTheTipFinite) {
+  // Seqs far from zero (a driver that counts from its epoch, or a hostile sender): the device
+  // time s · T in doubles would lose whole periods (found: two consecutive seqs near 2⁶² gave
+  // one device time and a NaN tip). The timeline counts from its first seq instead.
+  for (const std::int64_t start : {std::int64_t{1} << 53, std::int64_t{1} << 62,
+                                   std::numeric_limits<std::int64_t>::max() - 100}) {
+    InputResampler tip(kT * 1e-9, kMaxAheadS);
+    for (std::int64_t k = 0; k < 50; ++k) {
+      tip.Add(start + k, k * kT, Press(static_cast<double>(k * kT)));
+      const std::array<double, 3> at = tip.TipAt(k * kT + kT / 2);
+      ASSERT_TRUE(std::isfinite(at[2])) << start << " + " << k;
+    }
+    EXPECT_NEAR(tip.TipAt(50 * kT)[2], Press(49.0 * kT)[2], 1e-12) << start;
+  }
+  // A seq that leaps ahead by more than a double holds exactly starts a new timeline too.
+  InputResampler tip(kT * 1e-9, kMaxAheadS);
+  tip.Add(1, 0, {0.1, 0.1, 0.001});
+  tip.Add(2, kT, {0.1, 0.1, 0.002});
+  tip.Add(std::numeric_limits<std::int64_t>::max(), 2 * kT, {0.1, 0.1, 0.003});
+  tip.Add(std::numeric_limits<std::int64_t>::min(), 3 * kT, {0.1, 0.1, 0.004});
+  EXPECT_TRUE(std::isfinite(tip.TipAt(4 * kT)[2]));
 }
 
 TEST(InputResampler, ContinuesAtMostMaxAheadPastTheNewestInputThenHolds) {
