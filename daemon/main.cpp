@@ -79,11 +79,21 @@ struct MapState {
   std::shared_ptr<const ErrorMap> map;  // shared with a choice being computed
 };
 
-MapState LoadMap(const std::string& path, bool reload = false) {
+// The map at `path`, checked as the supervisor will use it with `scene` (MapProblem).
+// @throws Error naming the file and what is wrong with it.
+std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Scene& scene) {
+  auto map = std::make_shared<const ErrorMap>(LoadErrorMap(path));
+  if (const std::string problem = MapProblem(scene, *map); !problem.empty()) {
+    throw Error("error map " + path + " refused: " + problem);
+  }
+  return map;
+}
+
+MapState LoadMap(const std::string& path, const Scene& scene, bool reload = false) {
   MapState state{path, nullptr};
   if (path.empty()) return state;
   try {
-    state.map = std::make_shared<const ErrorMap>(LoadErrorMap(path));
+    state.map = LoadUsableMap(path, scene);
     spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
                  state.map->provenance.grid, state.map->provenance.code_version);
   } catch (const Error& e) {
@@ -131,6 +141,14 @@ int Serve(const Arguments& args) {
   if (args.print_config || args.check_config) {
     if (args.print_config) std::cout << FormatDaemonConfig(config);
     if (args.check_config) {
+      // The map too: a config whose map is missing or unusable would start without one.
+      if (!config.error_map.empty()) {
+        try {
+          (void)LoadUsableMap(config.error_map, config.scene);
+        } catch (const Error& e) {
+          throw Error(std::string("supervisor.error_map: ") + e.what());
+        }
+      }
       std::cout << "hapticsimd: configuration "
                 << (default_missing ? "(built-in defaults; " + args.config + " does not exist)"
                                     : args.config)
@@ -154,7 +172,7 @@ int Serve(const Arguments& args) {
         "may be paged, running on",
         std::strerror(errno));
   }
-  MapState map = LoadMap(config.error_map);
+  MapState map = LoadMap(config.error_map, config.scene);
   double target = config.error_target_percent;
   std::optional<RegionConfiguration> pinned;
   SupervisorDecision decision = ChooseConfiguration(config.scene, map.map.get(), target, pinned);
@@ -397,7 +415,7 @@ int Serve(const Arguments& args) {
         }
       }
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
-      MapState reloaded = LoadMap(config.error_map, true);
+      MapState reloaded = LoadMap(config.error_map, config.scene, true);
       if (reloaded.map || config.error_map.empty()) map = std::move(reloaded);
       report_error();  // the new target or map, until the new choice replaces the decision
       choose_again(pinned);

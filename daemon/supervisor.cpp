@@ -105,6 +105,31 @@ CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfigurati
               std::to_string(node[2]) + "), not even at equal rates");
 }
 
+std::string MapProblem(const Scene& scene, const ErrorMap& map) {
+  if (!map.grid) return "";
+  try {
+    const ErrorLookup lookup(map, ErrorField::kMagnitude);
+    const MapPoint own = PointOfScene(scene);
+    for (int a = 0; a < kNumMapAxes; ++a) {
+      for (double value : map.axes[a]) {
+        MapPoint point = own;
+        point[a] = value;
+        (void)SceneAtPoint(scene, point);  // throws naming the key, for a value it refuses
+      }
+    }
+    for (double rate : map.axes[kRate]) {
+      if (rate > PrimaryRateHz(scene)) {
+        return "adaptivity.secondary_rate = " + FormatReal(rate) +
+               " Hz in the map is above the primary rate, " + FormatReal(PrimaryRateHz(scene)) +
+               " Hz";
+      }
+    }
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
                                        double target_percent,
                                        const std::optional<RegionConfiguration>& pinned,
@@ -116,7 +141,9 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     bool clamped = false;
   };
   std::vector<Candidate> candidates;
-  if (map && map->grid) {
+  // Only a map it can use: its lookup takes every axis and its configuration values are whole
+  // numbers in range (they are cast to int below).
+  if (map && map->grid && MapProblem(scene, *map).empty()) {
     const ErrorLookup lookup(*map, ErrorField::kMagnitude);
     // Mean measured cost of each configuration over the map's ok samples.
     std::map<std::array<double, 3>, std::pair<double, int>> cost;

@@ -40,11 +40,20 @@ struct SupervisorDecision {
  * (the daemon passes the node its regions are centred on; stability is estimated around it too)
  * with the input frequency and amplitude unknown (their worst case over the map). Without a map:
  * the scene's own configuration if stable, else equal rates (always stable when the primary rate
- * is). `pinned`: only that configuration (refused — an Error — if it is unstable).
+ * is); a map with a MapProblem counts as none. `pinned`: only that configuration (refused — an
+ * Error — if it is unstable).
  * `below_cost_us_per_ms`: only configurations the map measured cheaper than this (deadlines
  * before accuracy, when the running one keeps missing them).
  * @throws Error when no stable configuration exists at all (or none cheaper, with a ceiling).
  */
+/**
+ * Why the daemon cannot use a grid map with its scene, or "" when it can: the lookup must take
+ * every axis (at most ErrorLookup::kMaxAxisValues values), and every axis value must be one its
+ * scene key accepts (a primary size of 1e300 is no configuration). The message names the key.
+ * Scattered maps have no lookup and are left to ChooseConfiguration (it runs without them).
+ */
+std::string MapProblem(const Scene& scene, const ErrorMap& map);
+
 SupervisorDecision ChooseConfiguration(
     const Scene& scene, const ErrorMap* map, double target_percent,
     const std::optional<RegionConfiguration>& pinned,

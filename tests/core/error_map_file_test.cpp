@@ -105,6 +105,25 @@ TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSaying
   std::filesystem::remove(path);
 }
 
+TEST(ErrorMapFile, AxesWhoseSizesOverflowAreRefusedNotWrappedRound) {
+  // 32¹⁰ × 16384 = 2⁶⁴ samples: the product wrapped round to 0 and a map of 0 samples on those
+  // axes was taken for a whole one.
+  ErrorMap map;
+  map.grid = true;
+  for (int a = 0; a < kNumMapAxes; ++a) {
+    const int values = a < 10 ? 32 : a == 10 ? 16384 : 1;
+    for (int i = 0; i < values; ++i) map.axes[a].push_back(i + 1.0);
+  }
+  const std::string path = TempPath("overflow.hsmap");
+  SaveErrorMap(map, path);
+  EXPECT_NE(LoadError(path).find("corrupted: sample count differs from the axes"),
+            std::string::npos)
+      << LoadError(path);
+  EXPECT_NE(LoadError(path, MapLoadParts::kLookupOnly).find("sample count differs"),
+            std::string::npos);
+  std::filesystem::remove(path);
+}
+
 TEST(ErrorMapFile, TheDaemonsLookupTableLoadsAloneAndAgreesWithTheWholeMap) {
   const std::string path = TempPath("lookup.hsmap");
   const ErrorMap map = ExampleMap();

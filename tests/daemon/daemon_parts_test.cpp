@@ -291,6 +291,44 @@ TEST(Supervisor, ChoosesTheCheapestStableConfigurationMeetingTheTargetElseTheMos
   EXPECT_EQ(no_map.error_percent, -1);
 }
 
+// What the daemon will not trust in a map, each with the key it names: an axis longer than the
+// lookup takes (the daemon exited: ChooseConfiguration threw), a configuration value no scene
+// accepts (cast from a double to int: undefined behaviour for 1e300). The choice then runs as
+// with no map.
+TEST(Supervisor, AMapTheDaemonCannotUseIsNamedAndChosenAsNoMap) {
+  Scene scene;
+  scene.mesh.nodes = 9;
+  const ErrorMap good = TwoConfigurationMap(scene);
+  scene.adaptivity.primary_size = 3;  // what runs without a map
+  EXPECT_EQ(MapProblem(scene, good), "");
+
+  std::array<std::vector<double>, kNumMapAxes> axes = good.axes;
+  axes[static_cast<int>(MapAxis::kPrimarySize)].clear();
+  for (int size = 1; size <= 65; ++size) {
+    axes[static_cast<int>(MapAxis::kPrimarySize)].push_back(size);
+  }
+  ErrorMap long_axis = ErrorMap::MakeGrid(axes);
+  for (MapSample& sample : long_axis.samples) sample.status = SampleStatus::kOk;
+  EXPECT_NE(MapProblem(scene, long_axis).find("adaptivity.primary_size: a lookup axis needs 1 to 64"),
+            std::string::npos)
+      << MapProblem(scene, long_axis);
+  const SupervisorDecision no_map = ChooseConfiguration(scene, &long_axis, 7.0, std::nullopt);
+  EXPECT_FALSE(no_map.have_map);
+
+  for (const double size : {1e300, 2.5, -1.0, 1001.0}) {
+    ErrorMap bad = good;
+    bad.axes[static_cast<int>(MapAxis::kPrimarySize)] = {1, size};
+    if (size < 1) bad.axes[static_cast<int>(MapAxis::kPrimarySize)] = {size, 1};
+    EXPECT_NE(MapProblem(scene, bad).find("adaptivity.primary_size"), std::string::npos)
+        << size << ": " << MapProblem(scene, bad);
+    EXPECT_FALSE(ChooseConfiguration(scene, &bad, 7.0, std::nullopt).have_map) << size;
+  }
+  ErrorMap bad_rate = good;
+  bad_rate.axes[static_cast<int>(MapAxis::kSecondaryRate)] = {1e308};
+  EXPECT_NE(MapProblem(scene, bad_rate).find("adaptivity.secondary_rate"), std::string::npos)
+      << MapProblem(scene, bad_rate);
+}
+
 // Where the tool moves the regions, the status's error is looked up for that node: between the
 // mapped contact nodes interpolated, beyond them the edge's and flagged, and none where the map
 // calls the configuration unstable.

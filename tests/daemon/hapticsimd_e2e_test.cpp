@@ -32,6 +32,10 @@
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "core/error_map.hpp"
+#include "core/error_map_file.hpp"
+#include "core/map_axes.hpp"
+#include "core/scene.hpp"
 #include "ipc/shm_device_client.hpp"
 #include "tests/support/late_wakes.hpp"
 #include "tests/support/run_command.hpp"
@@ -523,6 +527,57 @@ TEST(HapticsimdReload, ACorruptMapOnReloadIsRefusedAndTheDaemonKeepsServing) {
       << daemon.Log();
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0);
+}
+
+// A map the daemon cannot use — here a primary-size axis of 65 values, one more than the lookup
+// takes — is refused by --check-config naming the key, and at start the daemon serves without it
+// (it exited: the supervisor's lookup threw). So does a map file that does not exist.
+TEST(HapticsimdMaps, AMapTheLookupCannotTakeIsRefusedAndTheDaemonServesWithoutIt) {
+  const Scene scene;
+  const MapPoint at = PointOfScene(scene);
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};
+  axes[static_cast<int>(MapAxis::kSecondaryLod)] = {2};
+  axes[static_cast<int>(MapAxis::kSecondaryRate)] = {1000};
+  auto& sizes = axes[static_cast<int>(MapAxis::kPrimarySize)];
+  sizes.clear();
+  for (int size = 1; size <= 65; ++size) sizes.push_back(size);
+  ErrorMap long_axis = ErrorMap::MakeGrid(axes);
+  for (MapSample& sample : long_axis.samples) {
+    sample.status = SampleStatus::kOk;
+    sample.max_magnitude_percent = 1.0;
+  }
+  const std::string map = Temp("long-axis.hsmap");
+  SaveErrorMap(long_axis, map);
+
+  const auto check = testing::RunCommand({HAPTICSIMD_PATH, "--check-config", "--error-map", map});
+  EXPECT_EQ(check.exit_status, 2) << check.out << check.err;
+  EXPECT_NE(check.err.find("supervisor.error_map: error map " + map + " refused: "
+                           "adaptivity.primary_size: a lookup axis needs 1 to 64 values"),
+            std::string::npos)
+      << check.err;
+  const auto missing = testing::RunCommand(
+      {HAPTICSIMD_PATH, "--check-config", "--error-map", Temp("no-such-map.hsmap")});
+  EXPECT_EQ(missing.exit_status, 2) << missing.out;
+  EXPECT_NE(missing.err.find("supervisor.error_map: "), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("cannot open"), std::string::npos) << missing.err;
+
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--error-map", map}, Temp("long-axis.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  EXPECT_NE(daemon.Log().find("running without an error map"), std::string::npos)
+      << daemon.Log();
+  Client client;
+  auto next = Clock::now();
+  for (std::int64_t seq = 1; seq <= 300; ++seq) {
+    client.Send(seq, kEdge / 2, kEdge / 2, 0.002);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ASSERT_TRUE(daemon.running()) << daemon.Log();
+  EXPECT_GT(client.Forces().size(), 250u) << daemon.Log();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
 // The shared-memory interface with a real second process: the example driver client.
