@@ -32,12 +32,6 @@ inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChann
   return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
 }
 
-BoundaryChannel::Snapshot SnapshotOf(int width) {
-  BoundaryChannel::Snapshot snapshot;
-  snapshot.values = Eigen::VectorXd::Zero(width);
-  return snapshot;
-}
-
 // K of a region's own elements plus the inner region's band, for the region's own limit: with
 // the displacement exchange the region evaluates the band's force on its Γ from its own current Γ,
 // so that stiffness acts on Γ within the step, unlagged, as its own does. Construction only.
@@ -83,11 +77,11 @@ struct AsyncRegions::Region {
   std::unique_ptr<BoundaryChannel> outward;   // this → outer: band displacements or Γ forces
   std::unique_ptr<ElementSetStiffness> band;  // this region's elements next to its outer Γ
   std::vector<int> band_layer;                // their DOFs off the outer Γ
-  BoundaryChannel::Snapshot outer_newer, outer_older;  // read by this region's thread
+  BoundaryChannel::ReadPair outer;  // Γ from the outer region, read by this region's thread
   std::vector<double> outward_values;                  // written by this region's thread
 
   // Link with the region inwards: this region is its outer side (owns that Γ).
-  BoundaryChannel::Snapshot inner_newer, inner_older;  // read by this region's thread
+  BoundaryChannel::ReadPair inner;  // the inner region's side, read by this region's thread
   std::vector<double> inward_values, load_values;
   Eigen::VectorXd band_u, band_ku;  // for evaluating the inner region's band
 
@@ -212,14 +206,12 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
           coupling_ == Coupling::kForce ? gamma : static_cast<int>(region->band_layer.size());
       region->inward = std::make_unique<BoundaryChannel>(gamma);
       region->outward = std::make_unique<BoundaryChannel>(outward_width);
-      region->outer_newer = SnapshotOf(gamma);
-      region->outer_older = SnapshotOf(gamma);
+      region->outer = BoundaryChannel::ReadPair(gamma);
       region->outward_values.assign(static_cast<size_t>(outward_width), 0.0);
     }
     if (a > 0) {
       const Region& inner = *regions_[a - 1];
-      region->inner_newer = SnapshotOf(inner.outward->width());
-      region->inner_older = SnapshotOf(inner.outward->width());
+      region->inner = BoundaryChannel::ReadPair(inner.outward->width());
       region->inward_values.assign(dofs.inner_interface.size(), 0.0);
       region->load_values.assign(dofs.inner_interface.size(), 0.0);
       region->band_u = Eigen::VectorXd::Zero(n);
@@ -311,34 +303,34 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   }
   // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
   if (region.inward) {
-    (void)region.inward->TryReadLatestTwo(&region.outer_newer, &region.outer_older);
+    (void)region.inward->TryReadLatestTwo(&region.outer);
     // The outer region is ahead: interpolate. If it is late, hold its newest state.
-    const double t = std::min(t0 + h, region.outer_newer.time_s);
+    const double t = std::min(t0 + h, region.outer.newer.time_s);
     if (a == kPrimaryRegion) {
       primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
     }
     for (size_t i = 0; i < outer_gamma.size(); ++i) {
       region.prescribed_values[region.outer_offset + i] =
-          OnLine(region.outer_older, region.outer_newer, static_cast<int>(i), t);
+          OnLine(region.outer.older, region.outer.newer, static_cast<int>(i), t);
     }
   }
   if (a > 0) {
     const Region& inner = *regions_[a - 1];
-    (void)inner.outward->TryReadLatestTwo(&region.inner_newer, &region.inner_older);
+    (void)inner.outward->TryReadLatestTwo(&region.inner);
     // The schedule keeps the inner region less than one of its nominal periods behind; never
     // extrapolate further than that, should it be late.
-    const double t = std::min(t0, region.inner_newer.time_s + 1.0 / inner.schedule.rate_hz);
+    const double t = std::min(t0, region.inner.newer.time_s + 1.0 / inner.schedule.rate_hz);
     if (coupling_ == Coupling::kForce) {
       for (size_t i = 0; i < inner_gamma.size(); ++i) {
         region.load_values[i] =
-            -OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+            -OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
       }
     } else {
       // The inner region's force on Γ from its band: its displacements next to Γ on the line
       // through its newest two states, Γ itself as this region has it now.
       for (size_t i = 0; i < inner.band_layer.size(); ++i) {
         region.band_u[inner.band_layer[i]] =
-            OnLine(region.inner_older, region.inner_newer, static_cast<int>(i), t);
+            OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
       }
       const Eigen::VectorXd& u = integrator.u();
       for (int dof : inner_gamma) region.band_u[dof] = u[dof];

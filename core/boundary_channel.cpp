@@ -1,6 +1,7 @@
 #include "core/boundary_channel.hpp"
 
 #include <cassert>
+#include <utility>
 
 namespace hapticsim {
 
@@ -44,19 +45,32 @@ bool BoundaryChannel::TryReadSlot(std::uint64_t generation, Snapshot* out) const
   return false;
 }
 
-bool BoundaryChannel::TryReadLatestTwo(Snapshot* newer, Snapshot* older) const noexcept {
-  assert(newer->values.size() == width_ && older->values.size() == width_);
+BoundaryChannel::ReadPair::ReadPair(int width) {
+  for (Snapshot* s : {&newer, &older, &next_newer_, &next_older_}) {
+    s->values = Eigen::VectorXd::Zero(width);
+  }
+}
+
+bool BoundaryChannel::TryReadLatestTwo(ReadPair* pair) const noexcept {
+  Snapshot& newer = pair->next_newer_;
+  Snapshot& older = pair->next_older_;
+  assert(newer.values.size() == width_ && older.values.size() == width_);
+  // Read into the pair's spare snapshots; only a whole, consistent pair replaces the one it has
+  // (swapping vectors: no copy, no allocation).
   for (int attempt = 0; attempt < 8; ++attempt) {
     const std::uint64_t latest = published_.load(std::memory_order_acquire);
     if (latest == 0) return false;
-    if (!TryReadSlot(latest, newer)) continue;
+    if (!TryReadSlot(latest, &newer)) continue;
     if (latest == 1) {
-      older->time_s = newer->time_s;
-      older->generation = newer->generation;
-      older->values = newer->values;
-      return true;
+      older.time_s = newer.time_s;
+      older.generation = newer.generation;
+      older.values = newer.values;
+    } else if (!TryReadSlot(latest - 1, &older)) {
+      continue;
     }
-    if (TryReadSlot(latest - 1, older)) return true;
+    std::swap(pair->newer, newer);
+    std::swap(pair->older, older);
+    return true;
   }
   return false;
 }

@@ -33,6 +33,21 @@ class BoundaryChannel {
     Eigen::VectorXd values;
   };
 
+  /**
+   * What one reader keeps: the newest two snapshots it has read, and room to read the next two
+   * into, so that a read that fails part-way leaves `newer` and `older` as they were — a pair
+   * the reader can go on interpolating between.
+   */
+  class ReadPair {
+   public:
+    explicit ReadPair(int width = 0);
+    Snapshot newer, older;
+
+   private:
+    friend class BoundaryChannel;
+    Snapshot next_newer_, next_older_;
+  };
+
   explicit BoundaryChannel(int width);
 
   int width() const { return width_; }
@@ -41,12 +56,13 @@ class BoundaryChannel {
   void Publish(double time_s, std::span<const double> values) noexcept;
 
   /**
-   * Copies the newest snapshot into `newer` and the one published before it into `older`
-   * (both equal to the newest when only one has been published).
+   * Copies the newest snapshot into pair->newer and the one published before it into
+   * pair->older (both equal to the newest when only one has been published).
    * @return false when nothing has been published yet, or no consistent copy could be taken
-   *         within a few attempts because the writer kept overwriting the slots.
+   *         within a few attempts because the writer kept overwriting the slots; the pair is then
+   *         exactly as it was. @pre the pair was made for this channel's width.
    */
-  [[nodiscard]] bool TryReadLatestTwo(Snapshot* newer, Snapshot* older) const noexcept;
+  [[nodiscard]] bool TryReadLatestTwo(ReadPair* pair) const noexcept;
 
   /** Forgets every snapshot (not thread-safe: only while no thread uses the channel). */
   void Clear();
