@@ -64,6 +64,7 @@ const std::map<std::string, Setter>& Setters() {
     text("scene.file", &DaemonConfig::scene_file);
     flag("lcm.enabled", &DaemonConfig::lcm_enabled);
     text("lcm.url", &DaemonConfig::lcm_url);
+    flag("lcm.allow_network", &DaemonConfig::lcm_allow_network);
     text("lcm.device_channel", &DaemonConfig::device_channel);
     text("lcm.force_channel", &DaemonConfig::force_channel);
     text("lcm.status_channel", &DaemonConfig::status_channel);
@@ -201,11 +202,59 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(
       c.shm_name.size() > 1 && c.shm_name[0] == '/' && c.shm_name.find('/', 1) == std::string::npos,
       "shm.name must be '/' and a name, e.g. \"/hapticsim\"");
-  require(c.lcm_url.find("://") != std::string::npos,
-          "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq://");
+  const std::string url_problem = LcmUrlProblem(c.lcm_url, c.lcm_allow_network);
+  require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
   ValidateScene(c.scene);
+}
+
+std::string LcmUrlProblem(const std::string& url, bool allow_network) {
+  const size_t scheme_end = url.find("://");
+  if (scheme_end == std::string::npos || scheme_end == 0) {
+    return "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq:// (it is \"" + url +
+           "\")";
+  }
+  const std::string scheme = url.substr(0, scheme_end), rest = url.substr(scheme_end + 3);
+  const std::string allow =
+      ": keep it on this host, or set lcm.allow_network = true on a network you trust";
+  if (scheme == "memq" || scheme == "file") return "";
+  if (scheme == "udpm" || scheme == "mpudpm") {
+    std::optional<std::string> ttl;
+    const size_t query = rest.find('?');
+    for (size_t at = query; at != std::string::npos && at + 1 < rest.size();) {
+      const size_t end = rest.find('&', at + 1);
+      const std::string option = rest.substr(at + 1, end == std::string::npos ? end : end - at - 1);
+      if (option.rfind("ttl=", 0) == 0) ttl = option.substr(4);
+      at = end;
+    }
+    if (!ttl) {
+      return allow_network ? ""
+                           : "lcm.url must say ttl=0, as in udpm://239.255.76.67:7667?ttl=0, to "
+                             "keep LCM traffic on this host, or lcm.allow_network = true must be "
+                             "set";
+    }
+    const bool whole = !ttl->empty() && ttl->size() <= 3 &&
+                       std::all_of(ttl->begin(), ttl->end(), [](char d) { return d >= '0' && d <= '9'; });
+    if (!whole || std::stoi(*ttl) > 255) {
+      return "lcm.url: ttl must be a whole number from 0 to 255 (it is '" + *ttl + "')";
+    }
+    if (std::stoi(*ttl) > 0 && !allow_network) {
+      return "lcm.url: ttl=" + *ttl + " sends LCM traffic off this host" + allow;
+    }
+    return "";
+  }
+  if (scheme == "tcpq") {
+    const std::string host = rest.substr(0, rest.find_first_of(":/"));
+    const bool loopback = host == "localhost" || host.rfind("127.", 0) == 0;
+    if (!loopback && !allow_network) return "lcm.url: " + url + " sends LCM traffic off this host" + allow;
+    return "";
+  }
+  return "lcm.url: unknown LCM provider '" + scheme + "' (udpm, mpudpm, tcpq, memq or file)";
+}
+
+bool LcmUrlLeavesHost(const std::string& url) {
+  return !LcmUrlProblem(url, false).empty() && LcmUrlProblem(url, true).empty();
 }
 
 std::string DeviceInputOf(const DaemonConfig& config) {
@@ -300,6 +349,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "[scene]\nfile = " << quote(c.scene_file) << "\n\n"
       << "[lcm]\nenabled = " << (c.lcm_enabled ? "true" : "false") << "\n"
       << "url = " << quote(c.lcm_url) << "  # ttl=0: multicast stays on this host\n"
+      << "allow_network = " << (c.lcm_allow_network ? "true" : "false")
+      << "  # true lets url send traffic off this host (ttl > 0, tcpq:// to another machine)\n"
       << "device_channel = " << quote(c.device_channel) << "\n"
       << "force_channel = " << quote(c.force_channel) << "\n"
       << "status_channel = " << quote(c.status_channel) << "\n"

@@ -20,6 +20,9 @@ struct DaemonConfig {
   bool lcm_enabled = true;
   /// Host-local by default: ttl=0 keeps multicast on this machine.
   std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  /// Only with this set may lcm.url send traffic off the host (a ttl above 0, tcpq:// to another
+  /// machine); the daemon then says so at start, as a warning.
+  bool lcm_allow_network = false;
   std::string device_channel = "HAPTIC_DEVICE";
   std::string force_channel = "HAPTIC_FORCE";
   std::string status_channel = "HAPTIC_STATUS";
@@ -68,6 +71,15 @@ DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& o
 
 /** The transport that owns the device input: device.input, or its default. */
 std::string DeviceInputOf(const DaemonConfig& config);
+
+/**
+ * Why `url` may not be lcm.url, or "" if it may: a provider LCM has (udpm, mpudpm, tcpq, memq,
+ * file), and, unless `allow_network`, traffic that stays on this host — udpm with an explicit
+ * ttl=0, tcpq to a loopback address.
+ */
+std::string LcmUrlProblem(const std::string& url, bool allow_network);
+/** Whether `url` is a valid LCM URL that sends traffic off this host. */
+bool LcmUrlLeavesHost(const std::string& url);
 
 /** The defaults, as with an empty config file. */
 DaemonConfig DefaultDaemonConfig();

@@ -201,6 +201,12 @@ int Serve(const Arguments& args) {
     spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
                  config.device_channel, config.force_channel, config.status_channel,
                  config.command_channel);
+    if (LcmUrlLeavesHost(config.lcm_url)) {
+      spdlog::warn(
+          "LCM traffic LEAVES THIS HOST (lcm.url = {}, allowed by lcm.allow_network = true): any "
+          "machine on that network can read the forces and send device input and commands",
+          config.lcm_url);
+    }
   }
   std::unique_ptr<ShmServer> shm;
   if (config.shm_enabled) {

@@ -143,6 +143,40 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       << ConfigError("[lcm\nurl = 3\n");
 }
 
+// LCM traffic stays on this host unless the config says, in a key of its own, that it may leave:
+// ttl=255 and a TCP provider to another machine were accepted as any URL with "://".
+TEST(DaemonConfig, AnLcmUrlThatLeavesTheHostNeedsAllowNetwork) {
+  for (const char* url : {"udpm://239.255.76.67:7667?ttl=0", "udpm://239.255.76.68:7700?ttl=0",
+                          "udpm://239.255.76.67:7667?recv_buf_size=2097152&ttl=0", "memq://",
+                          "tcpq://127.0.0.1:7700", "tcpq://localhost:7700"}) {
+    EXPECT_EQ(ConfigError(std::string("[lcm]\nurl = \"") + url + "\"\n"), "") << url;
+  }
+  const std::pair<const char*, const char*> refused[] = {
+      {"udpm://239.255.76.67:7667?ttl=1", "lcm.url: ttl=1 sends LCM traffic off this host"},
+      {"udpm://239.255.76.67:7667?ttl=255", "lcm.url: ttl=255 sends LCM traffic off this host"},
+      {"udpm://239.255.76.67:7667", "lcm.url must say ttl=0"},
+      {"udpm://239.255.76.67:7667?ttl=256", "lcm.url: ttl must be a whole number from 0 to 255"},
+      {"udpm://239.255.76.67:7667?ttl=zero", "lcm.url: ttl must be a whole number from 0 to 255"},
+      {"tcpq://10.0.0.5:7700", "lcm.url: tcpq://10.0.0.5:7700 sends LCM traffic off this host"},
+      {"carrier-pigeon://home", "lcm.url: unknown LCM provider 'carrier-pigeon'"},
+      {"239.255.76.67", "lcm.url must look like udpm://239.255.76.67:7667?ttl=0 or memq://"},
+  };
+  for (const auto& [url, message] : refused) {
+    const std::string error = ConfigError(std::string("[lcm]\nurl = \"") + url + "\"\n");
+    EXPECT_NE(error.find(message), std::string::npos) << url << ": " << error;
+    if (std::string(message).find("off this host") != std::string::npos) {
+      EXPECT_NE(error.find("lcm.allow_network = true"), std::string::npos) << error;
+      // Said in so many words, it is allowed.
+      EXPECT_EQ(ConfigError(std::string("[lcm]\nallow_network = true\nurl = \"") + url + "\"\n"),
+                "")
+          << url;
+    }
+  }
+  EXPECT_FALSE(DefaultDaemonConfig().lcm_allow_network);
+  EXPECT_FALSE(LcmUrlLeavesHost(DefaultDaemonConfig().lcm_url));
+  EXPECT_TRUE(LcmUrlLeavesHost("udpm://239.255.76.67:7667?ttl=1"));
+}
+
 TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
   const std::string path = ::testing::TempDir() + "hapticsimd_config_device.toml";
   std::ofstream(path) << "[shm]\nenabled = true\n[device]\nmax_force_n = 3.0\n"

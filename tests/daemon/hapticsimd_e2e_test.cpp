@@ -580,6 +580,29 @@ TEST(HapticsimdMaps, AMapTheLookupCannotTakeIsRefusedAndTheDaemonServesWithoutIt
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
+// LCM off the host only when the config says so: refused by --check-config and at start, and
+// when allowed, said at start as a warning. (Run inside the test's private network namespace:
+// the multicast with ttl=1 reaches nothing but its loopback.)
+TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSaidAloud) {
+  const std::string off_host = "udpm://239.255.76.67:7667?ttl=1";
+  const auto check = testing::RunCommand({HAPTICSIMD_PATH, "--check-config", "--lcm-url", off_host});
+  EXPECT_EQ(check.exit_status, 2) << check.out << check.err;
+  EXPECT_NE(check.err.find("lcm.url: ttl=1 sends LCM traffic off this host"), std::string::npos)
+      << check.err;
+  const auto start = testing::RunCommand({HAPTICSIMD_PATH, "--lcm-url", off_host, "--duration", "1"});
+  EXPECT_EQ(start.exit_status, 2) << start.err;
+
+  const std::string config = Temp("allow-network.toml");
+  std::ofstream(config) << "[lcm]\nallow_network = true\nurl = \"" << off_host << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config, "--duration", "2"},
+                                    Temp("allow-network.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  EXPECT_NE(daemon.Log().find("warning LCM traffic LEAVES THIS HOST (lcm.url = " + off_host),
+            std::string::npos)
+      << daemon.Log();
+  EXPECT_EQ(daemon.Wait(10), 0) << daemon.Log();
+}
+
 // The shared-memory interface with a real second process: the example driver client.
 TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
   const std::string name = "/hapticsim-e2e-" + std::to_string(getpid());
