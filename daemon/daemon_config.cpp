@@ -143,10 +143,13 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
           "supervisor.status_rate_hz must be from 0.1 to 100 Hz");
   require(std::isfinite(c.stale_after_s) && c.stale_after_s >= 0.002 && c.stale_after_s <= 10,
           "input.stale_after_s must be from 0.002 to 10 s");
-  require(std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0,
-          "input.max_speed_m_per_s must be > 0 m/s");
-  require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0,
-          "input.workspace_margin_m must be >= 0 m");
+  // Ceilings a hand and a desk set: a limit of 1e300 checks nothing.
+  require(std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0 &&
+              c.max_speed_m_per_s <= 100,
+          "input.max_speed_m_per_s must be in (0, 100] m/s; a hand moves at most a few m/s");
+  require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0 &&
+              c.workspace_margin_m <= 10,
+          "input.workspace_margin_m must be from 0 to 10 m");
   const PortGuardSettings& p = c.port;
   auto value = [](double v) { return " (it is " + FormatReal(v) + ")"; };
   require(std::isfinite(p.max_force_n) && p.max_force_n > 0 && p.max_force_n <= 100,
@@ -187,8 +190,10 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(c.fifo_priority >= 0 && c.fifo_priority <= 99,
           "realtime.fifo_priority must be from 0 (off) to 99");
   for (int cpu : c.cpus) require(cpu >= 0 && cpu < 4096, "realtime.cpus: CPU numbers are >= 0");
-  require(std::isfinite(c.max_log_lines_per_s) && c.max_log_lines_per_s > 0,
-          "log.max_lines_per_s must be > 0");
+  require(std::isfinite(c.max_log_lines_per_s) && c.max_log_lines_per_s > 0 &&
+              c.max_log_lines_per_s <= 1000,
+          "log.max_lines_per_s must be in (0, 1000]: more would let a flood of bad input flood "
+          "the journal");
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
   require(std::find(levels.begin(), levels.end(), c.log_level) != levels.end(),
           "log.level must be one of trace, debug, info, warn, error");

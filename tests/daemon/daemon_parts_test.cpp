@@ -139,6 +139,25 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       << ConfigError("[realtime]\nfifo_priority = 4294967306\n");
   EXPECT_NE(ConfigError("[realtime]\ncpus = [4294967297]\n").find("realtime.cpus"),
             std::string::npos);
+  // Every number has a ceiling: at it accepted, beyond it refused naming the key.
+  const std::pair<const char*, const char*> ceilings[] = {
+      {"[input]\nmax_speed_m_per_s = 100\n", ""},
+      {"[input]\nmax_speed_m_per_s = 1e300\n", "input.max_speed_m_per_s must be in (0, 100]"},
+      {"[input]\nworkspace_margin_m = 10\n", ""},
+      {"[input]\nworkspace_margin_m = 11\n", "input.workspace_margin_m must be from 0 to 10"},
+      {"[log]\nmax_lines_per_s = 1000\n", ""},
+      {"[log]\nmax_lines_per_s = 1e9\n", "log.max_lines_per_s must be in (0, 1000]"},
+      {"[device]\nmax_force_n = 100\nengage_rate_n_per_ms = 0.1\nfault_force_n = 100\n", ""},
+      {"[device]\nmax_force_n = 1e300\n", "device.max_force_n must be in (0, 100] N"},
+  };
+  for (const auto& [text, message] : ceilings) {
+    const std::string error = ConfigError(text);
+    if (*message == 0) {
+      EXPECT_EQ(error, "") << text;
+    } else {
+      EXPECT_NE(error.find(message), std::string::npos) << text << error;
+    }
+  }
   EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find(ConfigTestPath() + ":1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
 }
