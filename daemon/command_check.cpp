@@ -1,5 +1,7 @@
 #include "daemon/command_check.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <sstream>
 
@@ -48,6 +50,19 @@ CheckedCommand CheckCommand(const command_t& command, double primary_rate_hz) {
   out.kind = CheckedCommand::Kind::kRefused;
   out.refusal = why.str();
   return out;
+}
+
+bool CommandRateLimit::Admit(std::int64_t now_ns) noexcept {
+  if (last_ns_ >= 0 && now_ns > last_ns_) {
+    tokens_ = std::min(kBurst, tokens_ + static_cast<double>(now_ns - last_ns_) * 1e-9 * kPerSecond);
+  }
+  if (last_ns_ < 0 || now_ns > last_ns_) last_ns_ = now_ns;
+  if (tokens_ >= 1) {
+    tokens_ -= 1;
+    return true;
+  }
+  ++refused_;
+  return false;
 }
 
 }  // namespace hapticsim

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+
 #include <string>
 
 #include "daemon/supervisor.hpp"
@@ -23,5 +25,26 @@ struct CheckedCommand {
  * unstable configuration: a pin that passes here is still verified by the supervisor.
  */
 CheckedCommand CheckCommand(const command_t& command, double primary_rate_hz);
+
+/**
+ * How many commands the supervisor takes: kBurst at once, then kPerSecond a second (a token
+ * bucket). A person or a script changes a target or pins a configuration a few times a minute;
+ * a flood (a pin at 1 kHz) is refused beyond this, and counted.
+ */
+class CommandRateLimit {
+ public:
+  static constexpr double kPerSecond = 10;
+  static constexpr double kBurst = 10;
+
+  /** Whether a command arriving at `now_ns` (CLOCK_MONOTONIC) is taken. */
+  bool Admit(std::int64_t now_ns) noexcept;
+  /** Commands refused so far. */
+  std::int64_t refused() const noexcept { return refused_; }
+
+ private:
+  double tokens_ = kBurst;
+  std::int64_t last_ns_ = -1;
+  std::int64_t refused_ = 0;
+};
 
 }  // namespace hapticsim

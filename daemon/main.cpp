@@ -22,7 +22,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <future>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -33,6 +32,7 @@
 #include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
 #include "core/error_sweep.hpp"
+#include "daemon/background_worker.hpp"
 #include "daemon/black_box.hpp"
 #include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
@@ -283,11 +283,15 @@ int Serve(const Arguments& args) {
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
   std::int64_t wrong_transport_seen = 0;
+  CommandRateLimit command_limit;
+  std::int64_t last_command_refusal_ns = 0;
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
   constexpr int kOverrunBurst = 10;
-  std::future<SupervisorDecision> choice;         // a new choice being computed
-  std::optional<RegionConfiguration> choice_pin;  // the pin that choice was asked with
+  // New choices are made on one background thread (stability estimates take seconds): the tick
+  // never waits, and no command makes a thread.
+  BackgroundWorker<SupervisorDecision> chooser("hsim-choose");
+  std::optional<RegionConfiguration> choice_pin;  // the pin the newest choice was asked with
   std::optional<SupervisorDecision> pending;      // chosen, waiting for the tool to be away
   bool choice_for_overload = false;               // the running choice is for deadlines
   // The scene as the regions run it: centred on the node the tool last touched. A choice is made
@@ -302,18 +306,12 @@ int Serve(const Arguments& args) {
   // before accuracy: a choice for a node does not bring the dear configuration back).
   std::set<LatticeIndex> chosen_for_nodes{ContactNode(config.scene)};
   double cost_ceiling = std::numeric_limits<double>::infinity();
-  // Choices replaced while still running: their futures are kept until they finish, since
-  // destroying a running std::async future waits for it (the tick must not).
-  std::vector<std::future<SupervisorDecision>> abandoned;
   auto start_choice = [&](const std::optional<RegionConfiguration>& pin) {
-    // Stability estimates take up to seconds: off the supervisor's tick.
-    if (choice.valid()) abandoned.push_back(std::move(choice));
     choice_pin = pin;
     chosen_for_nodes.insert(loop.centre_node());
-    choice = std::async(std::launch::async,
-                        [scene = scene_at_centre(), m = map.map, target, pin, cost_ceiling] {
-                          return ChooseConfiguration(scene, m.get(), target, pin, cost_ceiling);
-                        });
+    chooser.Submit([scene = scene_at_centre(), m = map.map, target, pin, cost_ceiling] {
+      return ChooseConfiguration(scene, m.get(), target, pin, cost_ceiling);
+    });
   };
   // A new target, map or pin: every node may be chosen for again, at any cost.
   auto choose_again = [&](const std::optional<RegionConfiguration>& pin) {
@@ -353,7 +351,7 @@ int Serve(const Arguments& args) {
   // for that node, once per node. What is chosen switches like any other, once the tool is away.
   auto choose_for_centre_if_missed = [&] {
     const LatticeIndex& node = loop.centre_node();
-    if (reported_target_met || !decision.have_map || !map.map || pinned || choice.valid() ||
+    if (reported_target_met || !decision.have_map || !map.map || pinned || chooser.busy() ||
         pending || chosen_for_nodes.count(node)) {
       return;
     }
@@ -492,6 +490,14 @@ int Serve(const Arguments& args) {
     }
     if (bridge) {
       while (std::optional<command_t> command = bridge->PopCommand()) {
+        if (!command_limit.Admit(now)) {
+          if ((now - last_command_refusal_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s) {
+            last_command_refusal_ns = now;
+            spdlog::warn("command refused: more than {} a second ({} refused so far)",
+                         CommandRateLimit::kPerSecond, command_limit.refused());
+          }
+          continue;
+        }
         const CheckedCommand checked = CheckCommand(*command, PrimaryRateHz(config.scene));
         switch (checked.kind) {
           case CheckedCommand::Kind::kSetErrorTarget:
@@ -526,9 +532,9 @@ int Serve(const Arguments& args) {
         }
       }
     }
-    if (choice.valid() && choice.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-      try {
-        SupervisorDecision chosen = choice.get();
+    if (std::optional<BackgroundWorker<SupervisorDecision>::Outcome> outcome = chooser.Take()) {
+      if (outcome->result) {
+        SupervisorDecision chosen = std::move(*outcome->result);
         if (choice_pin) spdlog::info("configuration pinned");
         pinned = choice_pin;
         if (chosen.configuration == decision.configuration) {
@@ -542,18 +548,15 @@ int Serve(const Arguments& args) {
           pending = chosen;
         }
         report_error();
-      } catch (const Error& e) {
+      } else {
         if (choice_for_overload) cheapest_cost_us_per_ms = decision.cost_us_per_ms;
         spdlog::error("{} failed: {}; keeping the active configuration",
                       choice_pin ? "pinning a configuration" : "choosing a configuration",
-                      e.what());
+                      outcome->error);
       }
       choice_for_overload = false;
       choose_for_centre_if_missed();  // the regions may have moved while it was being made
     }
-    std::erase_if(abandoned, [](const std::future<SupervisorDecision>& f) {
-      return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
-    });
     // Moving the regions — to the pending configuration, or onto the node the tool touches or
     // hovers over. A new configuration only out of contact, after the object has settled: the
     // force is zero then and the regions restart from rest, so the user feels no step. A touch on
@@ -617,7 +620,7 @@ int Serve(const Arguments& args) {
     if (const int region = overload.Check(now, rates_hz); region >= 0) {
       const std::string name = loop.regions().partition().RegionName(region);
       const bool nothing_cheaper = decision.cost_us_per_ms == cheapest_cost_us_per_ms;
-      if (decision.have_map && !pinned && !choice.valid() && !nothing_cheaper) {
+      if (decision.have_map && !pinned && !chooser.busy() && !nothing_cheaper) {
         spdlog::error(
             "{} thread missed {} of its {} periods in the last second, and more than 5 % in "
             "each of the 3 before: choosing a configuration cheaper than {} µs per simulated "

@@ -11,7 +11,7 @@ void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
     known_ = known->second;
     return;
   }
-  verifying_ = std::async(std::launch::async, [scene = scene_, request] {
+  verifier_.Submit([scene = scene_, request] {
     return VerifyCentredOn(scene, request.configuration, request.node);
   });
 }
@@ -21,18 +21,15 @@ std::optional<RegionsMover::Verified> RegionsMover::Poll(std::int64_t now_ns) {
   std::optional<CentredConfiguration> verdict = std::move(known_);
   known_.reset();
   if (!verdict) {
-    if (!verifying_.valid() ||
-        verifying_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
-      return std::nullopt;
-    }
+    std::optional<BackgroundWorker<CentredConfiguration>::Outcome> outcome = verifier_.Take();
+    if (!outcome) return std::nullopt;
     const Request request = *asked_;
-    try {
-      verdict = verifying_.get();
-    } catch (const Error&) {
+    if (!outcome->result) {
       refused_.insert(KeyOf(request));
       asked_.reset();
-      throw;
+      throw Error(outcome->error);
     }
+    verdict = std::move(outcome->result);
     verdicts_[KeyOf(request)] = *verdict;
   }
   Verified done{*asked_, *verdict, (now_ns - asked_ns_) * 1e-6};

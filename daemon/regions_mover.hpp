@@ -1,12 +1,12 @@
 #pragma once
 
 #include <cstdint>
-#include <future>
 #include <map>
 #include <optional>
 #include <set>
 #include <tuple>
 
+#include "daemon/background_worker.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {
@@ -14,8 +14,8 @@ namespace hapticsim {
 /**
  * The supervisor's side of moving the regions — to another configuration or to another contact
  * node. Before the regions move, their coupled stability around the node is verified
- * (VerifyCentredOn, a fraction of a second on the paper's cube) on a background thread so the
- * supervisor's tick never waits; verdicts are kept per configuration and node, so a node touched
+ * (VerifyCentredOn, a fraction of a second on the paper's cube) on a background thread of its
+ * own, made once, so the supervisor's tick never waits and no request makes a thread; verdicts are kept per configuration and node, so a node touched
  * before moves at once. The move itself is HapticLoop::Reconfigure, done by the caller.
  */
 class RegionsMover {
@@ -61,7 +61,7 @@ class RegionsMover {
   std::set<Key> refused_;
   std::optional<Request> asked_;
   std::int64_t asked_ns_ = 0;
-  std::future<CentredConfiguration> verifying_;
+  BackgroundWorker<CentredConfiguration> verifier_{"hsim-verify"};
   std::optional<CentredConfiguration> known_;  // a cached verdict waiting for Poll
 };
 

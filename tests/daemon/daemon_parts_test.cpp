@@ -265,6 +265,27 @@ TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {
             "seq outside 0 to 2^53 (input.seq counts device periods)");
 }
 
+TEST(CommandRateLimit, TakesABurstThenTenASecondAndCountsTheRest) {
+  CommandRateLimit limit;
+  const std::int64_t ms = 1'000'000;
+  for (int i = 0; i < 10; ++i) EXPECT_TRUE(limit.Admit(0)) << i;
+  EXPECT_FALSE(limit.Admit(0));
+  EXPECT_FALSE(limit.Admit(50 * ms));  // half a token
+  EXPECT_TRUE(limit.Admit(100 * ms));
+  EXPECT_EQ(limit.refused(), 2);
+  // A pin at 1 kHz for 10 s: 100 taken (one every 100 ms), the rest refused.
+  CommandRateLimit flood;
+  int taken = 0;
+  for (std::int64_t k = 0; k < 10'000; ++k) taken += flood.Admit(k * ms);
+  EXPECT_LE(taken, 10 + 100);
+  EXPECT_GE(taken, 100);
+  EXPECT_EQ(flood.refused(), 10'000 - taken);
+  // A clock that goes back takes nothing extra.
+  CommandRateLimit back;
+  for (int i = 0; i < 10; ++i) back.Admit(1000 * ms);
+  EXPECT_FALSE(back.Admit(0));
+}
+
 TEST(DeadlineMonitor, CountsMissesAndReportsExecutionPercentiles) {
   DeadlineMonitor monitor(1e-3);
   std::int64_t t = 0;

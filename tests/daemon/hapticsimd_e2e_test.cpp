@@ -603,6 +603,50 @@ TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSai
   EXPECT_EQ(daemon.Wait(10), 0) << daemon.Log();
 }
 
+int ThreadsOf(int pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  }
+  return -1;
+}
+
+// A flood of commands from any local process: pins at 1 kHz of a configuration whose
+// verification takes many seconds (1000:999 Hz). The daemon made a thread per command (6 → 28
+// threads, the primary late in 733 periods), aborted when it could not make one, and took over
+// 30 s to stop. Now: no new thread, the flood refused beyond 10 commands a second and counted,
+// device input still answered, and SIGTERM obeyed within 2 s.
+TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeconds) {
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH}, Temp("command-flood.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const int threads_before = ThreadsOf(daemon.pid());
+  ASSERT_GT(threads_before, 0);
+  Client client;
+  command_t pin{};
+  pin.command = command_t::PIN_CONFIGURATION;
+  pin.primary_size = 1, pin.secondary_lod = 2, pin.secondary_rate_hz = 999;
+  int most_threads = threads_before;
+  auto next = Clock::now();
+  for (std::int64_t k = 1; k <= 2000; ++k) {  // 2 s at 1 kHz: a pin and a device input each
+    client.Command(pin);
+    client.Send(k, kEdge / 2, kEdge / 2, -0.002);
+    if (k % 100 == 0) most_threads = std::max(most_threads, ThreadsOf(daemon.pid()));
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ASSERT_TRUE(daemon.running()) << daemon.Log();
+  EXPECT_EQ(most_threads, threads_before) << "a command made a thread";
+  EXPECT_GT(client.Forces().size(), 1800u) << "device input went unanswered during the flood";
+  EXPECT_NE(daemon.Log().find("command refused: more than 10 a second"), std::string::npos)
+      << daemon.Log();
+  const auto stop = Clock::now();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - stop).count(), 2.0) << daemon.Log();
+}
+
 // The shared-memory interface with a real second process: the example driver client.
 TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
   const std::string name = "/hapticsim-e2e-" + std::to_string(getpid());
