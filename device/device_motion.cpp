@@ -11,11 +11,19 @@
 namespace hapticsim::device {
 namespace {
 
-std::vector<std::array<double, 3>> ReadReplay(const std::string& path, const std::string& channel) {
+// One entry per device period: the inputs in order, and where the device's own clock (utime, µs)
+// jumps by more than a period and a half, as many silent periods as it paused for. The device's
+// clock, not the logger's: a logger woken late receives a burst, which is no silence.
+std::vector<std::optional<std::array<double, 3>>> ReadReplay(const std::string& path,
+                                                             const std::string& channel,
+                                                             double rate_hz) {
   lcm::LogFile log(path, "r");
   if (!log.good()) throw Error("--replay " + path + ": cannot open it as an LCM log");
-  std::vector<std::array<double, 3>> positions;
+  std::vector<std::optional<std::array<double, 3>>> positions;
   std::int64_t undecodable = 0;
+  std::optional<std::int64_t> last_utime;
+  const auto max_silence =
+      static_cast<std::int64_t>(DeviceMotion::kMaxReplaySilence_s * rate_hz);
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     if (event->channel != channel) continue;
     device_input_t input;
@@ -23,7 +31,14 @@ std::vector<std::array<double, 3>> ReadReplay(const std::string& path, const std
       ++undecodable;
       continue;
     }
-    positions.push_back({input.position[0], input.position[1], input.position[2]});
+    if (last_utime && input.utime > *last_utime) {
+      const double periods = static_cast<double>(input.utime - *last_utime) * 1e-6 * rate_hz;
+      const std::int64_t silent = std::min<std::int64_t>(max_silence, std::llround(periods) - 1);
+      for (std::int64_t k = 0; k < silent; ++k) positions.emplace_back(std::nullopt);
+    }
+    last_utime = input.utime;
+    positions.push_back(std::array<double, 3>{input.position[0], input.position[1],
+                                              input.position[2]});
   }
   if (positions.empty()) {
     throw Error("--replay " + path + ": no device_input_t on channel " + channel +
@@ -46,7 +61,7 @@ DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.se
     if (!(c >= 0 && c <= s.edge_m)) throw Error("--at must lie on the front face: 0 ≤ x, y ≤ edge");
   }
   if (s.kind == "replay") {
-    replay_ = ReadReplay(s.replay_path, s.replay_channel);
+    replay_ = ReadReplay(s.replay_path, s.replay_channel, s.rate_hz);
   } else if (s.kind == "walk") {
     to_ = {s.at_m[0], s.at_m[1], 0.0};  // the walk starts above --at
     from_ = to_ = NewWaypoint(false);
@@ -86,7 +101,7 @@ std::array<double, 3> DeviceMotion::NextWalk() {
   return tip;
 }
 
-std::array<double, 3> DeviceMotion::Next() {
+std::optional<std::array<double, 3>> DeviceMotion::Next() {
   const double t = static_cast<double>(period_) / settings_.rate_hz;
   const double phase = 2 * std::numbers::pi * settings_.frequency_hz * t;
   std::array<double, 3> tip{settings_.at_m[0], settings_.at_m[1], 0.0};
@@ -98,7 +113,11 @@ std::array<double, 3> DeviceMotion::Next() {
   } else if (settings_.kind == "walk") {
     tip = NextWalk();
   } else {
-    tip = replay_[std::min<std::size_t>(static_cast<std::size_t>(period_), replay_.size() - 1)];
+    // Past the end, the last input held (the log's last entry is an input, never a silence).
+    const std::optional<std::array<double, 3>>& recorded =
+        replay_[std::min<std::size_t>(static_cast<std::size_t>(period_), replay_.size() - 1)];
+    ++period_;
+    return recorded;
   }
   ++period_;
   return tip;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -33,15 +34,20 @@ struct MotionSettings {
  *   apart, alternately above the surface and pressed into it (up to `amplitude_m`), joined at up to
  *   `walk_speed_m_per_s` with smooth starts and stops, so it touches down and lifts off at a
  *   different surface point each time;
- * - replay: the positions of a recorded LCM log's device inputs, in order, then the last held.
+ * - replay: a recorded LCM log's device inputs, in order and in time: where the device's own
+ *   clock (utime) shows a pause of more than a period and a half, the replay is silent as long
+ *   (up to kMaxReplaySilence_s each), as the recorded session was; then the last input held.
  */
 class DeviceMotion {
  public:
   /** @throws Error for bad settings or an unreadable replay log (the message says which). */
   explicit DeviceMotion(const MotionSettings& settings);
 
-  /** The tip for the next period. */
-  std::array<double, 3> Next();
+  /** The tip for the next period; nothing for a period the recorded device was silent in. */
+  std::optional<std::array<double, 3>> Next();
+
+  /** The longest silence a replay keeps from a pause in its log, s (a bad utime is no hour). */
+  static constexpr double kMaxReplaySilence_s = 10;
   /** Periods a replay holds (0 for the generated motions, which go on forever). */
   std::int64_t replay_periods() const { return static_cast<std::int64_t>(replay_.size()); }
 
@@ -55,7 +61,7 @@ class DeviceMotion {
   std::array<double, 3> from_{}, to_{};
   std::int64_t leg_start_ = 0, leg_periods_ = 1;
   bool inside_next_ = true;
-  std::vector<std::array<double, 3>> replay_;
+  std::vector<std::optional<std::array<double, 3>>> replay_;
 };
 
 }  // namespace hapticsim::device

@@ -155,13 +155,15 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
     const std::int64_t release = start + std::llround(n * period_ns);
     SleepUntilMonotonicNs(release);
     const std::int64_t seq = n + 1;
-    std::array<double, 3> tip = motion.Next();
+    const std::optional<std::array<double, 3>> next = motion.Next();  // none: a replayed silence
+    std::array<double, 3> tip = next.value_or(last_good);
     const auto burst = std::find_if(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
       return n >= b && n < b + kBurstPeriods;
     });
-    const bool silent = std::any_of(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
-      return n >= b + kBurstPeriods && n < b + kBurstPeriods + kSilentPeriods;
-    });
+    const bool silent =
+        !next || std::any_of(burst_starts.begin(), burst_starts.end(), [&](std::int64_t b) {
+          return n >= b + kBurstPeriods && n < b + kBurstPeriods + kSilentPeriods;
+        });
     if (silent) {
       bad[seq] = 1;  // nothing sent: nothing to answer
       ++report.silent_periods;

@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <set>
+#include <vector>
 
 #include "core/error.hpp"
+#include "hapticsim/device_input_t.hpp"
 
 namespace hapticsim::device {
 namespace {
@@ -15,7 +20,7 @@ TEST(DeviceMotion, ThePressGoesFromAboveTheSurfaceToItsDepthAndBack) {
   MotionSettings s;  // 1 cm at 1 Hz, from 2 mm above the middle of the front face
   DeviceMotion press(s);
   std::vector<std::array<double, 3>> tips;
-  for (int n = 0; n <= 1000; ++n) tips.push_back(press.Next());
+  for (int n = 0; n <= 1000; ++n) tips.push_back(press.Next().value());
   EXPECT_DOUBLE_EQ(tips[0][2], -0.002);
   EXPECT_NEAR(tips[500][2], 0.01, 1e-12);
   EXPECT_NEAR(tips[1000][2], -0.002, 1e-12);
@@ -31,14 +36,14 @@ TEST(DeviceMotion, TheWalkIsReproducibleAndTouchesDownSomewhereNewEachTime) {
   s.seed = 12;
   DeviceMotion other(s);
   std::set<std::pair<long, long>> touch_points;
-  std::array<double, 3> previous = a.Next();
+  std::array<double, 3> previous = a.Next().value();
   (void)b.Next();
   (void)other.Next();
   double fastest = 0;
   bool differs = false;
   for (int n = 1; n < 20000; ++n) {
-    const auto tip = a.Next();
-    ASSERT_EQ(tip, b.Next()) << "same seed, different walk at period " << n;
+    const std::array<double, 3> tip = a.Next().value();
+    ASSERT_EQ(tip, b.Next().value()) << "same seed, different walk at period " << n;
     differs = differs || tip != other.Next();
     if (previous[2] <= 0 && tip[2] > 0) {
       touch_points.insert({std::lround(tip[0] * 1000), std::lround(tip[1] * 1000)});  // mm
@@ -71,6 +76,50 @@ TEST(DeviceMotion, BadSettingsAreRefusedNamingTheOption) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("--at"), std::string::npos) << e.what();
   }
+}
+
+// A recorded session that went silent for 0.1 s (a driver that stalled, or the bad-input test's
+// stale gap) replays that silence instead of running on: the replay once kept only the inputs,
+// in order, and the pause vanished. Timed by the device's own utime, not the logger's clock.
+TEST(DeviceMotion, AReplayKeepsTheRecordedSilences) {
+  const std::string path = ::testing::TempDir() + "hapticsim_replay_silence.lcmlog";
+  {
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    auto write = [&](std::int64_t seq, std::int64_t utime_us, double z) {
+      device_input_t input{};
+      input.utime = utime_us;
+      input.seq = seq;
+      input.position[0] = input.position[1] = 0.125;
+      input.position[2] = z;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(input.getEncodedSize()));
+      input.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      lcm::LogEvent event{};
+      event.timestamp = 5'000'000;  // the logger received them all at once: no timing here
+      event.channel = "HAPTIC_DEVICE";
+      event.datalen = static_cast<std::int32_t>(bytes.size());
+      event.data = bytes.data();
+      log.writeEvent(&event);
+    };
+    write(1, 1'000'000, 0.001);
+    write(2, 1'001'000, 0.002);
+    write(3, 1'002'000, 0.003);
+    write(4, 1'103'000, 0.004);  // 101 ms later: 100 silent periods
+    write(5, 1'104'400, 0.005);  // 1.4 periods: jitter, not a silence
+  }
+  MotionSettings s;
+  s.kind = "replay";
+  s.replay_path = path;
+  DeviceMotion replay(s);
+  EXPECT_EQ(replay.replay_periods(), 3 + 100 + 2);
+  std::vector<std::optional<std::array<double, 3>>> periods;
+  for (int n = 0; n < 110; ++n) periods.push_back(replay.Next());
+  for (int n = 0; n < 3; ++n) EXPECT_NEAR(periods[n].value()[2], 0.001 * (n + 1), 1e-15);
+  for (int n = 3; n < 103; ++n) EXPECT_FALSE(periods[n].has_value()) << "period " << n;
+  EXPECT_NEAR(periods[103].value()[2], 0.004, 1e-15);
+  EXPECT_NEAR(periods[104].value()[2], 0.005, 1e-15);
+  EXPECT_NEAR(periods[109].value()[2], 0.005, 1e-15);  // then the last input, held
+  std::filesystem::remove(path);
 }
 
 }  // namespace
