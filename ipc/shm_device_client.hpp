@@ -7,24 +7,69 @@
 //   hapticsim::shm::ShmForceOutput force;
 //   if (client.ReadForce(&force) && force.seq == seq) { /* render force.force_n */ }
 //   client.ReadForcesSince(last_period, [&](const ShmForceOutput& f) { /* log every answer */ });
+//   if (client.Source(now_ns) == ForceSource::kNone) { /* render zero; client.Reconnect() off
+//                                                           the device thread, now and then */ }
 //
-// Both calls are wait-free: no locks, no allocation, no system calls. Link hapticsim_ipc.
+// All but Reconnect are wait-free: no locks, no allocation, no system calls (the clock is read
+// by the caller). Link hapticsim_ipc.
 
 #include <algorithm>
 #include <climits>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "ipc/shm_segment.hpp"
 
 namespace hapticsim::shm {
 
+/** Whether a daemon is answering (ShmDeviceClient::Source). */
+enum class ForceSource { kLive, kNone };
+
 class ShmDeviceClient {
  public:
+  /** A daemon whose newest answer is older than this is no force source. */
+  static constexpr std::int64_t kLiveWithin_ns = 10'000'000;
+
   /** @throws Error when the segment is missing or not a compatible hapticsimd segment. */
   explicit ShmDeviceClient(const std::string& name = kDefaultName)
-      : mapping_(MappedSegment::Open(name)) {}
+      : name_(name), mapping_(MappedSegment::Open(name)) {}
+
+  /**
+   * kLive while the daemon that made the segment runs and its newest answer is at most
+   * kLiveWithin_ns old at `now_ns` (CLOCK_MONOTONIC); else kNone: the force read is not being
+   * computed by anyone (a daemon killed or hung leaves its last answer in the segment, in
+   * contact, for ever) — render zero. The daemon answers every input, so a driver writing at
+   * its device rate sees kLive within a period of each write.
+   */
+  ForceSource Source(std::int64_t now_ns) const {
+    const ShmHeader& h = mapping_->segment().header;
+    if (h.daemon_pid.load(std::memory_order_relaxed) == 0) return ForceSource::kNone;
+    const std::int64_t heartbeat = h.daemon_heartbeat_ns.load(std::memory_order_acquire);
+    return heartbeat > 0 && now_ns - heartbeat <= kLiveWithin_ns ? ForceSource::kLive
+                                                                  : ForceSource::kNone;
+  }
+
+  /**
+   * Not wait-free (it opens the name again: system calls, an allocation): call it off the
+   * device's real-time thread, now and then, while Source says kNone. Maps the segment a
+   * restarted service made under the same name; true when it did. Writes go on into the new
+   * segment. @throws nothing: a name that is missing or foreign just leaves the old mapping.
+   */
+  bool Reconnect() {
+    try {
+      MappedSegment fresh = MappedSegment::Open(name_);
+      // Another daemon's: a killed one leaves its segment, pid and all, under the name.
+      const std::int64_t pid = fresh.segment().header.daemon_pid.load();
+      if (pid == 0 || pid == mapping_->segment().header.daemon_pid.load()) return false;
+      mapping_.reset();
+      mapping_.emplace(std::move(fresh));
+      return true;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
 
   /**
    * The tool tip (object frame, m), once per device period. Only one process may write: this is a
@@ -37,7 +82,7 @@ class ShmDeviceClient {
     input.seq = seq;
     input.utime = utime_us;
     for (int c = 0; c < 3; ++c) input.position_m[c] = position_m[c];
-    ShmSegment& s = mapping_.segment();
+    ShmSegment& s = mapping_->segment();
     // A restarted writer goes on from the ring's newest write (from 0 if that is nonsense).
     const std::int64_t newest = s.newest_input.load(std::memory_order_relaxed);
     const std::int64_t next = newest >= 0 && newest < INT64_MAX ? newest + 1 : 0;
@@ -46,7 +91,7 @@ class ShmDeviceClient {
   }
   /** The newest force; false when none is available consistently yet. */
   bool ReadForce(ShmForceOutput* out) const {
-    const ShmSegment& s = mapping_.segment();
+    const ShmSegment& s = mapping_->segment();
     const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
     return newest >= 0 && s.outputs[newest % kOutputSlots].Read(out) && out->period >= 0;
   }
@@ -58,7 +103,7 @@ class ShmDeviceClient {
    */
   template <class Each>
   std::int64_t ReadForcesSince(std::int64_t after, Each&& each) const {
-    const ShmSegment& s = mapping_.segment();
+    const ShmSegment& s = mapping_->segment();
     const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
     for (std::int64_t p = std::max(after + 1, newest - kOutputSlots + 1); p <= newest; ++p) {
       ShmForceOutput out;
@@ -68,10 +113,11 @@ class ShmDeviceClient {
     return std::max(after, newest);
   }
   /** True while the daemon that created the segment runs. */
-  bool DaemonRunning() { return mapping_.segment().header.daemon_pid.load() != 0; }
+  bool DaemonRunning() { return mapping_->segment().header.daemon_pid.load() != 0; }
 
  private:
-  MappedSegment mapping_;
+  std::string name_;
+  std::optional<MappedSegment> mapping_;  // always holds one (reset only to replace it)
 };
 
 }  // namespace hapticsim::shm

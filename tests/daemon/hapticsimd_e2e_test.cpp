@@ -677,6 +677,7 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
   // daemon that stopped answering or fell behind for good is seconds behind by the end.
   EXPECT_LE(number("max_lag_periods"), 150) << json;
   EXPECT_EQ(number("out_of_order"), 0) << json;
+  EXPECT_LE(number("no_force_source_periods"), 150) << json;  // stalls only, as for the lag
   EXPECT_EQ(number("nonfinite_forces"), 0) << json;
   EXPECT_GT(number("in_contact_periods"), 1000) << json;
   EXPECT_GT(number("max_push_back_N"), 1.0) << json;  // a 1 cm press pushes back about 1.4 N
@@ -736,6 +737,78 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
   EXPECT_LT(again.force_n[2], -0.3);  // pushes back (the object had not settled: not equal)
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+}
+
+// A daemon killed outright (SIGKILL: nothing cleaned up) leaves its last answer in the segment,
+// in contact, and the client read that frozen force as long as it liked. Now the client says
+// "no force source" within 10 ms of the daemon's last answer, and maps the segment a restarted
+// daemon makes, by itself, and is served by it.
+TEST(HapticsimdSharedMemory, AClientSeesNoForceSourceWithin10msOfAKilledDaemonAndReconnects) {
+  const std::string name = "/hapticsim-e2e-killed-" + std::to_string(getpid());
+  const std::string config = Temp("shm_killed.toml");
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+                        << "\"\n";
+  auto now_ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  };
+  std::int64_t seq = 0;
+  auto press = [&](shm::ShmDeviceClient& driver, int periods) {
+    for (int n = 0; n < periods; ++n, ++seq) {
+      const double z = n < 50 ? -0.002 : std::min(0.005, 1e-5 * (n - 50));
+      driver.WriteInput(seq, 0, {0.125, 0.125, z});
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  };
+  auto daemon = std::make_unique<testing::BackgroundProcess>(
+      std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("shm_killed.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(*daemon));
+  shm::ShmDeviceClient driver(name);
+  press(driver, 400);
+  EXPECT_EQ(driver.Source(now_ns()), shm::ForceSource::kLive);
+  shm::ShmForceOutput pressed;
+  ASSERT_TRUE(driver.ReadForce(&pressed));
+  EXPECT_TRUE(pressed.flags & force_feedback_t::FLAG_IN_CONTACT) << pressed.flags;
+
+  const auto killed = std::chrono::steady_clock::now();
+  daemon->Signal(SIGKILL);
+  daemon->Wait(5);
+  double none_after_ms = -1;
+  for (int n = 0; n < 100 && none_after_ms < 0; ++n) {  // the driver goes on writing
+    driver.WriteInput(seq++, 0, {0.125, 0.125, 0.005});
+    if (driver.Source(now_ns()) == shm::ForceSource::kNone) {
+      none_after_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - killed)
+              .count();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GE(none_after_ms, 0) << "still a force source 100 ms after the daemon was killed";
+  EXPECT_LT(none_after_ms, 15.0);  // 10 ms after its last answer, and the kill's own latency
+  shm::ShmForceOutput frozen;
+  EXPECT_TRUE(driver.ReadForce(&frozen));  // the last answer is still there to read …
+  EXPECT_TRUE(frozen.flags & force_feedback_t::FLAG_IN_CONTACT);  // … in contact: hence Source
+  EXPECT_FALSE(driver.Reconnect()) << "nothing new to connect to yet";
+
+  daemon = std::make_unique<testing::BackgroundProcess>(
+      std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("shm_killed2.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(*daemon));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  bool reconnected = false;
+  while (!reconnected && std::chrono::steady_clock::now() < deadline) {
+    reconnected = driver.Reconnect();
+    if (!reconnected) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(reconnected);
+  press(driver, 700);  // the driver's seq goes on: the new daemon takes it as a new session
+  EXPECT_EQ(driver.Source(now_ns()), shm::ForceSource::kLive);
+  shm::ShmForceOutput again;
+  ASSERT_TRUE(driver.ReadForce(&again));
+  EXPECT_TRUE(again.flags & force_feedback_t::FLAG_IN_CONTACT) << again.flags;
+  EXPECT_LT(again.force_n[2], -0.3);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(5), 0) << daemon->Log();
 }
 
 TEST(HapticsimdSharedMemory, AClientRefusesASegmentThatIsNotHapticsimds) {

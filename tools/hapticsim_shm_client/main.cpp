@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     hapticsim::shm::ShmDeviceClient client(name);
     const std::int64_t periods = std::llround(duration_s * 1000);
     std::int64_t answered_same_period = 0, nonfinite = 0, in_contact = 0, stale = 0;
-    std::int64_t max_lag = 0, last_seen = -1, out_of_order = 0;
+    std::int64_t max_lag = 0, last_seen = -1, out_of_order = 0, no_source = 0;
     double max_push_back = 0;
     std::set<std::int64_t> seen;
     const std::int64_t start = NowNs() + 1'000'000;
@@ -61,6 +61,11 @@ int main(int argc, char** argv) {
                     static_cast<long>(read_at % 1'000'000'000)};
       while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &then, nullptr) == EINTR) {
       }
+      // A driver renders zero when no daemon is answering: the segment keeps the last force.
+      if (client.Source(NowNs()) == hapticsim::shm::ForceSource::kNone) {
+        ++no_source;
+        continue;
+      }
       hapticsim::shm::ShmForceOutput force;
       if (!client.ReadForce(&force) || force.seq < 0) continue;
       if (force.seq == seq) ++answered_same_period;
@@ -77,11 +82,12 @@ int main(int argc, char** argv) {
         "{\"periods\": %lld, \"answered_same_period\": %lld, \"distinct_seqs_answered\": %zu, "
         "\"max_lag_periods\": %lld, \"out_of_order\": %lld, \"nonfinite_forces\": %lld, "
         "\"in_contact_periods\": %lld, \"stale_periods\": %lld, \"max_push_back_N\": %.6g, "
-        "\"daemon_running\": %s}\n",
+        "\"no_force_source_periods\": %lld, \"daemon_running\": %s}\n",
         static_cast<long long>(periods), static_cast<long long>(answered_same_period), seen.size(),
         static_cast<long long>(max_lag), static_cast<long long>(out_of_order),
         static_cast<long long>(nonfinite), static_cast<long long>(in_contact),
-        static_cast<long long>(stale), max_push_back, client.DaemonRunning() ? "true" : "false");
+        static_cast<long long>(stale), max_push_back, static_cast<long long>(no_source),
+        client.DaemonRunning() ? "true" : "false");
     return 0;
   } catch (const hapticsim::Error& e) {
     std::fprintf(stderr, "hapticsim-shm-client: error: %s\n", e.what());
