@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -28,7 +29,9 @@ namespace hapticsim {
  *
  * At destruction the thread is asked to stop and joined; a job still running after
  * kJoinWait_s (an estimate can take a minute) is left to the process's exit, so that shutdown
- * never waits for it. Jobs must therefore own everything they touch (capture by value).
+ * never waits for it. Jobs must therefore own everything they touch (capture by value). (Not
+ * yet: cancelling a running estimate. A job left running while the process exits may still read
+ * a static the exit is destroying — the scene's key table — a small window, not closed.)
  *
  * Submit and Take are for one thread (the supervisor's); they take a mutex the worker holds only
  * to hand jobs and outcomes over.
@@ -47,6 +50,13 @@ class BackgroundWorker {
   explicit BackgroundWorker(const std::string& thread_name) : state_(std::make_shared<State>()) {
     thread_ = std::thread([state = state_] { Run(*state); });
     pthread_setname_np(thread_.native_handle(), thread_name.substr(0, 15).c_str());
+  }
+
+  /** Asks the thread to stop after the job it runs (if any); the destructor then waits less. */
+  void RequestStop() {
+    std::lock_guard lock(state_->mutex);
+    state_->stop = true;
+    state_->wake.notify_all();
   }
 
   ~BackgroundWorker() {
@@ -114,7 +124,10 @@ class BackgroundWorker {
         outcome.result = job();
       } catch (const std::exception& e) {
         outcome.error = e.what();
+      } catch (...) {
+        outcome.error = "an exception of unknown type";
       }
+      job = nullptr;  // its captures (a scene, maybe a map's last reference) freed unlocked
       lock.lock();
       if (generation == state.submitted) state.outcome = std::move(outcome);
     }

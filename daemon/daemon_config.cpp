@@ -1,5 +1,8 @@
 #include "daemon/daemon_config.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -233,12 +236,7 @@ std::string LcmUrlProblem(const std::string& url, bool allow_network) {
       if (option.rfind("ttl=", 0) == 0) ttl = option.substr(4);
       at = end;
     }
-    if (!ttl) {
-      return allow_network ? ""
-                           : "lcm.url must say ttl=0, as in udpm://239.255.76.67:7667?ttl=0, to "
-                             "keep LCM traffic on this host, or lcm.allow_network = true must be "
-                             "set";
-    }
+    if (!ttl) return "";  // LCM's own default: ttl=0
     const bool whole = !ttl->empty() && ttl->size() <= 3 &&
                        std::all_of(ttl->begin(), ttl->end(), [](char d) { return d >= '0' && d <= '9'; });
     if (!whole || std::stoi(*ttl) > 255) {
@@ -251,7 +249,10 @@ std::string LcmUrlProblem(const std::string& url, bool allow_network) {
   }
   if (scheme == "tcpq") {
     const std::string host = rest.substr(0, rest.find_first_of(":/"));
-    const bool loopback = host == "localhost" || host.rfind("127.", 0) == 0;
+    in_addr address{};  // an address in 127.0.0.0/8, parsed, not a name that starts "127."
+    const bool loopback = host == "localhost" ||
+                          (inet_pton(AF_INET, host.c_str(), &address) == 1 &&
+                           (ntohl(address.s_addr) >> 24) == 127);
     if (!loopback && !allow_network) return "lcm.url: " + url + " sends LCM traffic off this host" + allow;
     return "";
   }

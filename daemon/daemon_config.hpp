@@ -74,8 +74,8 @@ std::string DeviceInputOf(const DaemonConfig& config);
 
 /**
  * Why `url` may not be lcm.url, or "" if it may: a provider LCM has (udpm, mpudpm, tcpq, memq,
- * file), and, unless `allow_network`, traffic that stays on this host — udpm with an explicit
- * ttl=0, tcpq to a loopback address.
+ * file), and, unless `allow_network`, traffic that stays on this host — udpm with ttl=0 (LCM's
+ * default when the URL names none), tcpq to an address in 127.0.0.0/8.
  */
 std::string LcmUrlProblem(const std::string& url, bool allow_network);
 /** Whether `url` is a valid LCM URL that sends traffic off this host. */

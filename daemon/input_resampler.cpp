@@ -12,10 +12,13 @@ void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
   if (count_ > 0 && seq <= newest_seq_) Reset();  // a restarted driver: its own new timeline
   // The timeline counts from its first seq: device times stay small enough for a double to hold
   // every period exactly (s · T near 2⁶² lost whole seconds, and two inputs shared one time).
+  // A leap past the history (inputs lost by the hundred, or a seq no device counts to), or a
+  // timeline too long for its times to be exact in a double: a new timeline.
   std::int64_t periods = 0;
-  if (count_ > 0 &&
-      (__builtin_sub_overflow(seq, base_seq_, &periods) || periods > kMaxTimelinePeriods)) {
-    Reset();  // a leap no device makes: a new timeline
+  if (count_ > 0 && (seq - newest_seq_ > kHistory ||
+                     __builtin_sub_overflow(seq, base_seq_, &periods) ||
+                     static_cast<double>(periods) * period_ns_ > kExactNs)) {
+    Reset();
   }
   if (count_ == 0) base_seq_ = seq, periods = 0;
   const double device_ns = static_cast<double>(periods) * period_ns_;

@@ -64,8 +64,9 @@ class InputResampler {
    * released anyway; a period further back than the history is clamped to its oldest input.
    */
   static constexpr int kHistory = 256;
-  /** The longest timeline, device periods from its first seq: 2⁵³, every one exact in a double. */
-  static constexpr std::int64_t kMaxTimelinePeriods = std::int64_t{1} << 53;
+  /** The longest timeline, ns from its first seq: 2⁵³, every whole ns exact in a double (104
+   *  days). (Counting periods instead let seq 1 then 2⁵³ give device times ~1 ms apart.) */
+  static constexpr double kExactNs = 9007199254740992.0;
 
   /** How many of the newest inputs' latencies the timeline's mapping takes the minimum of. */
   static constexpr int kLatencyWindow = 16;

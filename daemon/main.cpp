@@ -690,6 +690,9 @@ int Serve(const Arguments& args) {
     }
   }
   systemd.Notify("STOPPING=1");
+  // Both background threads told at once: their destructors then wait (at most 1 s) side by side.
+  chooser.RequestStop();
+  mover.RequestStop();
   stop_io = true;
   if (io.joinable()) io.join();
   loop.Stop();

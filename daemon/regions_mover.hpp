@@ -33,6 +33,9 @@ class RegionsMover {
 
   explicit RegionsMover(const Scene& scene) : scene_(scene) {}
 
+  /** Shutting down: the verifying thread stops after the verification it runs, if any. */
+  void RequestStop() { verifier_.RequestStop(); }
+
   /** True from Ask until Poll has returned its verdict. */
   bool busy() const { return asked_.has_value(); }
   /** False for a configuration and node found unstable (or invalid) before: not asked again. */

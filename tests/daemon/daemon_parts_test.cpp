@@ -167,13 +167,14 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 TEST(DaemonConfig, AnLcmUrlThatLeavesTheHostNeedsAllowNetwork) {
   for (const char* url : {"udpm://239.255.76.67:7667?ttl=0", "udpm://239.255.76.68:7700?ttl=0",
                           "udpm://239.255.76.67:7667?recv_buf_size=2097152&ttl=0", "memq://",
-                          "tcpq://127.0.0.1:7700", "tcpq://localhost:7700"}) {
+                          "udpm://239.255.76.67:7667", "tcpq://127.0.0.1:7700",
+                          "tcpq://127.1.2.3:7700", "tcpq://localhost:7700"}) {
     EXPECT_EQ(ConfigError(std::string("[lcm]\nurl = \"") + url + "\"\n"), "") << url;
   }
   const std::pair<const char*, const char*> refused[] = {
       {"udpm://239.255.76.67:7667?ttl=1", "lcm.url: ttl=1 sends LCM traffic off this host"},
       {"udpm://239.255.76.67:7667?ttl=255", "lcm.url: ttl=255 sends LCM traffic off this host"},
-      {"udpm://239.255.76.67:7667", "lcm.url must say ttl=0"},
+      {"tcpq://127.evil.example:7700", "lcm.url: tcpq://127.evil.example:7700 sends LCM traffic"},
       {"udpm://239.255.76.67:7667?ttl=256", "lcm.url: ttl must be a whole number from 0 to 255"},
       {"udpm://239.255.76.67:7667?ttl=zero", "lcm.url: ttl must be a whole number from 0 to 255"},
       {"tcpq://10.0.0.5:7700", "lcm.url: tcpq://10.0.0.5:7700 sends LCM traffic off this host"},

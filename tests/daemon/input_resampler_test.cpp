@@ -119,6 +119,17 @@ TEST(InputResampler, AHugeSeqKeepsTheTipFinite) {
     }
     EXPECT_NEAR(tip.TipAt(50 * kT)[2], Press(49.0 * kT)[2], 1e-12) << start;
   }
+  // From a small seq to 2⁵³ (the guard's largest) and on: a new timeline, the tip exact on it.
+  {
+    InputResampler leap(kT * 1e-9, kMaxAheadS);
+    leap.Add(1, 0, {0.1, 0.1, 0.0});
+    leap.Add(2, kT, {0.1, 0.1, 0.0});
+    const std::int64_t big = std::int64_t{1} << 53;
+    for (std::int64_t k = 0; k < 50; ++k) {
+      leap.Add(big - 50 + k, (10 + k) * kT, Press(static_cast<double>(k * kT)));
+    }
+    EXPECT_NEAR(leap.TipAt(60 * kT)[2], Press(49.0 * kT)[2], 1e-12);
+  }
   // A seq that leaps ahead by more than a double holds exactly starts a new timeline too.
   InputResampler tip(kT * 1e-9, kMaxAheadS);
   tip.Add(1, 0, {0.1, 0.1, 0.001});
