@@ -9,19 +9,18 @@ InputResampler::InputResampler(double device_period_s, double max_ahead_s) noexc
 
 void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
                          const std::array<double, 3>& position_m) noexcept {
-  if (count_ > 0 && seq <= newest_seq_) Reset();  // a restarted driver: its own new timeline
-  // The timeline counts from its first seq: device times stay small enough for a double to hold
-  // every period exactly (s · T near 2⁶² lost whole seconds, and two inputs shared one time).
-  // A leap past the history (inputs lost by the hundred, or a seq no device counts to), or a
-  // timeline too long for its times to be exact in a double: a new timeline.
-  std::int64_t periods = 0;
-  if (count_ > 0 && (seq - newest_seq_ > kHistory ||
-                     __builtin_sub_overflow(seq, base_seq_, &periods) ||
-                     static_cast<double>(periods) * period_ns_ > kExactNs)) {
-    Reset();
-  }
-  if (count_ == 0) base_seq_ = seq, periods = 0;
-  const double device_ns = static_cast<double>(periods) * period_ns_;
+  // The timeline counts device periods from its first input, so that device times stay small
+  // enough for a double to hold every one exactly (s · T near 2⁶² lost whole seconds, and two
+  // inputs shared one time). An input that does not continue it starts a new one: a seq that
+  // goes back (a restarted driver), a leap past the history (inputs lost by the hundred, or a seq
+  // no device counts to), or a timeline too long for its times to be exact.
+  std::int64_t gap = 0;
+  const bool continues = count_ > 0 && !__builtin_sub_overflow(seq, newest_seq_, &gap) &&
+                         gap > 0 && gap <= kHistory &&
+                         static_cast<double>(newest_periods_ + gap) * period_ns_ <= kExactNs;
+  if (!continues) Reset();
+  newest_periods_ = continues ? newest_periods_ + gap : 0;
+  const double device_ns = static_cast<double>(newest_periods_) * period_ns_;
   const double latency_ns = static_cast<double>(received_ns) - device_ns;
   if (count_ > 0 && latency_ns > latency_floor_ns_ + kRelock_ns) Reset();
   latencies_ns_[next_latency_] = latency_ns;

@@ -85,7 +85,7 @@ class InputResampler {
   int count_ = 0;                          // inputs it holds
   int newest_ = -1;                        // where the newest is
   std::int64_t newest_seq_ = 0;
-  std::int64_t base_seq_ = 0;  // the timeline's first seq: device time 0
+  std::int64_t newest_periods_ = 0;  // device periods from the timeline's first input to the newest
   std::array<double, kLatencyWindow> latencies_ns_{};  // received − device time, a ring
   int latencies_ = 0;                                  // how many the ring holds
   int next_latency_ = 0;                               // where the next one goes
