@@ -53,10 +53,13 @@ CheckedCommand CheckCommand(const command_t& command, double primary_rate_hz) {
 }
 
 bool CommandRateLimit::Admit(std::int64_t now_ns) noexcept {
-  if (last_ns_ >= 0 && now_ns > last_ns_) {
-    tokens_ = std::min(kBurst, tokens_ + static_cast<double>(now_ns - last_ns_) * 1e-9 * kPerSecond);
+  if (now_ns > last_ns_) {  // a clock that goes back refills nothing
+    if (last_ns_ >= 0) {
+      tokens_ =
+          std::min(kBurst, tokens_ + static_cast<double>(now_ns - last_ns_) * 1e-9 * kPerSecond);
+    }
+    last_ns_ = now_ns;
   }
-  if (last_ns_ < 0 || now_ns > last_ns_) last_ns_ = now_ns;
   if (tokens_ >= 1) {
     tokens_ -= 1;
     return true;

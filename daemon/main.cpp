@@ -468,8 +468,11 @@ int Serve(const Arguments& args) {
         last_overrun_dump_ns = now;
       }
     }
-    // Rejections: at most log.max_lines_per_s lines; the counts are in every status message.
-    const bool may_log = (now - last_rejection_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
+    // Rejections: at most log.max_lines_per_s lines each; the counts are in every status message.
+    auto line_due = [&](std::int64_t last_line_ns) {
+      return (now - last_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
+    };
+    const bool may_log = line_due(last_rejection_line_ns);
     const auto rejection = may_log
                                ? static_cast<InputRejection>(counters.last_rejection.exchange(0))
                                : InputRejection::kAccepted;
@@ -491,7 +494,7 @@ int Serve(const Arguments& args) {
     if (bridge) {
       while (std::optional<command_t> command = bridge->PopCommand()) {
         if (!command_limit.Admit(now)) {
-          if ((now - last_command_refusal_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s) {
+          if (line_due(last_command_refusal_ns)) {
             last_command_refusal_ns = now;
             spdlog::warn("command refused: more than {} a second ({} refused so far)",
                          CommandRateLimit::kPerSecond, command_limit.refused());

@@ -102,6 +102,10 @@ std::array<double, 3> DeviceMotion::NextWalk() {
 }
 
 std::optional<std::array<double, 3>> DeviceMotion::Next() {
+  if (settings_.kind == "replay") {
+    // Past the end, the last input held (the log's last entry is an input, never a silence).
+    return replay_[std::min<std::size_t>(static_cast<std::size_t>(period_++), replay_.size() - 1)];
+  }
   const double t = static_cast<double>(period_) / settings_.rate_hz;
   const double phase = 2 * std::numbers::pi * settings_.frequency_hz * t;
   std::array<double, 3> tip{settings_.at_m[0], settings_.at_m[1], 0.0};
@@ -110,14 +114,8 @@ std::optional<std::array<double, 3>> DeviceMotion::Next() {
              (settings_.amplitude_m + settings_.hover_m) * 0.5 * (1 - std::cos(phase));
   } else if (settings_.kind == "sine") {
     tip[2] = settings_.amplitude_m * std::sin(phase);
-  } else if (settings_.kind == "walk") {
+  } else {  // walk: the constructor refused any other kind
     tip = NextWalk();
-  } else {
-    // Past the end, the last input held (the log's last entry is an input, never a silence).
-    const std::optional<std::array<double, 3>>& recorded =
-        replay_[std::min<std::size_t>(static_cast<std::size_t>(period_), replay_.size() - 1)];
-    ++period_;
-    return recorded;
   }
   ++period_;
   return tip;
