@@ -269,8 +269,8 @@ std::uint64_t ReadMeta(MapFileReader& reader, ErrorMap* out) {
         // Capped without overflowing (the product once wrapped round to 0, and a map of 0 samples
         // passed for one of 2⁶⁴): the file size bounds the sample count anyway.
         constexpr std::uint64_t kCap = std::uint64_t{1} << 50;
-        grid_size = values.size() > kCap / grid_size ? kCap
-                                                      : std::min(kCap, grid_size * values.size());
+        grid_size =
+            values.size() > kCap / grid_size ? kCap : std::min(kCap, grid_size * values.size());
       }
     }
     const auto n = meta.at("samples").get<std::uint64_t>();

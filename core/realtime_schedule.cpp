@@ -114,7 +114,8 @@ TrialResult RealTimeSchedule::RunTrial() {
         if (held_ns > 0) SleepUntilMonotonicNs(MonotonicNowNs() + held_ns);
         const std::int64_t woke = MonotonicNowNs();
         // Woken far too late: hold the state over the missed periods, as the daemon does.
-        const auto missed = static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
+        const auto missed =
+            static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
         if (missed > AsyncRegions::kSkipAfterLatePeriods) {
           regions_.SkipRegion(a, missed * substeps);
           ++faulted.skips;

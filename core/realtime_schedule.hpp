@@ -25,7 +25,7 @@ struct DeadlineStats {
  */
 struct TimingFaults {
   unsigned seed = 0;
-  double secondary_lags_per_s = 0;   ///< a secondary wakes late by 1–max_lag_periods of its periods
+  double secondary_lags_per_s = 0;  ///< a secondary wakes late by 1–max_lag_periods of its periods
   int max_lag_periods = 10;
   double secondary_stalls_per_s = 0;  ///< a secondary stops for up to max_stall_s
   double max_stall_s = 0.3;

@@ -137,10 +137,10 @@ TimingFaults StressTimingFaults(unsigned seed);
 struct FaultOutcome {
   bool ran = false;
   TrialOutcome outcome = TrialOutcome::kCompleted;
-  bool diverged = false;          ///< non-finite, or its energy past kEnergyGrowthFactor × scale
-  double energy_gain_j = 0;       ///< EnergyAboveBound at the end (from rest)
-  double energy_scale_j = 0;  ///< the largest energy of the nominal run, for a relative tolerance
-  double max_force_step_n = 0;    ///< largest force change between primary periods, N
+  bool diverged = false;        ///< non-finite, or its energy past kEnergyGrowthFactor × scale
+  double energy_gain_j = 0;     ///< EnergyAboveBound at the end (from rest)
+  double energy_scale_j = 0;    ///< the largest energy of the nominal run, for a relative tolerance
+  double max_force_step_n = 0;  ///< largest force change between primary periods, N
   double nominal_force_step_n = 0;  ///< the same input on the virtual-time schedule, N
   FaultCounts faults;
   bool energy_balance_violated() const {

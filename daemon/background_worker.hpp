@@ -63,9 +63,8 @@ class BackgroundWorker {
     std::unique_lock lock(state_->mutex);
     state_->stop = true;
     state_->wake.notify_all();
-    const bool finished =
-        state_->wake.wait_for(lock, std::chrono::duration<double>(kJoinWait_s),
-                              [this] { return state_->exited; });
+    const bool finished = state_->wake.wait_for(lock, std::chrono::duration<double>(kJoinWait_s),
+                                                [this] { return state_->exited; });
     lock.unlock();
     if (finished) {
       thread_.join();
@@ -104,10 +103,10 @@ class BackgroundWorker {
   struct State {
     std::mutex mutex;
     std::condition_variable wake;
-    std::function<Result()> job;        // waiting to run
-    std::uint64_t submitted = 0;        // jobs submitted
-    std::uint64_t taken = 0;            // the `submitted` count at the last outcome taken
-    std::optional<Outcome> outcome;     // the newest job's, when it is done
+    std::function<Result()> job;     // waiting to run
+    std::uint64_t submitted = 0;     // jobs submitted
+    std::uint64_t taken = 0;         // the `submitted` count at the last outcome taken
+    std::optional<Outcome> outcome;  // the newest job's, when it is done
     bool stop = false, exited = false;
   };
 

@@ -1,7 +1,6 @@
 #include "daemon/command_check.hpp"
 
 #include <algorithm>
-
 #include <cmath>
 #include <sstream>
 

@@ -2,7 +2,6 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -147,9 +146,9 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(std::isfinite(c.stale_after_s) && c.stale_after_s >= 0.002 && c.stale_after_s <= 10,
           "input.stale_after_s must be from 0.002 to 10 s");
   // Ceilings a hand and a desk set: a limit of 1e300 checks nothing.
-  require(std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0 &&
-              c.max_speed_m_per_s <= 100,
-          "input.max_speed_m_per_s must be in (0, 100] m/s; a hand moves at most a few m/s");
+  require(
+      std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0 && c.max_speed_m_per_s <= 100,
+      "input.max_speed_m_per_s must be in (0, 100] m/s; a hand moves at most a few m/s");
   require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0 &&
               c.workspace_margin_m <= 10,
           "input.workspace_margin_m must be from 0 to 10 m");
@@ -237,8 +236,9 @@ std::string LcmUrlProblem(const std::string& url, bool allow_network) {
       at = end;
     }
     if (!ttl) return "";  // LCM's own default: ttl=0
-    const bool whole = !ttl->empty() && ttl->size() <= 3 &&
-                       std::all_of(ttl->begin(), ttl->end(), [](char d) { return d >= '0' && d <= '9'; });
+    const bool whole =
+        !ttl->empty() && ttl->size() <= 3 &&
+        std::all_of(ttl->begin(), ttl->end(), [](char d) { return d >= '0' && d <= '9'; });
     if (!whole || std::stoi(*ttl) > 255) {
       return "lcm.url: ttl must be a whole number from 0 to 255 (it is '" + *ttl + "')";
     }
@@ -250,10 +250,10 @@ std::string LcmUrlProblem(const std::string& url, bool allow_network) {
   if (scheme == "tcpq") {
     const std::string host = rest.substr(0, rest.find_first_of(":/"));
     in_addr address{};  // an address in 127.0.0.0/8, parsed, not a name that starts "127."
-    const bool loopback = host == "localhost" ||
-                          (inet_pton(AF_INET, host.c_str(), &address) == 1 &&
-                           (ntohl(address.s_addr) >> 24) == 127);
-    if (!loopback && !allow_network) return "lcm.url: " + url + " sends LCM traffic off this host" + allow;
+    const bool loopback = host == "localhost" || (inet_pton(AF_INET, host.c_str(), &address) == 1 &&
+                                                  (ntohl(address.s_addr) >> 24) == 127);
+    if (!loopback && !allow_network)
+      return "lcm.url: " + url + " sends LCM traffic off this host" + allow;
     return "";
   }
   return "lcm.url: unknown LCM provider '" + scheme + "' (udpm, mpudpm, tcpq, memq or file)";

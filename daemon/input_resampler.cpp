@@ -15,8 +15,8 @@ void InputResampler::Add(std::int64_t seq, std::int64_t received_ns,
   // goes back (a restarted driver), a leap past the history (inputs lost by the hundred, or a seq
   // no device counts to), or a timeline too long for its times to be exact.
   std::int64_t gap = 0;
-  const bool continues = count_ > 0 && !__builtin_sub_overflow(seq, newest_seq_, &gap) &&
-                         gap > 0 && gap <= kHistory &&
+  const bool continues = count_ > 0 && !__builtin_sub_overflow(seq, newest_seq_, &gap) && gap > 0 &&
+                         gap <= kHistory &&
                          static_cast<double>(newest_periods_ + gap) * period_ns_ <= kExactNs;
   if (!continues) Reset();
   newest_periods_ = continues ? newest_periods_ + gap : 0;
@@ -61,9 +61,8 @@ std::array<double, 3> InputResampler::TipAt(std::int64_t at_ns) const noexcept {
   // On the device's timeline, one device period back; never before the oldest input held, never
   // further past the newest than the prediction may go. Between the two inputs around it (past
   // the newest: on the line through the newest two).
-  const double t =
-      std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
-                 Newest(count_ - 1).device_ns, Newest(0).device_ns + max_ahead_ns_);
+  const double t = std::clamp(static_cast<double>(at_ns) - latency_floor_ns_ - period_ns_,
+                              Newest(count_ - 1).device_ns, Newest(0).device_ns + max_ahead_ns_);
   int i = 0;  // t lies between Newest(i + 1) and Newest(i), or past the newest
   while (i + 2 < count_ && Newest(i + 1).device_ns > t) ++i;
   const Input& a = Newest(i + 1);

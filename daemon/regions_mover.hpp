@@ -16,7 +16,8 @@ namespace hapticsim {
  * node. Before the regions move, their coupled stability around the node is verified
  * (VerifyCentredOn, a fraction of a second on the paper's cube) on a background thread of its
  * own, made once, so the supervisor's tick never waits and no request makes a thread; verdicts
- * are kept per configuration and node, so a node touched before moves at once. The move itself is HapticLoop::Reconfigure, done by the caller.
+ * are kept per configuration and node, so a node touched before moves at once. The move itself is
+ * HapticLoop::Reconfigure, done by the caller.
  */
 class RegionsMover {
  public:

@@ -22,8 +22,7 @@ std::vector<std::optional<std::array<double, 3>>> ReadReplay(const std::string& 
   std::vector<std::optional<std::array<double, 3>>> positions;
   std::int64_t undecodable = 0;
   std::optional<std::int64_t> last_utime;
-  const auto max_silence =
-      static_cast<std::int64_t>(DeviceMotion::kMaxReplaySilence_s * rate_hz);
+  const auto max_silence = static_cast<std::int64_t>(DeviceMotion::kMaxReplaySilence_s * rate_hz);
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     if (event->channel != channel) continue;
     device_input_t input;
@@ -37,8 +36,8 @@ std::vector<std::optional<std::array<double, 3>>> ReadReplay(const std::string& 
       for (std::int64_t k = 0; k < silent; ++k) positions.emplace_back(std::nullopt);
     }
     last_utime = input.utime;
-    positions.push_back(std::array<double, 3>{input.position[0], input.position[1],
-                                              input.position[2]});
+    positions.push_back(
+        std::array<double, 3>{input.position[0], input.position[1], input.position[2]});
   }
   if (positions.empty()) {
     throw Error("--replay " + path + ": no device_input_t on channel " + channel +

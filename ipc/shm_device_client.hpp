@@ -14,8 +14,8 @@
 // by the caller). Link hapticsim_ipc.
 
 #include <algorithm>
-#include <climits>
 #include <array>
+#include <climits>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -48,7 +48,7 @@ class ShmDeviceClient {
     if (h.daemon_pid.load(std::memory_order_relaxed) == 0) return ForceSource::kNone;
     const std::int64_t heartbeat = h.daemon_heartbeat_ns.load(std::memory_order_acquire);
     return heartbeat > 0 && now_ns - heartbeat <= kLiveWithin_ns ? ForceSource::kLive
-                                                                  : ForceSource::kNone;
+                                                                 : ForceSource::kNone;
   }
 
   /**

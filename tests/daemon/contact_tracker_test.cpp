@@ -186,7 +186,7 @@ TEST(ContactTracker, AJumpOfAFewPeriodsAfterAShortHoldIsCaughtUpWithToo) {
     previous_step = d - previous;
     previous = d;
   }
-  EXPECT_NEAR(previous, z, 1e-12);  // caught up
+  EXPECT_NEAR(previous, z, 1e-12);   // caught up
   EXPECT_LT(largest_change, 15e-6);  // the hold itself stops a 14 µm step; no 48 µm jump
 }
 

@@ -384,8 +384,9 @@ TEST(Supervisor, AMapTheDaemonCannotUseIsNamedAndChosenAsNoMap) {
   }
   ErrorMap long_axis = ErrorMap::MakeGrid(axes);
   for (MapSample& sample : long_axis.samples) sample.status = SampleStatus::kOk;
-  EXPECT_NE(MapProblem(scene, long_axis).find("adaptivity.primary_size: a lookup axis needs 1 to 64"),
-            std::string::npos)
+  EXPECT_NE(
+      MapProblem(scene, long_axis).find("adaptivity.primary_size: a lookup axis needs 1 to 64"),
+      std::string::npos)
       << MapProblem(scene, long_axis);
   const SupervisorDecision no_map = ChooseConfiguration(scene, &long_axis, 7.0, std::nullopt);
   EXPECT_FALSE(no_map.have_map);

@@ -28,14 +28,14 @@
 #include <set>
 #include <thread>
 
-#include "hapticsim/command_t.hpp"
-#include "hapticsim/device_input_t.hpp"
-#include "hapticsim/force_feedback_t.hpp"
-#include "hapticsim/status_t.hpp"
 #include "core/error_map.hpp"
 #include "core/error_map_file.hpp"
 #include "core/map_axes.hpp"
 #include "core/scene.hpp"
+#include "hapticsim/command_t.hpp"
+#include "hapticsim/device_input_t.hpp"
+#include "hapticsim/force_feedback_t.hpp"
+#include "hapticsim/status_t.hpp"
 #include "ipc/shm_device_client.hpp"
 #include "tests/support/late_wakes.hpp"
 #include "tests/support/run_command.hpp"
@@ -552,7 +552,8 @@ TEST(HapticsimdMaps, AMapTheLookupCannotTakeIsRefusedAndTheDaemonServesWithoutIt
 
   const auto check = testing::RunCommand({HAPTICSIMD_PATH, "--check-config", "--error-map", map});
   EXPECT_EQ(check.exit_status, 2) << check.out << check.err;
-  EXPECT_NE(check.err.find("supervisor.error_map: error map " + map + " refused: "
+  EXPECT_NE(check.err.find("supervisor.error_map: error map " + map +
+                           " refused: "
                            "adaptivity.primary_size: a lookup axis needs 1 to 64 values"),
             std::string::npos)
       << check.err;
@@ -564,8 +565,7 @@ TEST(HapticsimdMaps, AMapTheLookupCannotTakeIsRefusedAndTheDaemonServesWithoutIt
 
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--error-map", map}, Temp("long-axis.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
-  EXPECT_NE(daemon.Log().find("running without an error map"), std::string::npos)
-      << daemon.Log();
+  EXPECT_NE(daemon.Log().find("running without an error map"), std::string::npos) << daemon.Log();
   Client client;
   auto next = Clock::now();
   for (std::int64_t seq = 1; seq <= 300; ++seq) {
@@ -585,11 +585,13 @@ TEST(HapticsimdMaps, AMapTheLookupCannotTakeIsRefusedAndTheDaemonServesWithoutIt
 // the multicast with ttl=1 reaches nothing but its loopback.)
 TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSaidAloud) {
   const std::string off_host = "udpm://239.255.76.67:7667?ttl=1";
-  const auto check = testing::RunCommand({HAPTICSIMD_PATH, "--check-config", "--lcm-url", off_host});
+  const auto check =
+      testing::RunCommand({HAPTICSIMD_PATH, "--check-config", "--lcm-url", off_host});
   EXPECT_EQ(check.exit_status, 2) << check.out << check.err;
   EXPECT_NE(check.err.find("lcm.url: ttl=1 sends LCM traffic off this host"), std::string::npos)
       << check.err;
-  const auto start = testing::RunCommand({HAPTICSIMD_PATH, "--lcm-url", off_host, "--duration", "1"});
+  const auto start =
+      testing::RunCommand({HAPTICSIMD_PATH, "--lcm-url", off_host, "--duration", "1"});
   EXPECT_EQ(start.exit_status, 2) << start.err;
 
   const std::string config = Temp("allow-network.toml");

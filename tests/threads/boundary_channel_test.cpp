@@ -61,10 +61,10 @@ TEST(BoundaryChannel, EveryReadIsAConsistentSnapshotUnderContention) {
   while (!done.load()) {
     if (!dut.TryReadLatestTwo(&pair)) {
       ++failed;
-      if (reads > 0 && (newer.generation != last_seen ||
-                        newer.values[kWidth - 1] != static_cast<double>(last_seen) * 1000.0 +
-                                                        kWidth - 1 ||
-                        older.values[0] != static_cast<double>(older.generation) * 1000.0)) {
+      if (reads > 0 &&
+          (newer.generation != last_seen ||
+           newer.values[kWidth - 1] != static_cast<double>(last_seen) * 1000.0 + kWidth - 1 ||
+           older.values[0] != static_cast<double>(older.generation) * 1000.0)) {
         ++changed_by_failure;
       }
       continue;

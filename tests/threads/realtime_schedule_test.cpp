@@ -116,13 +116,13 @@ TEST(RealTimeSchedule, InjectedTimingFaultsAreCountedAndTheRunStaysBounded) {
   ASSERT_TRUE(std::isfinite(e.stored_j));
   EXPECT_GT(e.input_work_j, 0);
   EXPECT_LE(EnergyAboveBound(e, 0.0), e.pending_excess_j + 1e-9 * e.input_work_j);
-  std::printf("faults: %lld lags, %lld stalls, %lld late wakes, %lld skips; peak %.3g N, stored "
-              "%.3g J above the bound by %.3g J (backlog %.3g J)\n",
-              static_cast<long long>(counts.secondary_lags),
-              static_cast<long long>(counts.secondary_stalls),
-              static_cast<long long>(counts.primary_late_wakes),
-              static_cast<long long>(counts.skips), threaded.peak_force_n, e.stored_j,
-              EnergyAboveBound(e, 0.0), e.pending_excess_j);
+  std::printf(
+      "faults: %lld lags, %lld stalls, %lld late wakes, %lld skips; peak %.3g N, stored "
+      "%.3g J above the bound by %.3g J (backlog %.3g J)\n",
+      static_cast<long long>(counts.secondary_lags),
+      static_cast<long long>(counts.secondary_stalls),
+      static_cast<long long>(counts.primary_late_wakes), static_cast<long long>(counts.skips),
+      threaded.peak_force_n, e.stored_j, EnergyAboveBound(e, 0.0), e.pending_excess_j);
 }
 
 }  // namespace

@@ -170,8 +170,8 @@ int Run(const StressOptions& o) {
         outcomes[i] = RunStressCase(c, o.ranges);
         if ((first + i) % o.supervisor_every == 0) checks[i] = CheckSupervisor(outcomes[i]);
         if (o.faults) {
-          fault_outcomes[i] = RunFaultCase(outcomes[i], o.fault_run_s,
-                                           StressTimingFaults(c.state_seed));
+          fault_outcomes[i] =
+              RunFaultCase(outcomes[i], o.fault_run_s, StressTimingFaults(c.state_seed));
         }
       } catch (const std::exception& e) {
         std::lock_guard lock(error_mutex);
@@ -290,8 +290,8 @@ int Run(const StressOptions& o) {
     }
   }
   const bool passed = stable_diverged == 0 && undetected == 0 && energy_violations == 0 &&
-                      passive_diverged == 0 && fault_diverged == 0 &&
-                      chose_unstable == 0 && pinned_refused == 0;
+                      passive_diverged == 0 && fault_diverged == 0 && chose_unstable == 0 &&
+                      pinned_refused == 0;
   const double seconds = elapsed();
   if (o.json) {
     Json out = {{"count", count},
@@ -434,8 +434,7 @@ Command AddStressCommand(CLI::App& parent) {
                 "Also run every case the daemon would run (or the controllers should hold) on real "
                 "threads with injected timing faults: secondary lags of 1-10 periods, stalls up to "
                 "0.3 s, late primary wakes; counts divergence and energy-bound violations");
-  app->add_option("--fault-run", options->fault_run_s,
-                  "Wall time of each run under faults, s")
+  app->add_option("--fault-run", options->fault_run_s, "Wall time of each run under faults, s")
       ->capture_default_str()
       ->check(CLI::Range(0.05, 60.0));
   app->add_flag("--json", options->json, "One JSON object on stdout");
