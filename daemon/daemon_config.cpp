@@ -72,7 +72,13 @@ const std::map<std::string, Setter>& Setters() {
     text("lcm.status_channel", &DaemonConfig::status_channel);
     text("lcm.command_channel", &DaemonConfig::command_channel);
     flag("shm.enabled", &DaemonConfig::shm_enabled);
-    text("shm.name", &DaemonConfig::shm_name);
+    text("shm.socket", &DaemonConfig::shm_socket);
+    s["shm.name"] = [](DaemonConfig*, const toml::node&, const std::string& where) {
+      throw Error(where +
+                  ": shm.name is gone: the segment has no name any more (no other process can "
+                  "open or replace it). Drivers connect to shm.socket, a Unix socket path "
+                  "(default /run/hapticsim/hapticsimd.sock), and get the segment from it");
+    };
     text("shm.group", &DaemonConfig::shm_group);
     text("supervisor.error_map", &DaemonConfig::error_map);
     real("supervisor.error_target_percent", &DaemonConfig::error_target_percent);
@@ -206,9 +212,10 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
-  require(
-      c.shm_name.size() > 1 && c.shm_name[0] == '/' && c.shm_name.find('/', 1) == std::string::npos,
-      "shm.name must be '/' and a name, e.g. \"/hapticsim\"");
+  require(c.shm_socket.size() > 1 && c.shm_socket[0] == '/' && c.shm_socket.back() != '/' &&
+              c.shm_socket.size() <= 107,
+          "shm.socket must be an absolute path of a socket file, at most 107 bytes (a Unix "
+          "socket's limit), e.g. \"/run/hapticsim/hapticsimd.sock\"");
   const std::string url_problem = LcmUrlProblem(c.lcm_url, c.lcm_allow_network);
   require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
@@ -362,8 +369,9 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "status_channel = " << quote(c.status_channel) << "\n"
       << "command_channel = " << quote(c.command_channel) << "\n\n"
       << "[shm]\nenabled = " << (c.shm_enabled ? "true" : "false") << "\n"
-      << "name = " << quote(c.shm_name) << "\n"
-      << "group = " << quote(c.shm_group) << "  # the driver's group; mode 0660\n\n"
+      << "socket = " << quote(c.shm_socket)
+      << "  # drivers connect here; its directory only the daemon may write\n"
+      << "group = " << quote(c.shm_group) << "  # the driver's group; socket mode 0660\n\n"
       << "[supervisor]\nerror_map = " << quote(c.error_map) << "\n"
       << "error_target_percent = " << real(c.error_target_percent) << "\n"
       << "status_rate_hz = " << real(c.status_rate_hz) << "\n\n"

@@ -29,7 +29,8 @@ struct DaemonConfig {
   std::string command_channel = "HAPTIC_COMMAND";
   // [shm]
   bool shm_enabled = false;             ///< the shared-memory interface for a local driver
-  std::string shm_name = "/hapticsim";  ///< POSIX shm name (/dev/shm/hapticsim)
+  /// The service socket a driver connects to for its segment (ipc/service_socket.hpp)
+  std::string shm_socket = "/run/hapticsim/hapticsimd.sock";
   std::string shm_group;                ///< group the driver runs in (empty: the daemon's own)
   // [supervisor]
   std::string error_map;              ///< map file (empty: none; the error is reported as -1)

@@ -210,10 +210,10 @@ int Serve(const Arguments& args) {
   }
   std::unique_ptr<ShmServer> shm;
   if (config.shm_enabled) {
-    shm = std::make_unique<ShmServer>(config.shm_name, config.shm_group, config.scene.mesh,
-                                      config.workspace_margin_m, config.max_speed_m_per_s, loop,
-                                      counters, shm_owns_input);
-    spdlog::info("shared memory /dev/shm{} (mode 0660{})", config.shm_name,
+    shm = std::make_unique<ShmServer>(config.shm_socket, config.shm_group, config.scene.mesh,
+                                      config.workspace_margin_m, config.max_speed_m_per_s,
+                                      config.max_log_lines_per_s, loop, counters, shm_owns_input);
+    spdlog::info("shared memory: drivers connect to {} (mode 0660{})", config.shm_socket,
                  config.shm_group.empty() ? "" : ", group " + config.shm_group);
   }
   if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");

@@ -1,32 +1,54 @@
 #pragma once
 
+#include <spdlog/spdlog.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
 #include "daemon/input_intake.hpp"
+#include "ipc/service_socket.hpp"
 #include "ipc/shm_segment.hpp"
 
 namespace hapticsim {
 
 /**
- * The shared-memory side of the I/O thread: creates the segment (ipc/shm_layout.hpp), takes each
- * new device input from it (checked like LCM input), and writes every force back. Only the I/O
- * thread calls PollInput and Publish.
+ * The shared-memory side of the I/O thread. Listens on the service socket (ipc/service_socket.hpp)
+ * and gives each driver it admits a new sealed segment of its own: a driver that leaves, or is
+ * replaced by the next one, keeps a mapping nobody reads or writes any more, so no session sees
+ * another's. Takes each new device input from the session's segment (checked like LCM input), and
+ * writes every force back. Only the I/O thread calls PollInput and Publish.
  */
 class ShmServer {
  public:
-  /** @throws Error when the segment cannot be created (the message says what to check). */
-  ShmServer(const std::string& name, const std::string& group, const MeshSettings& mesh,
-            double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
-            InputCounters& counters, bool owns_input);
+  /** @throws Error when the socket cannot be made (the message says what to check). */
+  ShmServer(const std::string& socket_path, const std::string& group, const MeshSettings& mesh,
+            double workspace_margin_m, double max_speed_m_per_s, double max_log_lines_per_s,
+            HapticLoop& loop, InputCounters& counters, bool owns_input);
 
+  /** Answers drivers that connected, notices one that left, then reads the session's inputs. */
   void PollInput();
   void Publish(const ForceRecord& record);
-  const std::string& name() const { return mapping_.name(); }
+  const std::string& socket_path() const { return listener_.path(); }
 
  private:
-  shm::MappedSegment mapping_;
+  void Admit(shm::Connection connection);
+  void EndSessionIfGone();
+  /** At most max_log_lines_per_s lines: a connect flood must not flood the journal. */
+  template <typename... Args>
+  void Log(spdlog::level::level_enum level, const char* format, const Args&... args);
+
+  shm::ServiceListener listener_;
   InputIntake intake_;
+  std::optional<shm::MappedSegment> mapping_;  // the session's, while there is one
+  shm::UniqueFd session_;                      // the driver's connection while it drives
+  shm::PeerIdentity session_peer_;             // and who it is
   shm::ShmInputReader inputs_;
+  InputCounters& counters_;  // sessions started and connections refused are counted there
+  double min_log_gap_ns_;
+  std::int64_t last_log_ns_ = 0, unlogged_ = 0;
 };
 
 }  // namespace hapticsim

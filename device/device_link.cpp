@@ -99,7 +99,7 @@ class LcmLink final : public DeviceLink {
 
 class ShmLink final : public DeviceLink {
  public:
-  explicit ShmLink(const std::string& name) : client_(name) {}
+  explicit ShmLink(const std::string& socket_path) : client_(socket_path) {}
 
   void Send(std::int64_t seq, std::int64_t utime_us,
             const std::array<double, 3>& position_m) override {
@@ -135,8 +135,8 @@ std::unique_ptr<DeviceLink> MakeLcmLink(const std::string& url, const std::strin
   return std::make_unique<LcmLink>(url, device_channel, force_channel, status_channel, listen_only);
 }
 
-std::unique_ptr<DeviceLink> MakeShmLink(const std::string& name) {
-  return std::make_unique<ShmLink>(name);
+std::unique_ptr<DeviceLink> MakeShmLink(const std::string& socket_path) {
+  return std::make_unique<ShmLink>(socket_path);
 }
 
 }  // namespace hapticsim::device

@@ -55,8 +55,11 @@ std::unique_ptr<DeviceLink> MakeLcmLink(const std::string& url, const std::strin
                                         const std::string& status_channel,
                                         bool listen_only = false);
 
-/** Shared memory through ShmDeviceClient. @throws Error when the segment is missing or foreign. */
-std::unique_ptr<DeviceLink> MakeShmLink(const std::string& name);
+/**
+ * Shared memory through ShmDeviceClient, from the daemon serving `socket_path`. @throws Error when
+ * no daemon serves it, it is not to be trusted, or it refuses this driver.
+ */
+std::unique_ptr<DeviceLink> MakeShmLink(const std::string& socket_path);
 
 /** hapticsimd's default LCM URL: multicast that never leaves the host (ttl=0). */
 inline constexpr const char* kHostLocalLcmUrl = "udpm://239.255.76.67:7667?ttl=0";

@@ -1,7 +1,7 @@
-// Fuzz target: a shared-memory segment written by someone else. The fuzzer's bytes overwrite part
-// of a well-formed segment image (the first two bytes choose where), which is then put in real
-// POSIX shared memory and opened as a driver opens it (MappedSegment::Open checks the size and
-// the header); when it opens, the device-input slot is read as the daemon reads it (a torn or
+// Fuzz target: a shared segment written by someone else. The fuzzer's bytes overwrite part of a
+// well-formed segment image (the first two bytes choose where), which is then put in a real
+// memory file, sealed when the third byte is even, and adopted as a driver adopts what it is
+// handed (MappedSegment::Adopt checks the seals, the size and the header); when it maps, the device-input slot is read as the daemon reads it (a torn or
 // half-written slot reads as nothing) and checked by the InputGuard.
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -26,21 +26,13 @@ namespace {
 // A well-formed image, as hapticsimd creates it.
 std::vector<std::uint8_t> GoodImage() {
   std::vector<std::uint8_t> image(sizeof(shm::ShmSegment));
-  auto* segment = new (image.data()) shm::ShmSegment();
-  shm::ShmHeader& h = segment->header;
-  std::memcpy(h.magic, shm::kMagic, sizeof shm::kMagic);
-  h.layout_version = shm::kLayoutVersion;
-  h.header_bytes = sizeof(shm::ShmHeader);
-  h.input_slot_bytes = sizeof(hapticsim::SeqlockSlot<shm::ShmDeviceInput>);
-  h.output_slot_bytes = sizeof(hapticsim::SeqlockSlot<shm::ShmForceOutput>);
-  h.total_bytes = sizeof(shm::ShmSegment);
+  shm::FormatSegment(image.data(), 0);
   return image;
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::string name = "/hapticsim-fuzz-" + std::to_string(getpid());
   static const std::vector<std::uint8_t> good = GoodImage();
   std::vector<std::uint8_t> image = good;
   if (size >= 2) {
@@ -52,15 +44,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } else {
     image.resize(size);  // a segment too small to hold a header
   }
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0600);
+  const int fd = memfd_create("hapticsim-fuzz", MFD_CLOEXEC | MFD_ALLOW_SEALING);
   if (fd < 0) __builtin_trap();
   if (!image.empty() &&
       pwrite(fd, image.data(), image.size(), 0) != static_cast<ssize_t>(image.size())) {
     __builtin_trap();
   }
-  close(fd);
+  const bool sealed = size < 3 || data[2] % 2 == 0;
+  if (sealed && fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0) {
+    __builtin_trap();
+  }
   try {
-    shm::MappedSegment mapping = shm::MappedSegment::Open(name);
+    shm::MappedSegment mapping = shm::MappedSegment::Adopt(fd, "the fuzzer");  // closes fd
+    if (!sealed) __builtin_trap();  // an unsealed segment must be refused
     // The input ring read as the daemon reads it: at most kInputSlots, whatever the index says.
     hapticsim::InputGuard guard(hapticsim::MeshSettings{}, 0.05, 5.0);
     shm::ShmInputReader reader;
@@ -74,6 +70,5 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (read > shm::kInputSlots) __builtin_trap();
   } catch (const hapticsim::Error&) {
   }
-  shm_unlink(name.c_str());
   return 0;
 }

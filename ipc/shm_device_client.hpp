@@ -2,7 +2,8 @@
 
 // The client library for device-driver writers: talk to hapticsimd through shared memory.
 //
-//   hapticsim::shm::ShmDeviceClient client;              // opens "/hapticsim", checks it
+//   hapticsim::shm::ShmDeviceClient client;   // connects to /run/hapticsim/hapticsimd.sock,
+//                                              // checks the daemon and maps its segment
 //   client.WriteInput(seq, utime_us, {x, y, z});          // every device period (1 kHz)
 //   hapticsim::shm::ShmForceOutput force;
 //   if (client.ReadForce(&force) && force.seq == seq) { /* render force.force_n */ }
@@ -20,7 +21,7 @@
 #include <optional>
 #include <string>
 
-#include "ipc/shm_segment.hpp"
+#include "ipc/service_socket.hpp"
 
 namespace hapticsim::shm {
 
@@ -32,9 +33,17 @@ class ShmDeviceClient {
   /** A daemon whose newest answer is older than this is no force source. */
   static constexpr std::int64_t kLiveWithin_ns = 10'000'000;
 
-  /** @throws Error when the segment is missing or not a compatible hapticsimd segment. */
-  explicit ShmDeviceClient(const std::string& name = kDefaultName)
-      : name_(name), mapping_(MappedSegment::Open(name)) {}
+  /** How long the constructor waits for the daemon's answer. */
+  static constexpr int kConnectTimeout_ms = 2000;
+
+  /**
+   * Connects to hapticsimd's service socket and maps the segment it hands over (ipc/
+   * service_socket.hpp). @throws Error naming the problem: no daemon there, a socket another user
+   * could have put there, a refusal (not in its group; another driver holds the session), or a
+   * segment that is not the daemon's.
+   */
+  explicit ShmDeviceClient(const std::string& socket_path = kDefaultSocket)
+      : socket_path_(socket_path), session_(ConnectToService(socket_path, kConnectTimeout_ms)) {}
 
   /**
    * kLive while the daemon that made the segment runs and its newest answer is at most
@@ -44,7 +53,7 @@ class ShmDeviceClient {
    * its device rate sees kLive within a period of each write.
    */
   ForceSource Source(std::int64_t now_ns) const {
-    const ShmHeader& h = mapping_->segment().header;
+    const ShmHeader& h = segment().header;
     if (h.daemon_pid.load(std::memory_order_relaxed) == 0) return ForceSource::kNone;
     const std::int64_t heartbeat = h.daemon_heartbeat_ns.load(std::memory_order_acquire);
     return heartbeat > 0 && now_ns - heartbeat <= kLiveWithin_ns ? ForceSource::kLive
@@ -52,19 +61,17 @@ class ShmDeviceClient {
   }
 
   /**
-   * Not wait-free (it opens the name again: system calls, an allocation): call it off the
-   * device's real-time thread, now and then, while Source says kNone. Maps the segment a
-   * restarted service made under the same name; true when it did. Writes go on into the new
-   * segment. @throws nothing: a name that is missing or foreign just leaves the old mapping.
+   * Not wait-free (it connects: system calls, allocation, up to 200 ms): call it off the
+   * device's real-time thread, now and then, while Source says kNone. Starts a new session with
+   * the daemon at the same socket (a restarted service) and maps its segment; true when it did.
+   * Writes go on into the new segment. @throws nothing: no daemon, a refusal or a foreign
+   * socket just leaves the old session.
    */
   bool Reconnect() {
     try {
-      MappedSegment fresh = MappedSegment::Open(name_);
-      // Another daemon's: a killed one leaves its segment, pid and all, under the name.
-      const std::int64_t pid = fresh.segment().header.daemon_pid.load();
-      if (pid == 0 || pid == mapping_->segment().header.daemon_pid.load()) return false;
-      mapping_.reset();
-      mapping_.emplace(std::move(fresh));
+      ServiceSession fresh = ConnectToService(socket_path_, 200);
+      session_.reset();
+      session_.emplace(std::move(fresh));
       return true;
     } catch (const std::exception&) {
       return false;
@@ -82,16 +89,11 @@ class ShmDeviceClient {
     input.seq = seq;
     input.utime = utime_us;
     for (int c = 0; c < 3; ++c) input.position_m[c] = position_m[c];
-    ShmSegment& s = mapping_->segment();
-    // A restarted writer goes on from the ring's newest write (from 0 if that is nonsense).
-    const std::int64_t newest = s.newest_input.load(std::memory_order_relaxed);
-    const std::int64_t next = newest >= 0 && newest < INT64_MAX ? newest + 1 : 0;
-    s.inputs[static_cast<std::uint64_t>(next) % kInputSlots].Write(input);
-    s.newest_input.store(next, std::memory_order_release);
+    WriteDeviceInput(segment(), input);
   }
   /** The newest force; false when none is available consistently yet. */
   bool ReadForce(ShmForceOutput* out) const {
-    const ShmSegment& s = mapping_->segment();
+    const ShmSegment& s = segment();
     const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
     return newest >= 0 && s.outputs[newest % kOutputSlots].Read(out) && out->period >= 0;
   }
@@ -103,7 +105,7 @@ class ShmDeviceClient {
    */
   template <class Each>
   std::int64_t ReadForcesSince(std::int64_t after, Each&& each) const {
-    const ShmSegment& s = mapping_->segment();
+    const ShmSegment& s = segment();
     const std::int64_t newest = s.newest_output.load(std::memory_order_acquire);
     for (std::int64_t p = std::max(after + 1, newest - kOutputSlots + 1); p <= newest; ++p) {
       ShmForceOutput out;
@@ -112,12 +114,18 @@ class ShmDeviceClient {
     }
     return std::max(after, newest);
   }
-  /** True while the daemon that created the segment runs. */
-  bool DaemonRunning() { return mapping_->segment().header.daemon_pid.load() != 0; }
+  /** True while the daemon that created the segment runs and serves this session. */
+  bool DaemonRunning() const { return segment().header.daemon_pid.load() != 0; }
+
+  /** The daemon this session is with, as the kernel reported it when connecting. */
+  const PeerIdentity& daemon() const { return session_->daemon; }
+  /** The mapped segment itself: for tools and tests that look inside; drivers need not. */
+  ShmSegment& segment() { return session_->segment.segment(); }
+  const ShmSegment& segment() const { return session_->segment.segment(); }
 
  private:
-  std::string name_;
-  std::optional<MappedSegment> mapping_;  // always holds one (reset only to replace it)
+  std::string socket_path_;
+  std::optional<ServiceSession> session_;  // always holds one (reset only to replace it)
 };
 
 }  // namespace hapticsim::shm

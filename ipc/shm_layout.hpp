@@ -3,8 +3,8 @@
 // The shared-memory interface between a device driver and hapticsimd: the layout both sides map.
 // For driver writers: use ShmDeviceClient (shm_device_client.hpp) rather than this file directly.
 //
-// One POSIX shared-memory object (default name "/hapticsim", in /dev/shm), created by the daemon
-// with mode 0660 (owner and the configured group; other users get nothing). Layout:
+// One anonymous memory file per driver session, created and sealed by the daemon and handed to the
+// driver over the service socket (ipc/service_socket.hpp, ipc/shm_segment.hpp). Layout:
 //
 //   ShmHeader | newest_input, kInputSlots × SeqlockSlot<ShmDeviceInput> (the driver writes)
 //             | newest_output, kOutputSlots × SeqlockSlot<ShmForceOutput> (the daemon writes)
@@ -18,6 +18,7 @@
 // (every input gets its answer); the output ring does the same for the driver.
 
 #include <atomic>
+#include <climits>
 #include <cstdint>
 
 #include "core/seqlock_slot.hpp"
@@ -26,7 +27,6 @@ namespace hapticsim::shm {
 
 inline constexpr char kMagic[8] = {'H', 'S', 'I', 'M', 'S', 'H', 'M', '1'};
 inline constexpr std::uint32_t kLayoutVersion = 3;
-inline constexpr const char* kDefaultName = "/hapticsim";
 
 /** The tool tip, written by the driver every device period. Object frame, as in LCM. */
 struct ShmDeviceInput {
@@ -78,6 +78,17 @@ struct ShmSegment {
   alignas(64) std::atomic<std::int64_t> newest_output{-1};
   alignas(64) SeqlockSlot<ShmForceOutput> outputs[kOutputSlots];
 };
+
+/**
+ * The driver's side of the input ring: writes the next input and publishes it. A restarted writer
+ * goes on from the ring's newest write (from 0 if that is nonsense). Wait-free.
+ */
+inline void WriteDeviceInput(ShmSegment& segment, const ShmDeviceInput& input) {
+  const std::int64_t newest = segment.newest_input.load(std::memory_order_relaxed);
+  const std::int64_t next = newest >= 0 && newest < INT64_MAX ? newest + 1 : 0;
+  segment.inputs[static_cast<std::uint64_t>(next) % kInputSlots].Write(input);
+  segment.newest_input.store(next, std::memory_order_release);
+}
 
 /**
  * The daemon's side of the input ring: each call hands every input written since the last one to

@@ -1,7 +1,6 @@
 #include "ipc/shm_segment.hpp"
 
 #include <fcntl.h>
-#include <grp.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -17,36 +16,12 @@ namespace {
 
 std::string Why() { return std::strerror(errno); }
 
+/** The seals a segment must carry: its size is fixed for good. */
+constexpr int kRequiredSeals = F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL;
+
 }  // namespace
 
-MappedSegment MappedSegment::Create(const std::string& name, const std::string& group) {
-  HAPTICSIM_THROW_UNLESS(
-      name.size() > 1 && name[0] == '/' && name.find('/', 1) == std::string::npos,
-      "shm.name = \"" + name + "\": must be one '/' then a name, e.g. /hapticsim");
-  shm_unlink(name.c_str());  // a segment left by a crashed daemon
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  HAPTICSIM_THROW_UNLESS(fd >= 0, "cannot create shared memory " + name + ": " + Why());
-  auto fail = [&](const std::string& message) {
-    close(fd);
-    shm_unlink(name.c_str());
-    throw Error(message);
-  };
-  if (!group.empty()) {
-    const struct group* entry = getgrnam(group.c_str());
-    if (!entry) fail("shm.group = \"" + group + "\": no such group");
-    if (fchown(fd, static_cast<uid_t>(-1), entry->gr_gid) != 0) {
-      fail("cannot give " + name + " to group " + group + ": " + Why());
-    }
-  }
-  // 0660 whatever the umask: the owner and the group (the driver's), nobody else.
-  if (fchmod(fd, 0660) != 0) fail("cannot set the mode of " + name + ": " + Why());
-  if (ftruncate(fd, sizeof(ShmSegment)) != 0) fail("cannot size " + name + ": " + Why());
-  void* memory = mmap(nullptr, sizeof(ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  close(fd);
-  if (memory == MAP_FAILED) {
-    shm_unlink(name.c_str());
-    throw Error("cannot map " + name + ": " + Why());
-  }
+ShmSegment* FormatSegment(void* memory, std::int64_t daemon_pid) {
   auto* segment = new (memory) ShmSegment();
   ShmHeader& h = segment->header;
   h.layout_version = kLayoutVersion;
@@ -54,38 +29,56 @@ MappedSegment MappedSegment::Create(const std::string& name, const std::string& 
   h.input_slot_bytes = sizeof(SeqlockSlot<ShmDeviceInput>);
   h.output_slot_bytes = sizeof(SeqlockSlot<ShmForceOutput>);
   h.total_bytes = sizeof(ShmSegment);
-  h.daemon_pid.store(getpid());
+  h.daemon_pid.store(daemon_pid);
   std::atomic_thread_fence(std::memory_order_release);
   std::memcpy(h.magic, kMagic, sizeof kMagic);  // last: a reader sees the magic only when ready
-  return MappedSegment(name, segment, true);
+  return segment;
 }
 
-MappedSegment MappedSegment::Open(const std::string& name) {
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0);
-  HAPTICSIM_THROW_UNLESS(fd >= 0, "cannot open shared memory " + name + ": " + Why() +
-                                      " (is hapticsimd running with [shm] enabled = true, and "
-                                      "is this process in its group?)");
-  struct stat info {};
-  fstat(fd, &info);
-  if (static_cast<size_t>(info.st_size) < sizeof(ShmHeader)) {
+MappedSegment MappedSegment::CreateSealed(const std::string& label) {
+  const int fd = memfd_create(label.c_str(), MFD_CLOEXEC | MFD_ALLOW_SEALING);
+  HAPTICSIM_THROW_UNLESS(fd >= 0, "cannot create the shared segment: memfd_create: " + Why());
+  auto fail = [&](const std::string& what) {
+    const std::string why = Why();
     close(fd);
-    throw Error("shared memory " + name + " is too small to be hapticsimd's (" +
-                std::to_string(info.st_size) + " bytes)");
+    throw Error("cannot " + what + " the shared segment: " + why);
+  };
+  if (ftruncate(fd, sizeof(ShmSegment)) != 0) fail("size");
+  // Sealed before any other process holds it: nobody, the daemon included, can change its size.
+  if (fcntl(fd, F_ADD_SEALS, kRequiredSeals) != 0) fail("seal");
+  void* memory = mmap(nullptr, sizeof(ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (memory == MAP_FAILED) fail("map");
+  ShmSegment* segment = FormatSegment(memory, getpid());
+  return MappedSegment(segment, fd, true);
+}
+
+MappedSegment MappedSegment::Adopt(int fd, const std::string& from) {
+  auto refuse = [&](const std::string& problem) {
+    close(fd);
+    throw Error("the shared segment from " + from + " " + problem);
+  };
+  // Unsealed, the sender (or anyone it shared the file with) could shrink it under this mapping:
+  // the next access would kill this process with SIGBUS.
+  const int seals = fcntl(fd, F_GET_SEALS);
+  if (seals < 0) refuse("is not a sealable memory file (" + Why() + "): not hapticsimd's");
+  if ((seals & kRequiredSeals) != kRequiredSeals) {
+    refuse("is not sealed against size changes (seals " + std::to_string(seals) +
+           "): not hapticsimd's");
   }
+  struct stat info {};
+  if (fstat(fd, &info) != 0) refuse("cannot be examined: " + Why());
   if (static_cast<size_t>(info.st_size) != sizeof(ShmSegment)) {
-    close(fd);
-    throw Error("shared memory " + name + " has " + std::to_string(info.st_size) +
-                " bytes; this client expects " + std::to_string(sizeof(ShmSegment)) +
-                " (another layout version?)");
+    refuse("has " + std::to_string(info.st_size) + " bytes; this client expects " +
+           std::to_string(sizeof(ShmSegment)) + " (another layout version?)");
   }
   void* memory = mmap(nullptr, sizeof(ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (memory == MAP_FAILED) refuse("cannot be mapped: " + Why());
   close(fd);
-  HAPTICSIM_THROW_UNLESS(memory != MAP_FAILED, "cannot map " + name + ": " + Why());
   auto* segment = static_cast<ShmSegment*>(memory);
   const ShmHeader& h = segment->header;
   std::string problem;
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) {
-    problem = "has no hapticsim signature (not hapticsimd's, or not ready yet)";
+    problem = "has no hapticsim signature (not hapticsimd's)";
   } else if (h.layout_version != kLayoutVersion) {
     problem = "has layout version " + std::to_string(h.layout_version) + "; this client speaks " +
               std::to_string(kLayoutVersion);
@@ -97,21 +90,22 @@ MappedSegment MappedSegment::Open(const std::string& name) {
   }
   if (!problem.empty()) {
     munmap(memory, sizeof(ShmSegment));
-    throw Error("shared memory " + name + " " + problem);
+    throw Error("the shared segment from " + from + " " + problem);
   }
-  return MappedSegment(name, segment, false);
+  return MappedSegment(segment, -1, false);
 }
 
 MappedSegment::MappedSegment(MappedSegment&& other) noexcept
-    : name_(std::move(other.name_)), segment_(other.segment_), owner_(other.owner_) {
+    : segment_(other.segment_), fd_(other.fd_), owner_(other.owner_) {
   other.segment_ = nullptr;
+  other.fd_ = -1;
 }
 
 MappedSegment::~MappedSegment() {
   if (!segment_) return;
   if (owner_) segment_->header.daemon_pid.store(0);
   munmap(segment_, sizeof(ShmSegment));
-  if (owner_) shm_unlink(name_.c_str());
+  if (fd_ >= 0) close(fd_);
 }
 
 }  // namespace hapticsim::shm

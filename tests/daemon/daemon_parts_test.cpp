@@ -149,6 +149,10 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       {"[log]\nmax_lines_per_s = 1e9\n", "log.max_lines_per_s must be in (0, 1000]"},
       {"[device]\nmax_force_n = 100\nengage_rate_n_per_ms = 0.1\nfault_force_n = 100\n", ""},
       {"[device]\nmax_force_n = 1e300\n", "device.max_force_n must be in (0, 100] N"},
+      // The service socket: an absolute path a Unix socket can have (107 bytes).
+      {"[shm]\nsocket = \"/run/hapticsim/hapticsimd.sock\"\n", ""},
+      {"[shm]\nsocket = \"hapticsimd.sock\"\n", "shm.socket must be an absolute path"},
+      {"[shm]\nsocket = \"/run/hapticsim/\"\n", "shm.socket must be an absolute path"},
   };
   for (const auto& [text, message] : ceilings) {
     const std::string error = ConfigError(text);
@@ -158,6 +162,16 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       EXPECT_NE(error.find(message), std::string::npos) << text << error;
     }
   }
+  const std::string longest = "/" + std::string(106, 's'), too_long = longest + "s";
+  EXPECT_EQ(ConfigError("[shm]\nsocket = \"" + longest + "\"\n"), "");
+  EXPECT_NE(ConfigError("[shm]\nsocket = \"" + too_long + "\"\n").find("at most 107 bytes"),
+            std::string::npos);
+  // The segment's name is gone (a named segment could be opened, squatted and truncated by
+  // anyone who could see it): the key says what replaced it.
+  EXPECT_NE(ConfigError("[shm]\nname = \"/hapticsim\"\n")
+                .find("shm.name is gone: the segment has no name any more"),
+            std::string::npos)
+      << ConfigError("[shm]\nname = \"/hapticsim\"\n");
   EXPECT_NE(ConfigError("[lcm\nurl = 3\n").find(ConfigTestPath() + ":1"), std::string::npos)
       << ConfigError("[lcm\nurl = 3\n");
 }

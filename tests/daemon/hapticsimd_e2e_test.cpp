@@ -37,26 +37,21 @@
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
 #include "ipc/shm_device_client.hpp"
+#include "tests/support/daemon_harness.hpp"
 #include "tests/support/late_wakes.hpp"
+#include "tests/support/private_socket.hpp"
 #include "tests/support/run_command.hpp"
 
 namespace hapticsim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using testing::Client;
+using testing::WaitUntilServing;
 constexpr double kEdge = 0.25;  // the default cube
 
 std::string Temp(const std::string& name) {
   return ::testing::TempDir() + "hapticsimd_e2e_" + name;
-}
-
-// Waits until the daemon logs that it serves (startup estimates stability first), at most 30 s.
-void WaitUntilServing(testing::BackgroundProcess& daemon) {
-  const auto deadline = Clock::now() + std::chrono::seconds(30);
-  while (daemon.Log().find("serving") == std::string::npos && Clock::now() < deadline) {
-    ASSERT_TRUE(daemon.running()) << daemon.Log();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
 }
 
 // A map made by the real sweep over the grid file text `axes`; returns its path.
@@ -78,70 +73,6 @@ const std::string& SmallMap() {
                "frequency = [1.0]\n");
   return path;
 }
-
-// The client side: what a device driver and a monitoring tool see.
-class Client {
- public:
-  Client() : lcm_("udpm://239.255.76.67:7667?ttl=0") {
-    EXPECT_TRUE(lcm_.good()) << "no LCM: is this running inside tests/support/in_private_netns.sh?";
-    lcm_.subscribe("HAPTIC_FORCE", &Client::OnForce, this);
-    lcm_.subscribe("HAPTIC_STATUS", &Client::OnStatus, this);
-    thread_ = std::thread([this] {
-      while (!stop_) lcm_.handleTimeout(10);
-    });
-  }
-  ~Client() {
-    stop_ = true;
-    thread_.join();
-  }
-
-  void Send(std::int64_t seq, double x, double y, double z) {
-    device_input_t input{};
-    input.utime = seq;
-    input.seq = seq;
-    input.position[0] = x, input.position[1] = y, input.position[2] = z;
-    lcm_.publish("HAPTIC_DEVICE", &input);
-  }
-  void SendRaw(const std::string& bytes) {
-    lcm_.publish("HAPTIC_DEVICE", bytes.data(), static_cast<unsigned>(bytes.size()));
-  }
-  void Command(const command_t& command) { lcm_.publish("HAPTIC_COMMAND", &command); }
-
-  std::vector<force_feedback_t> Forces() {
-    std::lock_guard lock(mutex_);
-    return forces_;
-  }
-  std::optional<status_t> LastStatus() {
-    std::lock_guard lock(mutex_);
-    return status_;
-  }
-  // Waits until `predicate(last status)` holds.
-  bool WaitForStatus(const std::function<bool(const status_t&)>& predicate, double timeout_s) {
-    const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
-    while (Clock::now() < end) {
-      if (auto s = LastStatus(); s && predicate(*s)) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return false;
-  }
-
- private:
-  void OnForce(const lcm::ReceiveBuffer*, const std::string&, const force_feedback_t* f) {
-    std::lock_guard lock(mutex_);
-    forces_.push_back(*f);
-  }
-  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t* s) {
-    std::lock_guard lock(mutex_);
-    status_ = *s;
-  }
-
-  lcm::LCM lcm_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
-  std::mutex mutex_;
-  std::vector<force_feedback_t> forces_;
-  std::optional<status_t> status_;
-};
 
 class HapticsimdEndToEnd : public ::testing::Test {
  protected:
@@ -651,18 +582,18 @@ TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeco
 
 // The shared-memory interface with a real second process: the example driver client.
 TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
-  const std::string name = "/hapticsim-e2e-" + std::to_string(getpid());
+  const std::string name = testing::PrivateSocketPath();
   const std::string config = Temp("shm.toml");
-  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nsocket = \"" << name
                         << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   struct stat info {};
-  ASSERT_EQ(stat(("/dev/shm" + name).c_str(), &info), 0);
+  ASSERT_EQ(stat(name.c_str(), &info), 0);
   EXPECT_EQ(info.st_mode & 0777, 0660u) << "owner and group only";
 
   const auto result =
-      testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name, "--duration", "2"});
+      testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--socket", name, "--duration", "2"});
   ASSERT_EQ(result.exit_status, 0) << result.err;
   const std::string& json = result.out;
   auto number = [&json](const std::string& key) {
@@ -686,19 +617,20 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
 
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
-  EXPECT_NE(stat(("/dev/shm" + name).c_str(), &info), 0) << "the segment outlived the daemon";
-  const auto after = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name});
+  EXPECT_NE(stat(name.c_str(), &info), 0) << "the socket outlived the daemon";
+  const auto after = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--socket", name});
   EXPECT_EQ(after.exit_status, 2);
-  EXPECT_NE(after.err.find("cannot open shared memory"), std::string::npos) << after.err;
+  EXPECT_NE(after.err.find("cannot connect to hapticsimd at " + name), std::string::npos)
+      << after.err;
 }
 
 // A driver that dies mid-write leaves the input slot's sequence odd ("being written") for good:
 // the daemon reads nothing more from it, flags the input stale and renders no force; a restarted
 // driver is served again.
 TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestartedOneIsServed) {
-  const std::string name = "/hapticsim-e2e-dead-" + std::to_string(getpid());
+  const std::string name = testing::PrivateSocketPath();
   const std::string config = Temp("shm_dead.toml");
-  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nsocket = \"" << name
                         << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("shm_dead.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
@@ -713,25 +645,26 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
     EXPECT_TRUE(driver.ReadForce(&answer));
     return answer;
   };
-  shm::ShmDeviceClient first(name);
-  const shm::ShmForceOutput pressed = press(first);
+  auto first = std::make_unique<shm::ShmDeviceClient>(name);
+  const shm::ShmForceOutput pressed = press(*first);
   EXPECT_TRUE(pressed.flags & force_feedback_t::FLAG_IN_CONTACT) << pressed.flags;
   EXPECT_LT(pressed.force_n[2], -0.5);
 
   // It dies between the two sequence stores of its next write, before publishing it. (The slot's
   // sequence is its first word, core/seqlock_slot.hpp: this store leaves it exactly as such a
   // death does.)
-  shm::MappedSegment view = shm::MappedSegment::Open(name);
-  const std::int64_t next = view.segment().newest_input.load() + 1;
-  auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(
-      &view.segment().inputs[next % shm::kInputSlots]);
+  shm::ShmSegment& view = first->segment();
+  const std::int64_t next = view.newest_input.load() + 1;
+  auto& sequence =
+      *reinterpret_cast<std::atomic<std::uint64_t>*>(&view.inputs[next % shm::kInputSlots]);
   sequence.store(sequence.load() + 1);
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // > stale_after_s, > a session
   shm::ShmForceOutput expired;
-  ASSERT_TRUE(first.ReadForce(&expired));
+  ASSERT_TRUE(first->ReadForce(&expired));
   EXPECT_TRUE(expired.flags & force_feedback_t::FLAG_INPUT_STALE) << expired.flags;
   EXPECT_EQ(expired.force_n[2], 0.0);
 
+  first.reset();  // the dead driver's session ends with its process
   shm::ShmDeviceClient restarted(name);
   const shm::ShmForceOutput again = press(restarted);
   EXPECT_FALSE(again.flags & force_feedback_t::FLAG_INPUT_STALE) << again.flags;
@@ -746,9 +679,9 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
 // "no force source" within 10 ms of the daemon's last answer, and maps the segment a restarted
 // daemon makes, by itself, and is served by it.
 TEST(HapticsimdSharedMemory, AClientSeesNoForceSourceWithin10msOfAKilledDaemonAndReconnects) {
-  const std::string name = "/hapticsim-e2e-killed-" + std::to_string(getpid());
+  const std::string name = testing::PrivateSocketPath();
   const std::string config = Temp("shm_killed.toml");
-  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nname = \"" << name
+  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nsocket = \"" << name
                         << "\"\n";
   auto now_ns = [] {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -811,18 +744,6 @@ TEST(HapticsimdSharedMemory, AClientSeesNoForceSourceWithin10msOfAKilledDaemonAn
   EXPECT_LT(again.force_n[2], -0.3);
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(5), 0) << daemon->Log();
-}
-
-TEST(HapticsimdSharedMemory, AClientRefusesASegmentThatIsNotHapticsimds) {
-  const std::string name = "/hapticsim-foreign-" + std::to_string(getpid());
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(ftruncate(fd, 4096), 0);
-  close(fd);
-  const auto wrong_size = testing::RunCommand({HAPTICSIM_SHM_CLIENT_PATH, "--name", name});
-  EXPECT_EQ(wrong_size.exit_status, 2);
-  EXPECT_NE(wrong_size.err.find("bytes; this client expects"), std::string::npos) << wrong_size.err;
-  shm_unlink(name.c_str());
 }
 
 // The systemd protocol without systemd: the test is the notify socket.
@@ -907,11 +828,11 @@ namespace {
 // `hapticsim device` against a running daemon, over both transports, as a rig would use it; and
 // a recorded session replayed into it.
 TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSession) {
-  const std::string name = "/hapticsim-device-" + std::to_string(getpid());
+  const std::string name = testing::PrivateSocketPath();
   const std::string config = Temp("device.toml");
   // The segment exists, but the device input is LCM's (device.input): the shared-memory walk
   // below runs against a daemon whose input is shared memory's.
-  std::ofstream(config) << "[shm]\nenabled = true\nname = \"" << name
+  std::ofstream(config) << "[shm]\nenabled = true\nsocket = \"" << name
                         << "\"\n[device]\ninput = \"lcm\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("device.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
@@ -995,13 +916,13 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 
   const std::string shm_config = Temp("device-shm.toml");
-  std::ofstream(shm_config) << "[shm]\nenabled = true\nname = \"" << name << "\"\n";
+  std::ofstream(shm_config) << "[shm]\nenabled = true\nsocket = \"" << name << "\"\n";
   testing::BackgroundProcess shm_daemon({HAPTICSIMD_PATH, "--config", shm_config},
                                         Temp("device-shm.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(shm_daemon));
   // Shared memory, a seeded random walk: every daemon answer reaches the device.
   const auto shm = testing::RunCommand({HAPTICSIM_CLI_PATH, "device", "--transport", "shm",
-                                        "--shm-name", name, "--input", "walk", "--seed", "7",
+                                        "--shm-socket", name, "--input", "walk", "--seed", "7",
                                         "--duration", "3", "--json", "--max-lost", "0"});
   EXPECT_EQ(shm.exit_status, 0) << shm.out << shm.err;
   const auto walk = nlohmann::json::parse(shm.out);
@@ -1059,9 +980,9 @@ TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
 // One owner of the device input: with shared memory owning it, a process that publishes device
 // input on LCM changes nothing the shared-memory driver feels, and is refused and counted.
 TEST(HapticsimdInputOwner, LcmInputIsRefusedWhileSharedMemoryOwnsTheInput) {
-  const std::string name = "/hapticsim-owner-" + std::to_string(getpid());
+  const std::string name = testing::PrivateSocketPath();
   const std::string config = Temp("owner.toml");
-  std::ofstream(config) << "[shm]\nenabled = true\nname = \"" << name << "\"\n";
+  std::ofstream(config) << "[shm]\nenabled = true\nsocket = \"" << name << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("owner.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   Client intruder;

@@ -1,5 +1,5 @@
 // Every device input gets its answer: the shared-memory input ring loses nothing a driver writes
-// in quick succession (real POSIX shared memory), and a primary period that took several inputs
+// in quick succession (a real sealed segment, mapped twice as the daemon and the driver map it), and a primary period that took several inputs
 // names them all in its answer.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -16,9 +16,14 @@ namespace hapticsim {
 namespace {
 
 TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
-  const std::string name = "/hapticsim-ring-" + std::to_string(getpid());
-  shm::MappedSegment daemon = shm::MappedSegment::Create(name, "");
-  shm::ShmDeviceClient driver(name);
+  shm::MappedSegment daemon = shm::MappedSegment::CreateSealed("hapticsim-test");
+  shm::MappedSegment driver_mapping = shm::MappedSegment::Adopt(dup(daemon.fd()), "the test");
+  auto write = [&](std::int64_t seq) {
+    shm::ShmDeviceInput input;
+    input.seq = seq;
+    input.position_m[0] = input.position_m[1] = 0.1;
+    shm::WriteDeviceInput(driver_mapping.segment(), input);
+  };
   shm::ShmInputReader reader;
   std::vector<std::int64_t> seen;
   auto read = [&] {
@@ -27,14 +32,14 @@ TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
     });
   };
   EXPECT_EQ(read(), 0);
-  for (int seq = 1; seq <= 5; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});  // one poll
+  for (int seq = 1; seq <= 5; ++seq) write(seq);  // one poll
   EXPECT_EQ(read(), 5);
   EXPECT_EQ(seen, (std::vector<std::int64_t>{1, 2, 3, 4, 5}));
   EXPECT_EQ(read(), 0);  // nothing new
   // A daemon that did not poll for 300 writes reads the newest kInputSlots − 1 (the slot after
   // the newest may be being written), in order.
   seen.clear();
-  for (int seq = 6; seq <= 305; ++seq) driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
+  for (int seq = 6; seq <= 305; ++seq) write(seq);
   EXPECT_EQ(read(), shm::kInputSlots - 1);
   EXPECT_EQ(seen.front(), 307 - shm::kInputSlots);
   EXPECT_EQ(seen.back(), 305);
@@ -46,7 +51,7 @@ TEST(ShmInputRing, InputsWrittenInQuickSuccessionAllReachTheDaemonInOrder) {
     daemon.segment().newest_input.store(index);
     EXPECT_LE(read(), shm::kInputSlots - 1) << index;
     seen.clear();
-    driver.WriteInput(seq, 0, {0.1, 0.1, 0.0});
+    write(seq);
     EXPECT_GE(read(), 1) << index;
     ASSERT_FALSE(seen.empty()) << index;
     EXPECT_EQ(seen.back(), seq) << index;

@@ -9,6 +9,7 @@
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
+#include "ipc/service_socket.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/device_report.hpp"
 
@@ -18,7 +19,7 @@ namespace {
 struct DeviceOptions {
   std::string transport = "lcm";
   std::string lcm_url = device::kHostLocalLcmUrl;
-  std::string shm_name = "/hapticsim";
+  std::string shm_socket = shm::kDefaultSocket;
   std::string device_channel = "HAPTIC_DEVICE", force_channel = "HAPTIC_FORCE",
               status_channel = "HAPTIC_STATUS";
   device::MotionSettings motion;
@@ -44,7 +45,7 @@ int Run(DeviceOptions o) {
   if (o.transport == "lcm") {
     link = device::MakeLcmLink(o.lcm_url, o.device_channel, o.force_channel, o.status_channel);
   } else if (o.transport == "shm") {
-    link = device::MakeShmLink(o.shm_name);
+    link = device::MakeShmLink(o.shm_socket);
     // The daemon's status (deadlines, configuration) comes over LCM; listen when LCM is there.
     try {
       status_link = device::MakeLcmLink(o.lcm_url, o.device_channel, o.force_channel,
@@ -105,7 +106,7 @@ int Run(DeviceOptions o) {
   }
   if (report.stream.answers == 0) {
     std::cerr << "hapticsim device: no answer from hapticsimd over " << o.transport
-              << (o.transport == "lcm" ? " on " + o.lcm_url : " in /dev/shm" + o.shm_name)
+              << (o.transport == "lcm" ? " on " + o.lcm_url : " at " + o.shm_socket)
               << ": is it running, with that interface enabled?\n";
     return kExitLimitsExceeded;
   }
@@ -125,7 +126,9 @@ Command AddDeviceCommand(CLI::App& parent) {
   app->add_option("--transport", options->transport, "lcm or shm")->capture_default_str();
   app->add_option("--lcm-url", options->lcm_url, "LCM URL (the default stays on this host: ttl=0)")
       ->capture_default_str();
-  app->add_option("--shm-name", options->shm_name, "Shared-memory segment")->capture_default_str();
+  app->add_option("--shm-socket", options->shm_socket,
+                  "hapticsimd's service socket (its shm.socket), for --transport shm")
+      ->capture_default_str();
   app->add_option("--device-channel", options->device_channel)->capture_default_str();
   app->add_option("--force-channel", options->force_channel)->capture_default_str();
   app->add_option("--status-channel", options->status_channel)->capture_default_str();

@@ -108,6 +108,8 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
         {"reconfigurations", r.status->reconfigurations},
         {"input_owner", r.status->input_owner},
         {"inputs_wrong_transport", r.status->inputs_wrong_transport},
+        {"shm_sessions", r.status->shm_sessions},
+        {"shm_refused", r.status->shm_refused},
         {"max_force_n", r.status->max_force_n},
         {"force_limited_periods", r.status->force_limited_periods},
         {"port_dissipating_periods", r.status->port_dissipating_periods},

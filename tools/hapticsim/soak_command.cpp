@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -158,11 +159,23 @@ int RunSoak(const SoakOptions& o) {
   const std::string daemon = o.daemon.empty() ? DefaultDaemon() : o.daemon;
   const fs::path dir = fs::absolute(o.report_dir);
   fs::create_directories(dir);
-  const std::string shm_name = "/hapticsim_soak_" + std::to_string(getpid());
+  // The service socket in a directory of its own that only this user can write: the driver
+  // trusts no socket others could have put in place (ipc/service_socket.hpp).
+  char socket_dir[] = "/tmp/hapticsim-soak-XXXXXX";
+  HAPTICSIM_THROW_UNLESS(mkdtemp(socket_dir), std::string("cannot make a directory in /tmp: ") +
+                                                  std::strerror(errno));
+  const std::string shm_socket = std::string(socket_dir) + "/hapticsimd.sock";
+  struct RemoveDir {
+    std::string path;
+    ~RemoveDir() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } remove_socket_dir{socket_dir};
   const fs::path config = dir / "hapticsimd.toml", log = dir / "hapticsimd.log";
   {
     std::ofstream c(config);
-    c << "# written by hapticsim soak\n[shm]\nenabled = true\nname = \"" << shm_name << "\"\n";
+    c << "# written by hapticsim soak\n[shm]\nenabled = true\nsocket = \"" << shm_socket << "\"\n";
     if (!o.error_map.empty()) {
       c << "[supervisor]\nerror_map = \"" << fs::absolute(o.error_map).string() << "\"\n";
     }
@@ -193,7 +206,7 @@ int RunSoak(const SoakOptions& o) {
       throw Error("hapticsimd exited before serving; its log:\n" + TailOf(log, 20));
     }
     try {
-      link = device::MakeShmLink(shm_name);
+      link = device::MakeShmLink(shm_socket);
     } catch (const Error&) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
@@ -201,7 +214,7 @@ int RunSoak(const SoakOptions& o) {
   if (!link) {
     int status = 0;
     stop_daemon(&status);
-    throw Error("hapticsimd did not open " + shm_name + " within 30 s; its log:\n" +
+    throw Error("hapticsimd did not serve " + shm_socket + " within 30 s; its log:\n" +
                 TailOf(log, 20));
   }
   auto monitor = device::MakeLcmLink(device::kHostLocalLcmUrl, "HAPTIC_DEVICE", "HAPTIC_FORCE",

@@ -3,7 +3,7 @@
 // from above the surface into the object at the paper's contact point and back, reads the force
 // for every period, and prints a JSON summary.
 //
-//   hapticsim-shm-client [--name /hapticsim] [--duration 2] [--depth 0.01]
+//   hapticsim-shm-client [--socket /run/hapticsim/hapticsimd.sock] [--duration 2] [--depth 0.01]
 #include <time.h>
 
 #include <CLI/CLI.hpp>
@@ -25,19 +25,20 @@ std::int64_t NowNs() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string name = hapticsim::shm::kDefaultName;
+  std::string socket_path = hapticsim::shm::kDefaultSocket;
   double duration_s = 2.0, depth_m = 0.01, edge_m = 0.25;
   CLI::App app{
       "hapticsim-shm-client: drive hapticsimd through shared memory at 1 kHz and "
       "summarise its answers as JSON",
       "hapticsim-shm-client"};
-  app.add_option("--name", name, "Shared-memory name")->capture_default_str();
+  app.add_option("--socket", socket_path, "hapticsimd's service socket (its shm.socket)")
+      ->capture_default_str();
   app.add_option("--duration", duration_s, "Seconds to run")->capture_default_str();
   app.add_option("--depth", depth_m, "Deepest press into the object, m")->capture_default_str();
   app.add_option("--edge", edge_m, "Cube edge of the daemon's scene, m")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
-    hapticsim::shm::ShmDeviceClient client(name);
+    hapticsim::shm::ShmDeviceClient client(socket_path);
     const std::int64_t periods = std::llround(duration_s * 1000);
     std::int64_t answered_same_period = 0, nonfinite = 0, in_contact = 0, stale = 0;
     std::int64_t max_lag = 0, last_seen = -1, out_of_order = 0, no_source = 0;

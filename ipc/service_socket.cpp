@@ -1,0 +1,269 @@
+#include "ipc/service_socket.hpp"
+
+#include <fcntl.h>
+#include <grp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include "core/error.hpp"
+
+namespace hapticsim::shm {
+namespace {
+
+std::string Why() { return std::strerror(errno); }
+
+/** The greeting's first word: the protocol and its version. */
+constexpr const char* kSessionGreeting = "HSIM1 session";
+constexpr const char* kRefusedPrefix = "HSIM1 refused: ";
+
+sockaddr_un AddressOf(const std::string& path, const std::string& key) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  HAPTICSIM_THROW_UNLESS(!path.empty() && path[0] == '/',
+                         key + " = \"" + path + "\": must be an absolute path");
+  HAPTICSIM_THROW_UNLESS(path.size() < sizeof address.sun_path,
+                         key + " = \"" + path + "\": longer than a Unix socket path may be (" +
+                             std::to_string(sizeof address.sun_path - 1) + " bytes)");
+  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  return address;
+}
+
+std::string Octal(mode_t mode) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%04o", static_cast<unsigned>(mode & 07777));
+  return text;
+}
+
+std::string DirectoryOf(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+/** Whether a live process answers at `address` (a socket a dead daemon left does not). */
+bool SomeoneListens(const sockaddr_un& address) {
+  UniqueFd probe(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  if (!probe) return false;
+  return connect(probe.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0;
+}
+
+}  // namespace
+
+PeerIdentity PeerOf(int fd) {
+  PeerIdentity peer;
+  ucred credentials{};
+  socklen_t length = sizeof credentials;
+  HAPTICSIM_THROW_UNLESS(getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &credentials, &length) == 0,
+                         "cannot read the peer's credentials: " + Why());
+  peer.pid = credentials.pid;
+  peer.uid = credentials.uid;
+  peer.gid = credentials.gid;
+  std::vector<gid_t> groups(64);
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    socklen_t bytes = static_cast<socklen_t>(groups.size() * sizeof(gid_t));
+    if (getsockopt(fd, SOL_SOCKET, SO_PEERGROUPS, groups.data(), &bytes) == 0) {
+      groups.resize(bytes / sizeof(gid_t));
+      peer.groups = std::move(groups);
+      return peer;
+    }
+    if (errno != ERANGE) break;
+    groups.resize(std::max<std::size_t>(bytes / sizeof(gid_t), groups.size() * 2));
+  }
+  return peer;  // no supplementary groups known: only the primary group counts
+}
+
+std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid) {
+  if (peer.uid == 0 || peer.uid == daemon_uid || peer.gid == allowed_gid) return "";
+  if (std::find(peer.groups.begin(), peer.groups.end(), allowed_gid) != peer.groups.end()) {
+    return "";
+  }
+  const struct group* entry = getgrgid(allowed_gid);
+  return "pid " + std::to_string(peer.pid) + " (uid " + std::to_string(peer.uid) +
+         ") is not in group " +
+         (entry ? std::string(entry->gr_name) : std::to_string(allowed_gid)) +
+         " (shm.group): add the driver's user to it";
+}
+
+std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server) {
+  struct stat info {};
+  if (lstat(path.c_str(), &info) != 0) return path + " cannot be examined: " + Why();
+  if (!S_ISSOCK(info.st_mode)) return path + " is not a socket";
+  if (info.st_uid != server.uid) {
+    return path + " is owned by uid " + std::to_string(info.st_uid) + " but served by uid " +
+           std::to_string(server.uid) + " (pid " + std::to_string(server.pid) +
+           "): not the service that made it";
+  }
+  // The socket's own directory: nobody but its owner may create names in it, or someone else
+  // could have bound the name before the daemon did.
+  std::string directory = DirectoryOf(path);
+  bool own_directory = true;
+  while (true) {
+    if (stat(directory.c_str(), &info) != 0) return directory + " cannot be examined: " + Why();
+    if (info.st_uid != 0 && info.st_uid != server.uid) {
+      return directory + " is owned by uid " + std::to_string(info.st_uid) +
+             ", neither root nor the service (uid " + std::to_string(server.uid) +
+             "): that user could have put " + path + " there";
+    }
+    const bool others_write = info.st_mode & (S_IWGRP | S_IWOTH);
+    // Above the socket's own directory a sticky one (like /tmp) is safe: others can add names,
+    // but not move or remove the service's directory.
+    if (others_write && (own_directory || !(info.st_mode & S_ISVTX))) {
+      return directory + " (mode " + Octal(info.st_mode) +
+             ") can be written by users other than its owner: any of them could have put " + path +
+             " there; serve the socket from a directory only the service writes, e.g. "
+             "/run/hapticsim";
+    }
+    if (directory == "/") return "";
+    directory = DirectoryOf(directory);
+    own_directory = false;
+  }
+}
+
+ServiceListener::ServiceListener(const std::string& path, const std::string& group)
+    : path_(path), allowed_gid_(getegid()) {
+  const sockaddr_un address = AddressOf(path, "shm.socket");
+  if (!group.empty()) {
+    const struct group* entry = getgrnam(group.c_str());
+    HAPTICSIM_THROW_UNLESS(entry, "shm.group = \"" + group + "\": no such group");
+    allowed_gid_ = entry->gr_gid;
+  }
+  const std::string directory = DirectoryOf(path);
+  struct stat info {};
+  HAPTICSIM_THROW_UNLESS(stat(directory.c_str(), &info) == 0 && S_ISDIR(info.st_mode),
+                         "shm.socket = \"" + path + "\": " + directory +
+                             " is not a directory: create it, only writable by the daemon's "
+                             "user (systemd: RuntimeDirectory=hapticsim), or choose another path");
+  if (lstat(path.c_str(), &info) == 0) {
+    HAPTICSIM_THROW_UNLESS(S_ISSOCK(info.st_mode), "shm.socket = \"" + path +
+                                                       "\": a file that is not a socket is in "
+                                                       "the way; remove it or choose another path");
+    HAPTICSIM_THROW_UNLESS(!SomeoneListens(address),
+                           "shm.socket = \"" + path +
+                               "\": another hapticsimd already serves it; stop that one or "
+                               "choose another path");
+    unlink(path.c_str());  // left by a daemon that died
+  }
+  socket_.reset(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
+  HAPTICSIM_THROW_UNLESS(socket_, "cannot make the service socket: " + Why());
+  HAPTICSIM_THROW_UNLESS(
+      bind(socket_.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0,
+      "shm.socket = \"" + path + "\": cannot bind: " + Why());
+  // Owner and group only, before anyone can connect (listen comes last).
+  auto fail = [&](const std::string& what) {
+    const std::string why = Why();
+    unlink(path.c_str());
+    throw Error("shm.socket = \"" + path + "\": cannot " + what + ": " + why);
+  };
+  if (lstat(path.c_str(), &info) != 0) fail("examine it");
+  inode_ = info.st_ino;
+  if (!group.empty() && chown(path.c_str(), static_cast<uid_t>(-1), allowed_gid_) != 0) {
+    fail("give it to group " + group);
+  }
+  if (chmod(path.c_str(), 0660) != 0) fail("set its mode");
+  if (listen(socket_.get(), 8) != 0) fail("listen");
+}
+
+ServiceListener::~ServiceListener() {
+  struct stat info {};
+  // Only the socket this listener bound: a newer daemon's at the same path stays.
+  if (lstat(path_.c_str(), &info) == 0 && info.st_ino == inode_) unlink(path_.c_str());
+}
+
+std::optional<Connection> ServiceListener::Accept() {
+  UniqueFd socket(accept4(socket_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
+  if (!socket) return std::nullopt;
+  try {
+    PeerIdentity peer = PeerOf(socket.get());
+    return Connection{std::move(socket), std::move(peer)};
+  } catch (const Error&) {
+    return std::nullopt;  // gone before it could be asked: nobody to answer
+  }
+}
+
+bool SendMessage(int socket, const std::string& text, int fd_to_pass) {
+  iovec part{const_cast<char*>(text.data()), text.size()};
+  msghdr message{};
+  message.msg_iov = &part;
+  message.msg_iovlen = 1;
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+  if (fd_to_pass >= 0) {
+    message.msg_control = control;
+    message.msg_controllen = sizeof control;
+    cmsghdr* header = CMSG_FIRSTHDR(&message);
+    header->cmsg_level = SOL_SOCKET;
+    header->cmsg_type = SCM_RIGHTS;
+    header->cmsg_len = CMSG_LEN(sizeof(int));
+    std::memcpy(CMSG_DATA(header), &fd_to_pass, sizeof(int));
+  }
+  return sendmsg(socket, &message, MSG_DONTWAIT | MSG_NOSIGNAL) ==
+         static_cast<ssize_t>(text.size());
+}
+
+MappedSegment ReadSessionAnswer(int connection, const std::string& path, int timeout_ms) {
+  pollfd ready{connection, POLLIN, 0};
+  HAPTICSIM_THROW_UNLESS(
+      poll(&ready, 1, timeout_ms) == 1,
+      "hapticsimd at " + path + " did not answer within " + std::to_string(timeout_ms) + " ms");
+  char text[256];
+  iovec part{text, sizeof text - 1};
+  alignas(cmsghdr) char control[CMSG_SPACE(4 * sizeof(int))];
+  msghdr message{};
+  message.msg_iov = &part;
+  message.msg_iovlen = 1;
+  message.msg_control = control;
+  message.msg_controllen = sizeof control;
+  const ssize_t length = recvmsg(connection, &message, MSG_DONTWAIT | MSG_CMSG_CLOEXEC);
+  // Every descriptor that came, owned at once, so none leaks whatever is wrong with the message.
+  std::vector<UniqueFd> passed;
+  for (cmsghdr* h = CMSG_FIRSTHDR(&message); h; h = CMSG_NXTHDR(&message, h)) {
+    if (h->cmsg_level != SOL_SOCKET || h->cmsg_type != SCM_RIGHTS) continue;
+    const std::size_t count = (h->cmsg_len - CMSG_LEN(0)) / sizeof(int);
+    for (std::size_t k = 0; k < count; ++k) {
+      int fd;
+      std::memcpy(&fd, CMSG_DATA(h) + k * sizeof(int), sizeof fd);
+      passed.emplace_back(fd);
+    }
+  }
+  HAPTICSIM_THROW_UNLESS(length > 0, "hapticsimd at " + path + " hung up without an answer");
+  const std::string answer(text, static_cast<std::size_t>(length));
+  if (answer.rfind(kRefusedPrefix, 0) == 0) {
+    // The reason is the server's text: printable characters only reach the driver's log.
+    std::string why = answer.substr(std::strlen(kRefusedPrefix));
+    for (char& c : why) {
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    }
+    throw Error("hapticsimd at " + path + " refused this driver: " + why);
+  }
+  HAPTICSIM_THROW_UNLESS(answer == kSessionGreeting && passed.size() == 1 &&
+                             !(message.msg_flags & (MSG_TRUNC | MSG_CTRUNC)),
+                         "the service at " + path + " answered what hapticsimd does not say (" +
+                             std::to_string(passed.size()) + " descriptors): not hapticsimd?");
+  return MappedSegment::Adopt(passed[0].release(), path);
+}
+
+ServiceSession ConnectToService(const std::string& path, int timeout_ms) {
+  const sockaddr_un address = AddressOf(path, "the service socket");
+  UniqueFd connection(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  HAPTICSIM_THROW_UNLESS(connection, "cannot make a socket: " + Why());
+  HAPTICSIM_THROW_UNLESS(
+      connect(connection.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0,
+      "cannot connect to hapticsimd at " + path + ": " + Why() +
+          " (is it running with [shm] enabled = true and socket = \"" + path +
+          "\", and is this user in its shm.group?)");
+  PeerIdentity daemon = PeerOf(connection.get());
+  const std::string problem = ServerIdentityProblem(path, daemon);
+  HAPTICSIM_THROW_UNLESS(problem.empty(), "refusing the daemon at " + path + ": " + problem);
+
+  MappedSegment segment = ReadSessionAnswer(connection.get(), path, timeout_ms);
+  return ServiceSession{std::move(connection), std::move(daemon), std::move(segment)};
+}
+std::string SessionGreeting() { return kSessionGreeting; }
+std::string Refusal(const std::string& why) { return kRefusedPrefix + why; }
+
+}  // namespace hapticsim::shm

@@ -1,0 +1,117 @@
+#pragma once
+
+// The service socket: how a device driver gets its shared segment from hapticsimd, and how each
+// side makes sure of the other.
+//
+// The daemon listens on a Unix socket (shm.socket, default /run/hapticsim/hapticsimd.sock; mode
+// 0660, group shm.group). A driver connects; the daemon reads the driver's credentials from the
+// kernel (SO_PEERCRED, SO_PEERGROUPS) and either answers "HSIM1 session" with a new sealed segment
+// attached (SCM_RIGHTS; ipc/shm_segment.hpp), or "HSIM1 refused: <why>" and hangs up. The session
+// lasts while the driver keeps the connection open; one driver at a time. The driver checks the
+// daemon too (ServerIdentityProblem): the socket must be owned by the process that serves it, in
+// a directory nobody else can write, so no other local user can have put it there first.
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ipc/shm_segment.hpp"
+#include "ipc/unique_fd.hpp"
+
+namespace hapticsim::shm {
+
+/** Where hapticsimd listens unless shm.socket says otherwise (systemd: RuntimeDirectory). */
+inline constexpr const char* kDefaultSocket = "/run/hapticsim/hapticsimd.sock";
+
+/** The process at the other end of a connected Unix socket, as the kernel tells it. */
+struct PeerIdentity {
+  pid_t pid = 0;
+  uid_t uid = 0;
+  gid_t gid = 0;
+  std::vector<gid_t> groups;  ///< supplementary groups (SO_PEERGROUPS)
+};
+
+/** The identity of the peer of connected Unix socket `fd`. @throws Error when unreadable. */
+PeerIdentity PeerOf(int fd);
+
+/**
+ * Whether `peer` may drive the daemon running as `daemon_uid`: root, the daemon's own user, or a
+ * member of `allowed_gid` (as its primary or a supplementary group). Empty when it may, else why
+ * not, in words for the log.
+ */
+std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid);
+
+/**
+ * Why the socket at `path`, served by `server`, is not to be trusted; empty when it is. It must
+ * be a socket owned by the serving user, in a directory that only that user or root owns and that
+ * no one else can write; every directory above it must be writable only by its owner (root or
+ * that user), or be sticky (like /tmp).
+ */
+std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server);
+
+/** A connection the daemon accepted: the socket and who is at the other end. */
+struct Connection {
+  UniqueFd socket;
+  PeerIdentity peer;
+};
+
+/** The daemon's side: listens at `path` for drivers. Only the daemon's I/O thread uses it. */
+class ServiceListener {
+ public:
+  /**
+   * Binds `path` (mode 0660, group `group`, or the daemon's own group when empty). A socket left
+   * there by a daemon that died is replaced; a live daemon's, or any other file, is not.
+   * @throws Error naming the key and what to fix.
+   */
+  ServiceListener(const std::string& path, const std::string& group);
+  ~ServiceListener();
+  ServiceListener(const ServiceListener&) = delete;
+  ServiceListener& operator=(const ServiceListener&) = delete;
+
+  /** A connection waiting to be accepted, or nothing (never blocks). */
+  std::optional<Connection> Accept();
+  const std::string& path() const { return path_; }
+  gid_t allowed_gid() const { return allowed_gid_; }
+
+ private:
+  std::string path_;
+  UniqueFd socket_;
+  gid_t allowed_gid_;
+  ino_t inode_ = 0;  // of the socket file bound, so only that one is removed at the end
+};
+
+/**
+ * Sends `text` as one message, with `fd_to_pass` attached when it is >= 0. Never blocks; false
+ * when the message could not be sent whole.
+ */
+bool SendMessage(int socket, const std::string& text, int fd_to_pass = -1);
+
+/** The daemon's answers: a session (sent with the segment attached), or a refusal and why. */
+std::string SessionGreeting();
+std::string Refusal(const std::string& why);
+
+/** A driver's session with the daemon: held open for as long as the driver drives. */
+struct ServiceSession {
+  UniqueFd connection;
+  PeerIdentity daemon;
+  MappedSegment segment;
+};
+
+/**
+ * The driver's side of the answer: waits at most `timeout_ms` for the daemon's message on
+ * `connection` and maps the segment it carries; every descriptor that came with it is closed
+ * otherwise. `path` names the daemon in messages. @throws Error: a refusal (with the daemon's
+ * reason), a hang-up, silence, or an answer or segment that is not hapticsimd's.
+ */
+MappedSegment ReadSessionAnswer(int connection, const std::string& path, int timeout_ms);
+
+/**
+ * The driver's side: connects to the daemon at `path`, checks that it is the service
+ * (ServerIdentityProblem), and maps the segment it hands over, waiting at most `timeout_ms` for
+ * it. @throws Error that names the problem: no daemon, an untrusted socket, refused, no segment.
+ */
+ServiceSession ConnectToService(const std::string& path, int timeout_ms);
+
+}  // namespace hapticsim::shm

@@ -1,0 +1,247 @@
+// The service socket and the sealed segment (ipc/service_socket.hpp, ipc/shm_segment.hpp), with
+// real Unix sockets, real memory files and real file modes: what a driver accepts from a server,
+// and what it refuses, by name.
+#include "ipc/service_socket.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <thread>
+
+#include "core/error.hpp"
+#include "ipc/shm_device_client.hpp"
+#include "tests/support/private_socket.hpp"
+
+namespace hapticsim::shm {
+namespace {
+
+std::string DirectoryOf(const std::string& path) {
+  return std::filesystem::path(path).parent_path().string();
+}
+
+// A server at `path` that answers the first driver to connect with `answer(connection)`.
+class FakeServer {
+ public:
+  FakeServer(const std::string& path, std::function<void(int)> answer)
+      : listener_(path, ""), thread_([this, answer] {
+          for (int n = 0; n < 2000; ++n) {
+            if (auto connection = listener_.Accept()) {
+              answer(connection->socket.get());
+              // Held open until the driver has read the answer.
+              std::this_thread::sleep_for(std::chrono::milliseconds(100));
+              return;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          }
+        }) {}
+  ~FakeServer() { thread_.join(); }
+
+ private:
+  ServiceListener listener_;
+  std::thread thread_;
+};
+
+// What ConnectToService says about the server at `path`; empty when it connects.
+std::string DriverVerdict(const std::string& path) {
+  try {
+    ConnectToService(path, 1000);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+// Why a daemon could not listen at `path`; empty when it could.
+std::string ListenerRefusal(const std::string& path) {
+  try {
+    ServiceListener listener(path, "");
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+int MemoryFile(std::size_t bytes, bool sealed) {
+  const int fd = memfd_create("foreign", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+  EXPECT_EQ(ftruncate(fd, static_cast<off_t>(bytes)), 0);
+  if (sealed) EXPECT_EQ(fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL), 0);
+  return fd;
+}
+
+TEST(SealedSegment, NeitherItsMakerNorItsDriverCanChangeItsSizeOrItsSeals) {
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test");
+  const int driver = dup(daemon.fd());
+  EXPECT_NE(ftruncate(driver, 0), 0);  // a SIGBUS in the daemon's next access, before
+  EXPECT_EQ(errno, EPERM);
+  EXPECT_NE(ftruncate(driver, 2 * sizeof(ShmSegment)), 0);
+  EXPECT_EQ(errno, EPERM);
+  EXPECT_NE(fallocate(driver, 0, 0, 4 * sizeof(ShmSegment)), 0);
+  EXPECT_NE(fcntl(driver, F_ADD_SEALS, F_SEAL_WRITE), 0);  // sealed: no more seals either
+  struct stat info {};
+  ASSERT_EQ(fstat(driver, &info), 0);
+  EXPECT_EQ(static_cast<std::size_t>(info.st_size), sizeof(ShmSegment));
+  // The driver's mapping is the daemon's memory.
+  MappedSegment mapped = MappedSegment::Adopt(driver, "the test");
+  daemon.segment().newest_output.store(42);
+  EXPECT_EQ(mapped.segment().newest_output.load(), 42);
+}
+
+TEST(SealedSegment, ADriverRefusesAnUnsealedFileAWrongSizeAndAForeignHeader) {
+  auto verdict = [](int fd) {
+    try {
+      MappedSegment::Adopt(fd, "the server");
+      return std::string();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_NE(verdict(MemoryFile(sizeof(ShmSegment), false)).find("not sealed against size changes"),
+            std::string::npos);
+  EXPECT_NE(verdict(MemoryFile(4096, true)).find("has 4096 bytes; this client expects"),
+            std::string::npos);
+  // The right size, sealed, but all zeros: nobody's header.
+  EXPECT_NE(verdict(MemoryFile(sizeof(ShmSegment), true)).find("no hapticsim signature"),
+            std::string::npos);
+  // A regular file cannot be sealed at all.
+  char path[] = "/tmp/hapticsim-regular-XXXXXX";
+  const int regular = mkstemp(path);
+  unlink(path);
+  ASSERT_EQ(ftruncate(regular, sizeof(ShmSegment)), 0);
+  EXPECT_NE(verdict(regular).find("not a sealable memory file"), std::string::npos);
+}
+
+TEST(ServiceSocket, ADriverMapsTheSegmentItsDaemonHandsOver) {
+  const std::string path = testing::PrivateSocketPath();
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test");
+  {
+    FakeServer server(path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), daemon.fd()); });
+    ShmDeviceClient driver(path);
+    EXPECT_EQ(driver.daemon().pid, getpid());
+    EXPECT_EQ(driver.daemon().uid, geteuid());
+    driver.WriteInput(7, 0, {0.1, 0.1, 0.0});
+    ShmDeviceInput written;
+    ASSERT_TRUE(daemon.segment().inputs[0].Read(&written));
+    EXPECT_EQ(written.seq, 7);
+  }
+  std::filesystem::remove_all(DirectoryOf(path));
+}
+
+TEST(ServiceSocket, ADriverRefusesASocketThatOthersCouldHavePutThere) {
+  // A squatter's socket in a directory everybody can write, handing over a genuine-looking
+  // segment: the driver never maps it.
+  const std::string private_path = testing::PrivateSocketPath();
+  const std::string directory = DirectoryOf(private_path);
+  ASSERT_EQ(chmod(directory.c_str(), 01777), 0);
+  MappedSegment squatter = MappedSegment::CreateSealed("squatter");
+  {
+    FakeServer server(private_path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), squatter.fd()); });
+    const std::string verdict = DriverVerdict(private_path);
+    EXPECT_NE(verdict.find("refusing the daemon at " + private_path), std::string::npos) << verdict;
+    EXPECT_NE(verdict.find("(mode 1777) can be written by users other than its owner"),
+              std::string::npos)
+        << verdict;
+  }
+  // Group-writable is as bad.
+  ASSERT_EQ(chmod(directory.c_str(), 0770), 0);
+  {
+    FakeServer server(private_path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), squatter.fd()); });
+    EXPECT_NE(DriverVerdict(private_path).find("(mode 0770)"), std::string::npos);
+  }
+  std::filesystem::remove_all(directory);
+}
+
+TEST(ServiceSocket, ADriverRefusesASocketNotOwnedByTheProcessServingIt) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to give the socket to another user";
+  const std::string path = testing::PrivateSocketPath();
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test");
+  FakeServer server(path, [&](int socket) { SendMessage(socket, SessionGreeting(), daemon.fd()); });
+  if (chown(path.c_str(), 65534, static_cast<gid_t>(-1)) != 0) {
+    GTEST_SKIP() << "uid 65534 is not mapped here (a user namespace)";
+  }
+  const std::string verdict = DriverVerdict(path);
+  EXPECT_NE(verdict.find("is owned by uid 65534 but served by uid 0"), std::string::npos)
+      << verdict;
+  std::filesystem::remove_all(DirectoryOf(path));
+}
+
+TEST(ServiceSocket, ADriverSaysWhyItWasRefusedOrWhatWasWrongWithTheAnswer) {
+  const std::string path = testing::PrivateSocketPath();
+  {
+    FakeServer server(path, [](int socket) { SendMessage(socket, Refusal("go away")); });
+    EXPECT_NE(DriverVerdict(path).find("refused this driver: go away"), std::string::npos);
+  }
+  {
+    FakeServer server(path, [](int socket) { SendMessage(socket, "HELLO"); });
+    EXPECT_NE(DriverVerdict(path).find("answered what hapticsimd does not say (0 descriptors)"),
+              std::string::npos);
+  }
+  {
+    FakeServer server(path, [](int) {});  // hangs up without a word
+    EXPECT_NE(DriverVerdict(path).find("hung up without an answer"), std::string::npos);
+  }
+  EXPECT_NE(DriverVerdict(path).find("cannot connect to hapticsimd at " + path),
+            std::string::npos);  // nobody listens any more
+  std::filesystem::remove_all(DirectoryOf(path));
+}
+
+TEST(ServiceSocket, TheDaemonAdmitsRootItsOwnUserAndItsGroupOnly) {
+  PeerIdentity peer;
+  peer.pid = 1234;
+  peer.uid = 1000;
+  peer.gid = 1000;
+  EXPECT_EQ(PeerRefusal(peer, 1000, 2000), "");  // the daemon's own user
+  peer.uid = 0;
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // root
+  peer.uid = 1001;
+  EXPECT_NE(PeerRefusal(peer, 999, 2000).find("pid 1234 (uid 1001) is not in group"),
+            std::string::npos);
+  peer.gid = 2000;
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // primary group
+  peer.gid = 1001;
+  peer.groups = {5, 2000};
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // supplementary group
+}
+
+TEST(ServiceSocket, TheDaemonReplacesADeadDaemonsSocketButNotALiveOneOrAFile) {
+  const std::string path = testing::PrivateSocketPath();
+  { ServiceListener stopped(path, ""); }  // a daemon that stops removes its socket
+  ASSERT_FALSE(std::filesystem::exists(path));
+  {
+    ServiceListener live(path, "");
+    EXPECT_NE(ListenerRefusal(path).find("another hapticsimd already serves it"),
+              std::string::npos);
+    struct stat info {};
+    ASSERT_EQ(stat(path.c_str(), &info), 0);
+    EXPECT_EQ(info.st_mode & 0777, 0660u);
+  }
+  {
+    const int left = socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof address.sun_path, "%s", path.c_str());
+    ASSERT_EQ(bind(left, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    close(left);  // bound, never listening: what a killed daemon leaves
+    ServiceListener after_crash(path, "");
+  }
+  std::ofstream(path) << "not a socket";
+  EXPECT_NE(ListenerRefusal(path).find("a file that is not a socket is in the way"),
+            std::string::npos);
+  std::filesystem::remove_all(DirectoryOf(path));
+}
+
+}  // namespace
+}  // namespace hapticsim::shm
