@@ -71,6 +71,10 @@ const std::map<std::string, Setter>& Setters() {
     text("lcm.force_channel", &DaemonConfig::force_channel);
     text("lcm.status_channel", &DaemonConfig::status_channel);
     text("lcm.command_channel", &DaemonConfig::command_channel);
+    flag("lcm.accept_commands", &DaemonConfig::lcm_accept_commands);
+    flag("control.enabled", &DaemonConfig::control_enabled);
+    text("control.socket", &DaemonConfig::control_socket);
+    text("control.group", &DaemonConfig::control_group);
     flag("shm.enabled", &DaemonConfig::shm_enabled);
     text("shm.socket", &DaemonConfig::shm_socket);
     s["shm.name"] = [](DaemonConfig*, const toml::node&, const std::string& where) {
@@ -212,10 +216,15 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
-  require(c.shm_socket.size() > 1 && c.shm_socket[0] == '/' && c.shm_socket.back() != '/' &&
-              c.shm_socket.size() <= 107,
-          "shm.socket must be an absolute path of a socket file, at most 107 bytes (a Unix "
-          "socket's limit), e.g. \"/run/hapticsim/hapticsimd.sock\"");
+  for (const auto& [key, path] : {std::pair{"shm.socket", &c.shm_socket},
+                                  {"control.socket", &c.control_socket}}) {
+    require(path->size() > 1 && (*path)[0] == '/' && path->back() != '/' && path->size() <= 107,
+            std::string(key) +
+                " must be an absolute path of a socket file, at most 107 bytes (a Unix "
+                "socket's limit), e.g. \"/run/hapticsim/hapticsimd.sock\"");
+  }
+  require(!(c.shm_enabled && c.control_enabled && c.shm_socket == c.control_socket),
+          "shm.socket and control.socket must be different files");
   const std::string url_problem = LcmUrlProblem(c.lcm_url, c.lcm_allow_network);
   require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
@@ -367,7 +376,14 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "device_channel = " << quote(c.device_channel) << "\n"
       << "force_channel = " << quote(c.force_channel) << "\n"
       << "status_channel = " << quote(c.status_channel) << "\n"
-      << "command_channel = " << quote(c.command_channel) << "\n\n"
+      << "command_channel = " << quote(c.command_channel) << "\n"
+      << "accept_commands = " << (c.lcm_accept_commands ? "true" : "false")
+      << "  # commands come from hapticsim ctl ([control]); true: from anyone on the bus too\n\n"
+      << "[control]  # hapticsim ctl: reset, pin, release, set-error-target\n"
+      << "enabled = " << (c.control_enabled ? "true" : "false") << "\n"
+      << "socket = " << quote(c.control_socket) << "\n"
+      << "group = " << quote(c.control_group)
+      << "  # who may send commands besides root and the daemon's user\n\n"
       << "[shm]\nenabled = " << (c.shm_enabled ? "true" : "false") << "\n"
       << "socket = " << quote(c.shm_socket)
       << "  # drivers connect here; its directory only the daemon may write\n"

@@ -27,6 +27,13 @@ struct DaemonConfig {
   std::string force_channel = "HAPTIC_FORCE";
   std::string status_channel = "HAPTIC_STATUS";
   std::string command_channel = "HAPTIC_COMMAND";
+  /// Commands on command_channel are refused unless this is set: anyone who can send on the bus
+  /// could otherwise reset the simulation or pin a configuration. `hapticsim ctl` uses [control].
+  bool lcm_accept_commands = false;
+  // [control]: hapticsim ctl's Unix socket, where state-changing commands come from
+  bool control_enabled = true;
+  std::string control_socket = "/run/hapticsim/control.sock";
+  std::string control_group;  ///< who may send commands besides root and the daemon's user
   // [shm]
   bool shm_enabled = false;             ///< the shared-memory interface for a local driver
   /// The service socket a driver connects to for its segment (ipc/service_socket.hpp)

@@ -16,6 +16,8 @@ struct InputCounters {
   std::atomic<std::int64_t> inputs_wrong_transport{0};
   /// Driver sessions started on the service socket, and connections refused there.
   std::atomic<std::int64_t> shm_sessions{0}, shm_refused{0};
+  /// Commands refused, over LCM and hapticsim ctl (status_t::commands_refused says which ones).
+  std::atomic<std::int64_t> commands_refused{0};
   std::array<std::atomic<std::int64_t>, kNumInputRejections> rejected_by_kind{};
   std::atomic<int> last_rejection{0};  ///< newest rejection not yet logged (InputRejection)
 

@@ -35,6 +35,8 @@
 #include "daemon/background_worker.hpp"
 #include "daemon/black_box.hpp"
 #include "daemon/command_check.hpp"
+#include "daemon/control_line.hpp"
+#include "daemon/control_server.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
@@ -217,6 +219,22 @@ int Serve(const Arguments& args) {
                  config.shm_group.empty() ? "" : ", group " + config.shm_group);
   }
   if (!bridge && !shm) spdlog::warn("neither [lcm] nor [shm] is enabled: no device can connect");
+  std::unique_ptr<ControlServer> control;
+  if (config.control_enabled) {
+    try {
+      control = std::make_unique<ControlServer>(config.control_socket, config.control_group);
+      spdlog::info("commands from hapticsim ctl on {} (mode 0660{})", config.control_socket,
+                   config.control_group.empty() ? "" : ", group " + config.control_group);
+    } catch (const Error& e) {
+      spdlog::warn("no hapticsim ctl: {}; serving on without commands", e.what());
+    }
+  }
+  if (config.lcm_enabled && config.lcm_accept_commands) {
+    spdlog::warn(
+        "commands on {} are ACCEPTED from anyone who can send on the LCM bus "
+        "(lcm.accept_commands = true)",
+        config.command_channel);
+  }
   if (bridge || shm) {
     spdlog::info(
         "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage "
@@ -283,8 +301,9 @@ int Serve(const Arguments& args) {
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
   std::int64_t wrong_transport_seen = 0;
-  CommandRateLimit command_limit;
-  std::int64_t last_command_refusal_ns = 0;
+  CommandRateLimit command_limit, ctl_limit;  // one each: an LCM flood cannot crowd out ctl
+  std::int64_t last_command_refusal_ns = 0, lcm_commands_refused = 0;
+  std::int64_t control_refused_seen = 0, control_refused_logged = 0;
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
   constexpr int kOverrunBurst = 10;
@@ -385,6 +404,43 @@ int Serve(const Arguments& args) {
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
+  // A checked command, from LCM or hapticsim ctl: acted on, and what happened in words (the
+  // answer ctl prints; the log says it too).
+  auto apply_command = [&](const command_t& command, const std::string& from) -> std::string {
+    const CheckedCommand checked = CheckCommand(command, PrimaryRateHz(config.scene));
+    switch (checked.kind) {
+      case CheckedCommand::Kind::kSetErrorTarget:
+        target = checked.error_target_percent;
+        decision.target_met = decision.have_map && decision.error_percent <= target;
+        report_error();
+        spdlog::info(
+            "error target set to {} % by {}: the active configuration's {} % {}; choosing again",
+            target, from, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
+        choose_again(pinned);
+        return "ok: error target " + FormatReal(target) + " %; choosing again";
+      case CheckedCommand::Kind::kPinConfiguration:
+        spdlog::info(
+            "command PIN_CONFIGURATION from {}: verifying primary_size {}, secondary_lod {}, "
+            "secondary_rate {} Hz",
+            from, checked.pin.primary_size, checked.pin.secondary_lod,
+            checked.pin.secondary_rate_hz);
+        choose_again(checked.pin);
+        return "ok: verifying the pin (status says pinned once it runs; the log says why not)";
+      case CheckedCommand::Kind::kReleaseConfiguration:
+        spdlog::info("command RELEASE_CONFIGURATION from {}: choosing freely again", from);
+        pinned.reset();
+        choose_again(std::nullopt);
+        return "ok: released; choosing freely again";
+      case CheckedCommand::Kind::kReset:
+        spdlog::info("command RESET from {}: the simulation restarts from rest", from);
+        restart_from_rest("RESET");
+        return "ok: the simulation restarts from rest";
+      case CheckedCommand::Kind::kRefused:
+        spdlog::warn("command from {} {}", from, checked.refusal);
+        return "refused: " + checked.refusal;
+    }
+    return "refused: unknown";
+  };
   const timespec tick{0, 20'000'000};
   for (;;) {
     siginfo_t info{};
@@ -493,7 +549,20 @@ int Serve(const Arguments& args) {
     }
     if (bridge) {
       while (std::optional<command_t> command = bridge->PopCommand()) {
+        if (!config.lcm_accept_commands) {
+          ++lcm_commands_refused;
+          counters.commands_refused.fetch_add(1);
+          if (line_due(last_command_refusal_ns)) {
+            last_command_refusal_ns = now;
+            spdlog::warn(
+                "command on {} refused: lcm.accept_commands is false (use hapticsim ctl); {} "
+                "refused so far",
+                config.command_channel, lcm_commands_refused);
+          }
+          continue;
+        }
         if (!command_limit.Admit(now)) {
+          counters.commands_refused.fetch_add(1);
           if (line_due(last_command_refusal_ns)) {
             last_command_refusal_ns = now;
             spdlog::warn("command refused: more than {} a second ({} refused so far)",
@@ -501,38 +570,35 @@ int Serve(const Arguments& args) {
           }
           continue;
         }
-        const CheckedCommand checked = CheckCommand(*command, PrimaryRateHz(config.scene));
-        switch (checked.kind) {
-          case CheckedCommand::Kind::kSetErrorTarget:
-            target = checked.error_target_percent;
-            decision.target_met = decision.have_map && decision.error_percent <= target;
-            report_error();
-            spdlog::info(
-                "error target set to {} %: the active configuration's {} % {}; choosing "
-                "again",
-                target, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
-            choose_again(pinned);
-            break;
-          case CheckedCommand::Kind::kPinConfiguration:
-            spdlog::info(
-                "command PIN_CONFIGURATION: verifying primary_size {}, secondary_lod {}, "
-                "secondary_rate {} Hz",
-                checked.pin.primary_size, checked.pin.secondary_lod, checked.pin.secondary_rate_hz);
-            choose_again(checked.pin);
-            break;
-          case CheckedCommand::Kind::kReleaseConfiguration:
-            spdlog::info("command RELEASE_CONFIGURATION: choosing freely again");
-            pinned.reset();
-            choose_again(std::nullopt);
-            break;
-          case CheckedCommand::Kind::kReset:
-            spdlog::info("command RESET: the simulation restarts from rest");
-            restart_from_rest("RESET");
-            break;
-          case CheckedCommand::Kind::kRefused:
-            spdlog::warn("command {}", checked.refusal);
-            break;
+        apply_command(*command, "LCM");
+      }
+    }
+    if (control) {
+      while (std::optional<ControlRequest> request = control->Next(now)) {
+        std::string error;
+        const std::string who = "hapticsim ctl (pid " + std::to_string(request->peer.pid) +
+                                ", uid " + std::to_string(request->peer.uid) + ")";
+        std::string answer;
+        if (!ctl_limit.Admit(now)) {
+          answer = "refused: more than 10 commands a second";
+        } else if (const std::optional<command_t> command =
+                       ParseControlLine(request->line, &error)) {
+          answer = apply_command(*command, who);
+        } else {
+          answer = "refused: " + error;
         }
+        if (answer.rfind("refused:", 0) == 0) counters.commands_refused.fetch_add(1);
+        ControlServer::Answer(*request, answer);
+      }
+      if (control->refused() != control_refused_seen) {
+        counters.commands_refused.fetch_add(control->refused() - control_refused_seen);
+        control_refused_seen = control->refused();
+      }
+      if (control->refused() != control_refused_logged && line_due(last_command_refusal_ns)) {
+        last_command_refusal_ns = now;
+        control_refused_logged = control->refused();
+        spdlog::warn("control socket: refused {} ({} refused so far)", control->last_refusal(),
+                     control_refused_logged);
       }
     }
     if (std::optional<BackgroundWorker<SupervisorDecision>::Outcome> outcome = chooser.Take()) {

@@ -24,6 +24,7 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
     s.inputs_wrong_transport = counters->inputs_wrong_transport.load();
     s.shm_sessions = counters->shm_sessions.load();
     s.shm_refused = counters->shm_refused.load();
+    s.commands_refused = counters->commands_refused.load();
   }
   s.max_force_n = loop.port_settings().max_force_n;
   s.force_limited_periods = loop.limited_periods();

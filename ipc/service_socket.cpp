@@ -87,7 +87,7 @@ std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowe
   return "pid " + std::to_string(peer.pid) + " (uid " + std::to_string(peer.uid) +
          ") is not in group " +
          (entry ? std::string(entry->gr_name) : std::to_string(allowed_gid)) +
-         " (shm.group): add the driver's user to it";
+         ": add that user to the group";
 }
 
 std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server) {
@@ -125,26 +125,28 @@ std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& s
   }
 }
 
-ServiceListener::ServiceListener(const std::string& path, const std::string& group)
+ServiceListener::ServiceListener(const std::string& path, const std::string& group,
+                                 const std::string& section)
     : path_(path), allowed_gid_(getegid()) {
-  const sockaddr_un address = AddressOf(path, "shm.socket");
+  const std::string key = section + ".socket";
+  const sockaddr_un address = AddressOf(path, key);
   if (!group.empty()) {
     const struct group* entry = getgrnam(group.c_str());
-    HAPTICSIM_THROW_UNLESS(entry, "shm.group = \"" + group + "\": no such group");
+    HAPTICSIM_THROW_UNLESS(entry, section + ".group = \"" + group + "\": no such group");
     allowed_gid_ = entry->gr_gid;
   }
   const std::string directory = DirectoryOf(path);
   struct stat info {};
   HAPTICSIM_THROW_UNLESS(stat(directory.c_str(), &info) == 0 && S_ISDIR(info.st_mode),
-                         "shm.socket = \"" + path + "\": " + directory +
+                         key + " = \"" + path + "\": " + directory +
                              " is not a directory: create it, only writable by the daemon's "
                              "user (systemd: RuntimeDirectory=hapticsim), or choose another path");
   if (lstat(path.c_str(), &info) == 0) {
-    HAPTICSIM_THROW_UNLESS(S_ISSOCK(info.st_mode), "shm.socket = \"" + path +
+    HAPTICSIM_THROW_UNLESS(S_ISSOCK(info.st_mode), key + " = \"" + path +
                                                        "\": a file that is not a socket is in "
                                                        "the way; remove it or choose another path");
     HAPTICSIM_THROW_UNLESS(!SomeoneListens(address),
-                           "shm.socket = \"" + path +
+                           key + " = \"" + path +
                                "\": another hapticsimd already serves it; stop that one or "
                                "choose another path");
     unlink(path.c_str());  // left by a daemon that died
@@ -153,12 +155,12 @@ ServiceListener::ServiceListener(const std::string& path, const std::string& gro
   HAPTICSIM_THROW_UNLESS(socket_, "cannot make the service socket: " + Why());
   HAPTICSIM_THROW_UNLESS(
       bind(socket_.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0,
-      "shm.socket = \"" + path + "\": cannot bind: " + Why());
+      key + " = \"" + path + "\": cannot bind: " + Why());
   // Owner and group only, before anyone can connect (listen comes last).
   auto fail = [&](const std::string& what) {
     const std::string why = Why();
     unlink(path.c_str());
-    throw Error("shm.socket = \"" + path + "\": cannot " + what + ": " + why);
+    throw Error(key + " = \"" + path + "\": cannot " + what + ": " + why);
   };
   if (lstat(path.c_str(), &info) != 0) fail("examine it");
   inode_ = info.st_ino;
@@ -247,22 +249,31 @@ MappedSegment ReadSessionAnswer(int connection, const std::string& path, int tim
   return MappedSegment::Adopt(passed[0].release(), path);
 }
 
-ServiceSession ConnectToService(const std::string& path, int timeout_ms) {
-  const sockaddr_un address = AddressOf(path, "the service socket");
+UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint,
+                         PeerIdentity* daemon) {
+  const sockaddr_un address = AddressOf(path, "the daemon's socket");
   UniqueFd connection(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
   HAPTICSIM_THROW_UNLESS(connection, "cannot make a socket: " + Why());
   HAPTICSIM_THROW_UNLESS(
       connect(connection.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0,
-      "cannot connect to hapticsimd at " + path + ": " + Why() +
-          " (is it running with [shm] enabled = true and socket = \"" + path +
-          "\", and is this user in its shm.group?)");
-  PeerIdentity daemon = PeerOf(connection.get());
-  const std::string problem = ServerIdentityProblem(path, daemon);
+      "cannot connect to hapticsimd at " + path + ": " + Why() + " (" + hint + ")");
+  *daemon = PeerOf(connection.get());
+  const std::string problem = ServerIdentityProblem(path, *daemon);
   HAPTICSIM_THROW_UNLESS(problem.empty(), "refusing the daemon at " + path + ": " + problem);
+  return connection;
+}
 
+ServiceSession ConnectToService(const std::string& path, int timeout_ms) {
+  PeerIdentity daemon;
+  UniqueFd connection = ConnectToDaemon(
+      path,
+      "is it running with [shm] enabled = true and socket = \"" + path +
+          "\", and is this user in its shm.group?",
+      &daemon);
   MappedSegment segment = ReadSessionAnswer(connection.get(), path, timeout_ms);
   return ServiceSession{std::move(connection), std::move(daemon), std::move(segment)};
 }
+
 std::string SessionGreeting() { return kSessionGreeting; }
 std::string Refusal(const std::string& why) { return kRefusedPrefix + why; }
 

@@ -63,9 +63,11 @@ class ServiceListener {
   /**
    * Binds `path` (mode 0660, group `group`, or the daemon's own group when empty). A socket left
    * there by a daemon that died is replaced; a live daemon's, or any other file, is not.
+   * `section` is the config section that named them ("shm", "control"), for messages.
    * @throws Error naming the key and what to fix.
    */
-  ServiceListener(const std::string& path, const std::string& group);
+  ServiceListener(const std::string& path, const std::string& group,
+                  const std::string& section = "shm");
   ~ServiceListener();
   ServiceListener(const ServiceListener&) = delete;
   ServiceListener& operator=(const ServiceListener&) = delete;
@@ -98,6 +100,13 @@ struct ServiceSession {
   PeerIdentity daemon;
   MappedSegment segment;
 };
+
+/**
+ * A client's side: connects to the daemon's socket at `path` and checks that the daemon is the
+ * service (ServerIdentityProblem), filling `daemon`. `hint` says what to check when nothing
+ * answers there. @throws Error naming the problem.
+ */
+UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint, PeerIdentity* daemon);
 
 /**
  * The driver's side of the answer: waits at most `timeout_ms` for the daemon's message on

@@ -36,6 +36,7 @@
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "ipc/control_client.hpp"
 #include "ipc/shm_device_client.hpp"
 #include "tests/support/daemon_harness.hpp"
 #include "tests/support/late_wakes.hpp"
@@ -78,12 +79,23 @@ class HapticsimdEndToEnd : public ::testing::Test {
  protected:
   void SetUp() override {
     const std::string config = Temp("hapticsimd.toml");
+    control_ = testing::PrivateSocketPath();
     std::ofstream(config) << "# the defaults, and a map\n[supervisor]\nerror_map = \"" << SmallMap()
                           << "\"\nerror_target_percent = 7.0\n[lcm]\n"
-                             "url = \"udpm://239.255.76.67:7667?ttl=0\"\n";
+                             "url = \"udpm://239.255.76.67:7667?ttl=0\"\n"
+                          << "[control]\nsocket = \"" << control_ << "\"\n";
     daemon_ = std::make_unique<testing::BackgroundProcess>(
         std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("daemon.log"));
   }
+  void TearDown() override {
+    daemon_.reset();  // stopped (SIGKILL if still running) before its socket's directory goes
+    std::filesystem::remove_all(std::filesystem::path(control_).parent_path());
+  }
+  // A request over the control socket, as `hapticsim ctl` sends it; the daemon's answer.
+  std::string Ctl(const std::string& line) {
+    return shm::SendControlRequest(control_, line, 5000);
+  }
+  std::string control_;
   std::unique_ptr<testing::BackgroundProcess> daemon_;
 };
 
@@ -176,10 +188,7 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   ASSERT_TRUE(client.WaitForStatus(
       [](const status_t& s) { return s.target_met && s.primary_size == 1; }, 30))
       << daemon_->Log();
-  command_t command{};
-  command.command = command_t::SET_ERROR_TARGET;
-  command.error_target_percent = 0.001;  // unreachable
-  client.Command(command);
+  EXPECT_EQ(Ctl("set-error-target 0.001"), "ok: error target 0.001 %; choosing again");
   // Unreachable: the supervisor keeps the most accurate stable configuration (size 3), switched
   // while nothing touches the object, and flags the target as exceeded.
   ASSERT_TRUE(client.WaitForStatus(
@@ -197,14 +206,13 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   const auto forces = client.Forces();
   ASSERT_FALSE(forces.empty());
   EXPECT_TRUE(forces.back().flags & force_feedback_t::FLAG_ERROR_TARGET_EXCEEDED);
-  command.error_target_percent = -3;  // invalid: refused, target unchanged
-  client.Command(command);
+  // Invalid: refused with the reason, the target unchanged.
+  EXPECT_EQ(Ctl("set-error-target -3"),
+            "refused: SET_ERROR_TARGET -3 refused: the target must be in (0, 100] %");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->error_target_percent, 0.001);
-  EXPECT_NE(daemon_->Log().find("SET_ERROR_TARGET -3 refused"), std::string::npos);
   // While the tool is in contact the configuration is not changed under the user's hand.
-  command.error_target_percent = 5;  // size 1 meets it again, and is cheaper
-  client.Command(command);
+  EXPECT_EQ(Ctl("set-error-target 5").rfind("ok:", 0), 0u);  // size 1 meets it, and is cheaper
   for (std::int64_t seq = 101; seq <= 1600; ++seq) {
     client.Send(seq, kEdge / 2, kEdge / 2, 0.001);  // in contact for 1.5 s
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -280,23 +288,18 @@ TEST_F(HapticsimdEndToEnd, APinnedConfigurationHoldsUntilReleasedAndAnUnstableOn
   Client client;
   ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.primary_size == 1; }, 30))
       << daemon_->Log();
-  command_t pin{};
-  pin.command = command_t::PIN_CONFIGURATION;
-  pin.primary_size = 3, pin.secondary_lod = 2, pin.secondary_rate_hz = 1000;
-  client.Command(pin);
+  EXPECT_EQ(Ctl("pin 3 2 1000").rfind("ok: verifying", 0), 0u);
   ASSERT_TRUE(
       client.WaitForStatus([](const status_t& s) { return s.pinned && s.primary_size == 3; }, 15))
       << daemon_->Log();
-  pin.secondary_rate_hz = 5000;  // faster than the primary: refused before anything is built
-  client.Command(pin);
-  pin.secondary_rate_hz = 1000, pin.primary_size = 0;
-  client.Command(pin);
+  // Faster than the primary, or no primary region: refused before anything is built.
+  EXPECT_EQ(Ctl("pin 3 2 5000").rfind("refused: PIN_CONFIGURATION refused", 0), 0u);
+  EXPECT_EQ(Ctl("pin 0 2 1000").rfind("refused: PIN_CONFIGURATION refused", 0), 0u);
+  EXPECT_EQ(Ctl("pin 3 2"), "refused: pin takes three numbers: primary_size, secondary_lod, "
+                            "secondary rate in Hz");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->primary_size, 3);
-  EXPECT_NE(daemon_->Log().find("PIN_CONFIGURATION refused"), std::string::npos) << daemon_->Log();
-  command_t release{};
-  release.command = command_t::RELEASE_CONFIGURATION;
-  client.Command(release);
+  EXPECT_EQ(Ctl("release"), "ok: released; choosing freely again");
   ASSERT_TRUE(
       client.WaitForStatus([](const status_t& s) { return !s.pinned && s.primary_size == 1; }, 15))
       << daemon_->Log();
@@ -550,7 +553,10 @@ int ThreadsOf(int pid) {
 // 30 s to stop. Now: no new thread, the flood refused beyond 10 commands a second and counted,
 // device input still answered, and SIGTERM obeyed within 2 s.
 TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeconds) {
-  testing::BackgroundProcess daemon({HAPTICSIMD_PATH}, Temp("command-flood.log"));
+  const std::string config = Temp("command-flood.toml");  // commands on LCM, switched on
+  std::ofstream(config) << "[lcm]\naccept_commands = true\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config},
+                                    Temp("command-flood.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const int threads_before = ThreadsOf(daemon.pid());

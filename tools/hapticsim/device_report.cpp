@@ -110,6 +110,7 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
         {"inputs_wrong_transport", r.status->inputs_wrong_transport},
         {"shm_sessions", r.status->shm_sessions},
         {"shm_refused", r.status->shm_refused},
+        {"commands_refused", r.status->commands_refused},
         {"max_force_n", r.status->max_force_n},
         {"force_limited_periods", r.status->force_limited_periods},
         {"port_dissipating_periods", r.status->port_dissipating_periods},

@@ -10,6 +10,7 @@
 //   hapticsim analyze MAP [--report report.html]                 Table I and the HTML report
 //   hapticsim device [--transport lcm|shm] [--input press|sine|walk|replay]   simulated device
 //   hapticsim soak [--duration 60] [--json]                      daemon + device, checked
+//   hapticsim ctl reset | release | pin 3 2 600 | set-error-target 5    a command to the daemon
 //   hapticsim log SESSION.lcmlog [--csv out.csv]                 a recorded session
 //
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
@@ -37,7 +38,7 @@ int main(int argc, char** argv) {
                                       AddLookupCommand(app),    AddAnalyzeCommand(app),
                                       AddDeviceCommand(app),    AddSoakCommand(app, argc, argv),
                                       AddLogCommand(app),       AddStressCommand(app),
-                                      AddBenchCommand(app)};
+                                      AddBenchCommand(app),     AddCtlCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

@@ -1,0 +1,36 @@
+#include "ipc/control_client.hpp"
+
+#include <poll.h>
+#include <sys/socket.h>
+
+#include "core/error.hpp"
+#include "ipc/service_socket.hpp"
+
+namespace hapticsim::shm {
+
+std::string SendControlRequest(const std::string& path, const std::string& line, int timeout_ms) {
+  PeerIdentity daemon;
+  UniqueFd connection =
+      ConnectToDaemon(path,
+                      "is hapticsimd running with [control] socket = \"" + path +
+                          "\", and is this user root, the daemon's or in its control.group?",
+                      &daemon);
+  // A refusal may come before the request is sent (the daemon refuses by credentials at once,
+  // and hangs up): then sending fails, and the refusal is the answer.
+  const bool sent = SendMessage(connection.get(), line);
+  pollfd ready{connection.get(), POLLIN, 0};
+  HAPTICSIM_THROW_UNLESS(
+      poll(&ready, 1, timeout_ms) == 1,
+      "hapticsimd at " + path + " did not answer within " + std::to_string(timeout_ms) + " ms");
+  char text[512];
+  const ssize_t n = recv(connection.get(), text, sizeof text, 0);
+  HAPTICSIM_THROW_UNLESS(
+      n > 0, "hapticsimd at " + path + (sent ? " hung up without an answer" : " took no request"));
+  std::string answer(text, static_cast<std::size_t>(n));
+  for (char& c : answer) {  // the daemon's text, shown on a terminal: printable only
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  }
+  return answer;
+}
+
+}  // namespace hapticsim::shm

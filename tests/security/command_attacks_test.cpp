@@ -1,0 +1,109 @@
+// Hostile neighbours on the command channels (issue "Hostile neighbours", point 4): any local
+// process could RESET the simulation, pin a configuration or change the error target over LCM.
+// Now state-changing commands come from the control socket (hapticsim ctl), from root, the
+// daemon's user and control.group only; LCM commands are refused unless lcm.accept_commands.
+#include <grp.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <thread>
+
+#include "core/error.hpp"
+#include "hapticsim/command_t.hpp"
+#include "ipc/control_client.hpp"
+#include "tests/security/hostile_neighbour.hpp"
+
+namespace hapticsim {
+namespace {
+
+using security::Clock;
+using security::ExitStatusOf;
+using security::HostileNeighbour;
+using security::kWindow;
+using security::MissBound;
+using security::Spawn;
+
+// Any local process on the bus: RESET and pins at 100 Hz for the attacked window.
+TEST_F(HostileNeighbour, CommandsOnLcmAreRefusedByDefaultAndCounted) {
+  const std::int64_t quiet = MissesOver(Quiet);
+  const status_t before = *monitor_.LastStatus();
+  pid_t attacker = -1;
+  const std::int64_t attacked = MissesOver([&] {
+    attacker = Spawn([] {
+      lcm::LCM bus("udpm://239.255.76.67:7667?ttl=0");
+      if (!bus.good()) return 10;
+      command_t reset{}, pin{};
+      reset.command = command_t::RESET;
+      pin.command = command_t::PIN_CONFIGURATION;
+      pin.primary_size = 3, pin.secondary_lod = 2, pin.secondary_rate_hz = 1000;
+      const auto end = Clock::now() + kWindow;
+      for (int k = 0; Clock::now() < end; ++k) {
+        bus.publish("HAPTIC_COMMAND", k % 2 ? &reset : &pin);
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      return 0;
+    });
+    std::this_thread::sleep_for(kWindow + std::chrono::milliseconds(100));
+  });
+  ASSERT_EQ(ExitStatusOf(attacker), 0);
+  ASSERT_TRUE(daemon_->running()) << daemon_->Log();
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
+  ASSERT_TRUE(
+      monitor_.WaitForStatus([](const status_t& s) { return s.commands_refused >= 100; }, 2))
+      << daemon_->Log();
+  const status_t after = *monitor_.LastStatus();
+  EXPECT_EQ(after.reconfigurations, before.reconfigurations) << "a RESET or a pin went through";
+  EXPECT_FALSE(after.pinned);
+  EXPECT_NE(daemon_->Log().find("refused: lcm.accept_commands is false (use hapticsim ctl)"),
+            std::string::npos)
+      << daemon_->Log();
+  // The authorised channel still works: this test runs as the daemon's user.
+  EXPECT_EQ(shm::SendControlRequest(control_, "reset", 5000),
+            "ok: the simulation restarts from rest");
+  EXPECT_TRUE(monitor_.WaitForStatus(
+      [&](const status_t& s) { return s.reconfigurations > before.reconfigurations; }, 2));
+}
+
+// Even with the control socket opened to everyone by mistake, another user is refused: the
+// daemon asks the kernel who connected.
+TEST_F(HostileNeighbour, AUserOutsideTheControlGroupCannotCommandTheDaemon) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root, to be another user";
+  ASSERT_EQ(chmod(control_.c_str(), 0666), 0);
+  ASSERT_EQ(chmod(std::filesystem::path(control_).parent_path().c_str(), 0755), 0);
+  const std::int64_t quiet = MissesOver(Quiet);
+  const status_t before = *monitor_.LastStatus();
+  std::int64_t attacked = 0;
+  const int outsider_status = AttackAsAnotherUser(
+      [&] {
+        int refused = 0;
+        for (const char* request : {"reset", "pin 3 2 1000", "set-error-target 50", "release"}) {
+          try {
+            const std::string answer = shm::SendControlRequest(control_, request, 2000);
+            if (answer.find("(uid 65534) is not in group") != std::string::npos) ++refused;
+          } catch (const Error&) {
+          }
+        }
+        return refused == 4 ? 0 : 1;
+      },
+      &attacked);
+  if (outsider_status == kNoOtherUser)
+    GTEST_SKIP() << "uid 65534 is not available here (user namespace)";
+  EXPECT_EQ(outsider_status, 0) << "a request was not refused by name";
+  ASSERT_TRUE(daemon_->running()) << daemon_->Log();
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
+  ASSERT_TRUE(monitor_.WaitForStatus([](const status_t& s) { return s.commands_refused == 4; }, 2))
+      << daemon_->Log();
+  const status_t after = *monitor_.LastStatus();
+  EXPECT_EQ(after.reconfigurations, before.reconfigurations);
+  EXPECT_EQ(after.error_target_percent, before.error_target_percent);
+  EXPECT_NE(daemon_->Log().find("control socket: refused pid"), std::string::npos)
+      << daemon_->Log();
+}
+
+}  // namespace
+}  // namespace hapticsim
