@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -91,6 +92,14 @@ class BackgroundWorker {
     return state_->taken < state_->submitted;
   }
 
+  /**
+   * When the job running now started (CLOCK_MONOTONIC ns), or 0 when none runs: the health
+   * check's sign of a job that never ends.
+   */
+  std::int64_t running_since_ns() const {
+    return state_->running_since_ns.load(std::memory_order_relaxed);
+  }
+
   /** The newest job's outcome, once (nothing while it waits or runs). */
   std::optional<Outcome> Take() {
     std::lock_guard lock(state_->mutex);
@@ -108,7 +117,14 @@ class BackgroundWorker {
     std::uint64_t taken = 0;         // the `submitted` count at the last outcome taken
     std::optional<Outcome> outcome;  // the newest job's, when it is done
     bool stop = false, exited = false;
+    std::atomic<std::int64_t> running_since_ns{0};
   };
+
+  static std::int64_t NowNs() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
 
   static void Run(State& state) {
     std::unique_lock lock(state.mutex);
@@ -118,6 +134,7 @@ class BackgroundWorker {
       std::function<Result()> job = std::exchange(state.job, nullptr);
       const std::uint64_t generation = state.submitted;
       lock.unlock();
+      state.running_since_ns.store(NowNs(), std::memory_order_relaxed);
       Outcome outcome;
       try {
         outcome.result = job();
@@ -127,6 +144,7 @@ class BackgroundWorker {
         outcome.error = "an exception of unknown type";
       }
       job = nullptr;  // its captures (a scene, maybe a map's last reference) freed unlocked
+      state.running_since_ns.store(0, std::memory_order_relaxed);
       lock.lock();
       if (generation == state.submitted) state.outcome = std::move(outcome);
     }

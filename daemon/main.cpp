@@ -48,6 +48,7 @@
 #include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"
 #include "daemon/systemd_notify.hpp"
+#include "daemon/thread_health.hpp"
 
 namespace hapticsim {
 namespace {
@@ -246,15 +247,18 @@ int Serve(const Arguments& args) {
   const std::string refused = loop.Start();
   if (!refused.empty()) spdlog::warn("real-time settings: {}running on", refused);
   std::atomic<bool> stop_io{false};
+  std::atomic<std::int64_t> io_alive_ns{HapticLoop::NowNs()};  // the health check's sign of it
   // The I/O thread: everything that may block, at most 0.25 ms behind the primary thread. While
   // the loop is idle (regions asleep, no device) nothing needs it that often: LCM input wakes the
   // poll anyway, so it waits up to 20 ms; shared-memory input cannot wake it and is polled every
   // millisecond.
   std::thread io([&] {
+    pthread_setname_np(pthread_self(), "hsim-io");
     const timespec quarter_ms{0, 250'000}, one_ms{0, 1'000'000}, idle_wait{0, 20'000'000};
     ForceRecord record;
     std::int64_t inputs_seen = -1, last_input_ns = 0;
     while (!stop_io.load()) {
+      io_alive_ns.store(HapticLoop::NowNs(), std::memory_order_relaxed);
       // An input handed over lately: its answer comes within a period or two (the primary may
       // still say idle until its next period runs), so poll fast for a while whatever it says.
       const std::int64_t inputs = counters.inputs_received.load();
@@ -300,6 +304,9 @@ int Serve(const Arguments& args) {
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
+  std::int64_t regions_since_ns = start_ns, health_reconfigurations = 0, last_health_line_ns = 0;
+  bool health_asleep = false;
+  std::string reported_stalls;  // the stalled threads' names as last logged and told to systemd
   std::int64_t wrong_transport_seen = 0;
   CommandRateLimit command_limit, ctl_limit;  // one each: an LCM flood cannot crowd out ctl
   std::int64_t last_command_refusal_ns = 0, lcm_commands_refused = 0;
@@ -746,16 +753,46 @@ int Serve(const Arguments& args) {
         status_t status =
             MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters);
         status.input_owner = DeviceInputOf(config);
+        status.stalled_threads = DescribeStalls(
+            StalledThreads(HealthBeats(loop, primary_period_s, io_alive_ns.load(),
+                                       regions_since_ns, chooser.running_since_ns(),
+                                       mover.running_since_ns()),
+                           now));
         bridge->PostStatus(status);
       }
     }
-    if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns) {
-      // Only while the primary loop is alive: a hung loop stops the pings and systemd restarts us.
-      const double since_primary = (now - loop.primary_alive_ns()) * 1e-9;
-      if (since_primary < std::max(0.1, 50 * primary_period_s)) {
-        systemd.Notify("WATCHDOG=1");
-        next_watchdog_ns = now + static_cast<std::int64_t>(systemd.watchdog_interval_s() * 0.5e9);
+    // Every thread the force depends on, by its newest sign of life. A stalled primary or I/O
+    // thread (no force computed, or none reaching the device) stops the watchdog pings, so
+    // systemd restarts the daemon; a stalled secondary is rendered around (the primary holds its
+    // boundary, every answer flagged boundary stale); a job that never ends is reported.
+    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
+      regions_since_ns = now;  // new region threads, or ones just woken: give them a moment
+      health_reconfigurations = loop.reconfigurations();
+    }
+    health_asleep = loop.asleep();
+    const std::vector<Stall> stalls = StalledThreads(
+        HealthBeats(loop, primary_period_s, io_alive_ns.load(std::memory_order_relaxed),
+                    regions_since_ns, chooser.running_since_ns(), mover.running_since_ns()),
+        now);
+    // Said when the set of stalled threads changes, and every 10 s while it lasts.
+    std::string stalled_names;
+    for (const Stall& stall : stalls) stalled_names += stall.name + ";";
+    if (stalled_names != reported_stalls ||
+        (!stalled_names.empty() && now - last_health_line_ns > 10'000'000'000)) {
+      const std::string stalled = DescribeStalls(stalls);
+      if (stalled.empty()) {
+        spdlog::info("health: every thread runs again");
+      } else {
+        spdlog::error("health: stalled: {}{}", stalled,
+                      AnyOnForcePath(stalls) ? "; the systemd watchdog is not pinged" : "");
       }
+      last_health_line_ns = now;
+      systemd.Notify(stalled.empty() ? "STATUS=serving" : "STATUS=stalled: " + stalled);
+      reported_stalls = stalled_names;
+    }
+    if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns && !AnyOnForcePath(stalls)) {
+      systemd.Notify("WATCHDOG=1");
+      next_watchdog_ns = now + static_cast<std::int64_t>(systemd.watchdog_interval_s() * 0.5e9);
     }
   }
   systemd.Notify("STOPPING=1");

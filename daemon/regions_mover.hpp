@@ -39,6 +39,8 @@ class RegionsMover {
 
   /** True from Ask until Poll has returned its verdict. */
   bool busy() const { return asked_.has_value(); }
+  /** When its verification running now started (CLOCK_MONOTONIC ns), 0 when none runs. */
+  std::int64_t running_since_ns() const { return verifier_.running_since_ns(); }
   /** False for a configuration and node found unstable (or invalid) before: not asked again. */
   bool may_ask(const Request& request) const { return !refused_.count(KeyOf(request)); }
   /** Starts verifying; a verdict already known is returned by the next Poll. */

@@ -92,9 +92,7 @@ class HapticsimdEndToEnd : public ::testing::Test {
     std::filesystem::remove_all(std::filesystem::path(control_).parent_path());
   }
   // A request over the control socket, as `hapticsim ctl` sends it; the daemon's answer.
-  std::string Ctl(const std::string& line) {
-    return shm::SendControlRequest(control_, line, 5000);
-  }
+  std::string Ctl(const std::string& line) { return shm::SendControlRequest(control_, line, 5000); }
   std::string control_;
   std::unique_ptr<testing::BackgroundProcess> daemon_;
 };
@@ -295,8 +293,9 @@ TEST_F(HapticsimdEndToEnd, APinnedConfigurationHoldsUntilReleasedAndAnUnstableOn
   // Faster than the primary, or no primary region: refused before anything is built.
   EXPECT_EQ(Ctl("pin 3 2 5000").rfind("refused: PIN_CONFIGURATION refused", 0), 0u);
   EXPECT_EQ(Ctl("pin 0 2 1000").rfind("refused: PIN_CONFIGURATION refused", 0), 0u);
-  EXPECT_EQ(Ctl("pin 3 2"), "refused: pin takes three numbers: primary_size, secondary_lod, "
-                            "secondary rate in Hz");
+  EXPECT_EQ(Ctl("pin 3 2"),
+            "refused: pin takes three numbers: primary_size, secondary_lod, "
+            "secondary rate in Hz");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->primary_size, 3);
   EXPECT_EQ(Ctl("release"), "ok: released; choosing freely again");
@@ -765,34 +764,60 @@ pid_t ThreadOf(int pid, const std::string& name) {
   return -1;
 }
 
-TEST(HapticsimdSystemd, PingsTheWatchdogWhileServingNotWhileThePrimaryHangsAndSaysWhenStopping) {
-  const std::string socket_path = Temp("notify.sock");
-  std::filesystem::remove(socket_path);
-  const int fd = socket(AF_UNIX, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::strncpy(address.sun_path, socket_path.c_str(), sizeof address.sun_path - 1);
-  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-  const timeval receive_timeout{0, 100'000};
-  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
+// systemd's side of the notify protocol, without systemd: a datagram socket the daemon is
+// started against (NOTIFY_SOCKET; WATCHDOG_USEC 0.2 s, so it pings every 0.1 s), and what it said.
+class FakeSystemd {
+ public:
+  explicit FakeSystemd(const std::string& name) : path_(Temp(name + ".sock")) {
+    std::filesystem::remove(path_);
+    fd_ = socket(AF_UNIX, SOCK_DGRAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strncpy(address.sun_path, path_.c_str(), sizeof address.sun_path - 1);
+    EXPECT_EQ(bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    const timeval receive_timeout{0, 100'000};
+    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
+  }
+  ~FakeSystemd() { close(fd_); }
 
-  const std::string config = Temp("no-lcm.toml");
-  std::ofstream(config) << "[lcm]\nenabled = false\n";
-  setenv("NOTIFY_SOCKET", socket_path.c_str(), 1);
-  setenv("WATCHDOG_USEC", "200000", 1);  // 0.2 s: pings every 0.1 s
-  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("systemd.log"));
-  unsetenv("NOTIFY_SOCKET");
-  unsetenv("WATCHDOG_USEC");
-
-  std::vector<std::string> messages;
-  auto receive_for = [&](double seconds, bool until_first = false) {
+  std::unique_ptr<testing::BackgroundProcess> Start(const std::string& config,
+                                                    const std::string& log) {
+    setenv("NOTIFY_SOCKET", path_.c_str(), 1);
+    setenv("WATCHDOG_USEC", "200000", 1);
+    auto daemon = std::make_unique<testing::BackgroundProcess>(
+        std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, log);
+    unsetenv("NOTIFY_SOCKET");
+    unsetenv("WATCHDOG_USEC");
+    return daemon;
+  }
+  // Collects messages for `seconds` (or until the first, with `until_first`).
+  void ReceiveFor(double seconds, bool until_first = false) {
     const auto end = Clock::now() + std::chrono::duration<double>(seconds);
     char buffer[256];
     while (Clock::now() < end && !(until_first && !messages.empty())) {
-      const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+      const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
       if (n > 0) messages.emplace_back(buffer, static_cast<size_t>(n));
     }
+  }
+  long Count(const std::string& message) const {
+    return static_cast<long>(std::count(messages.begin(), messages.end(), message));
+  }
+  std::vector<std::string> messages;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+TEST(HapticsimdSystemd, PingsTheWatchdogWhileServingNotWhileThePrimaryHangsAndSaysWhenStopping) {
+  FakeSystemd systemd("notify");
+  const std::string config = Temp("no-lcm.toml");
+  std::ofstream(config) << "[lcm]\nenabled = false\n";
+  std::unique_ptr<testing::BackgroundProcess> started = systemd.Start(config, Temp("systemd.log"));
+  testing::BackgroundProcess& daemon = *started;
+  std::vector<std::string>& messages = systemd.messages;
+  auto receive_for = [&](double seconds, bool until_first = false) {
+    systemd.ReceiveFor(seconds, until_first);
   };
   receive_for(25, true);  // startup estimates the configuration's stability first
   ASSERT_FALSE(messages.empty()) << daemon.Log();
@@ -822,7 +847,6 @@ TEST(HapticsimdSystemd, PingsTheWatchdogWhileServingNotWhileThePrimaryHangsAndSa
   receive_for(1);
   EXPECT_EQ(daemon.Wait(5), 0);
   EXPECT_EQ(messages.back(), "STOPPING=1");
-  close(fd);
 }
 
 }  // namespace
@@ -961,8 +985,8 @@ TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
   for (int k = 0; k < 10; ++k) {
     const double q = quiet["press_peaks_n"][k], l = loaded["press_peaks_n"][k];
     EXPECT_GT(q, 1.3) << "press " << k;  // the default scene's 1 cm press: about 1.43–1.53 N
-    EXPECT_NEAR(l, q, 0.1 * q) << "press " << k << "\nquiet " << quiet.dump()
-                               << "\nloaded " << loaded.dump();
+    EXPECT_NEAR(l, q, 0.1 * q) << "press " << k << "\nquiet " << quiet.dump() << "\nloaded "
+                               << loaded.dump();
   }
   // The load was there: its two threads were given CPU time (about 17 s of the 20 s two cores had,
   // measured; a run's latencies are no proof, since a noisy machine moves the quiet run's too).
@@ -1021,11 +1045,64 @@ TEST(HapticsimdInputOwner, LcmInputIsRefusedWhileSharedMemoryOwnsTheInput) {
     EXPECT_LE(std::abs(f), std::abs(held) + 0.005);
     EXPECT_GE(std::abs(f), 0.85 * std::abs(held));
   }
-  ASSERT_TRUE(intruder.WaitForStatus(
-      [](const status_t& s) { return s.inputs_wrong_transport >= 500; }, 5))
+  ASSERT_TRUE(
+      intruder.WaitForStatus([](const status_t& s) { return s.inputs_wrong_transport >= 500; }, 5))
       << daemon.Log();
   EXPECT_NE(daemon.Log().find("device input on LCM refused: shared memory owns the input"),
             std::string::npos)
+      << daemon.Log();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+}
+
+// The health check covers every thread the force depends on. A stalled I/O thread (no force
+// reaches the device) stops the watchdog pings and is named; a stalled secondary is named while
+// the primary renders around it, and the pings go on (systemd would otherwise restart a daemon
+// whose force is still computed and sent).
+TEST(HapticsimdSystemd, AStalledIoThreadStopsThePingsAndAStalledSecondaryIsNamed) {
+  FakeSystemd systemd("notify-health");
+  const std::string config = Temp("health.toml");
+  // Awake at rest, so the secondary is expected to run.
+  std::ofstream(config) << "[lcm]\nenabled = false\n[realtime]\nsleep_at_rest = false\n";
+  std::unique_ptr<testing::BackgroundProcess> started = systemd.Start(config, Temp("health.log"));
+  testing::BackgroundProcess& daemon = *started;
+  std::vector<std::string>& messages = systemd.messages;
+  auto receive_for = [&](double seconds, bool until_first = false) {
+    systemd.ReceiveFor(seconds, until_first);
+  };
+  auto count = [&](const std::string& message) { return systemd.Count(message); };
+  // Stops `thread` alone; the messages of the `seconds` after the first 0.7 s (the health
+  // check calls a thread stalled after 0.5 s of silence; a ping already on its way may come).
+  auto stopped_for = [&](const std::string& thread, double seconds) {
+    const pid_t tid = ThreadOf(daemon.pid(), thread);
+    EXPECT_GT(tid, 0) << "no thread named " << thread;
+    if (tid <= 0) return;
+    EXPECT_EQ(ptrace(PTRACE_SEIZE, tid, nullptr, nullptr), 0) << std::strerror(errno);
+    EXPECT_EQ(ptrace(PTRACE_INTERRUPT, tid, nullptr, nullptr), 0) << std::strerror(errno);
+    int stop_status = 0;
+    EXPECT_EQ(waitpid(tid, &stop_status, __WALL), tid);
+    receive_for(0.7);
+    messages.clear();
+    receive_for(seconds);
+    ptrace(PTRACE_DETACH, tid, nullptr, nullptr);
+  };
+  receive_for(25, true);
+  ASSERT_FALSE(messages.empty()) << daemon.Log();
+  receive_for(1.0);
+
+  stopped_for("hsim-io", 1.5);
+  EXPECT_EQ(count("WATCHDOG=1"), 0) << "pinged while no force could reach the device";
+  messages.clear();
+  receive_for(1.0);
+  EXPECT_GE(count("WATCHDOG=1"), 5) << "the pings did not resume with the thread";
+  EXPECT_GE(count("STATUS=serving"), 1);
+
+  stopped_for("hsim-region1", 1.5);
+  EXPECT_GE(count("WATCHDOG=1"), 8) << "a stalled secondary stopped the pings";
+  // Named in the log and in systemd's status line (systemctl status), each.
+  EXPECT_NE(daemon.Log().find("health: stalled: I/O (hsim-io)"), std::string::npos);
+  EXPECT_NE(daemon.Log().find("; the systemd watchdog is not pinged"), std::string::npos);
+  EXPECT_NE(daemon.Log().find("health: stalled: secondary (hsim-region1)"), std::string::npos)
       << daemon.Log();
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
