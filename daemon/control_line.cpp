@@ -34,6 +34,16 @@ std::optional<std::int32_t> WholeNumber(const std::string& word) {
   return static_cast<std::int32_t>(*value);
 }
 
+// A word of the requester's, as it may be shown in an answer or the log: at most 40 characters,
+// printable ones only (no terminal escapes).
+std::string Shown(const std::string& word) {
+  std::string shown = word.substr(0, 40);
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  }
+  return shown;
+}
+
 }  // namespace
 
 std::optional<command_t> ParseControlLine(const std::string& line, std::string* error) {
@@ -51,7 +61,7 @@ std::optional<command_t> ParseControlLine(const std::string& line, std::string* 
   if (verb == "set-error-target") {
     if (arguments != 1) return fail("set-error-target takes one number: the target, %");
     const std::optional<double> target = Number(words[1]);
-    if (!target) return fail("set-error-target " + words[1] + ": not a number");
+    if (!target) return fail("set-error-target " + Shown(words[1]) + ": not a number");
     command.command = command_t::SET_ERROR_TARGET;
     command.error_target_percent = *target;
   } else if (verb == "pin") {
@@ -61,7 +71,7 @@ std::optional<command_t> ParseControlLine(const std::string& line, std::string* 
     const std::optional<std::int32_t> size = WholeNumber(words[1]), lod = WholeNumber(words[2]);
     const std::optional<double> rate = Number(words[3]);
     if (!size || !lod || !rate) {
-      return fail("pin " + words[1] + " " + words[2] + " " + words[3] +
+      return fail("pin " + Shown(words[1]) + " " + Shown(words[2]) + " " + Shown(words[3]) +
                   ": primary_size and secondary_lod must be whole numbers, the rate a number");
     }
     command.command = command_t::PIN_CONFIGURATION;
@@ -73,12 +83,7 @@ std::optional<command_t> ParseControlLine(const std::string& line, std::string* 
     command.command = verb == "release" ? std::int32_t{command_t::RELEASE_CONFIGURATION}
                                         : std::int32_t{command_t::RESET};
   } else {
-    // The verb is the requester's text: only printable characters go into the answer and log.
-    std::string shown = verb.substr(0, 40);
-    for (char& c : shown) {
-      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-    }
-    return fail("unknown request \"" + shown + "\": " + kUsage);
+    return fail("unknown request \"" + Shown(verb) + "\": " + kUsage);
   }
   return command;
 }

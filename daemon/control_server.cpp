@@ -33,7 +33,7 @@ std::optional<ControlRequest> ControlServer::Next(std::int64_t now_ns) {
     // Even a peer that is not admitted is answered only after its request is read: a Unix
     // socket closed with an unread request makes the client's receive fail (ECONNRESET), and
     // the refusal would be lost.
-    std::string refusal = shm::PeerRefusal(connection->peer, geteuid(), listener_.allowed_gid());
+    std::string refusal = listener_.Refusal(connection->peer);
     pending_.push_back({std::move(*connection), now_ns + kRequestTimeout_ns, std::move(refusal)});
   }
   for (std::size_t i = 0; i < pending_.size();) {

@@ -24,6 +24,11 @@ class InputIntake {
         owns_input_(owns_input) {}
 
   void Offer(std::int64_t seq, const std::array<double, 3>& position_m);
+  /** A new driver: its seq and positions are not checked against the previous one's. */
+  void Reset() {
+    guard_.Reset();
+    last_accepted_ = DeviceSample{};
+  }
 
  private:
   InputGuard guard_;

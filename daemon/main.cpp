@@ -532,6 +532,13 @@ int Serve(const Arguments& args) {
       }
     }
     // Rejections: at most log.max_lines_per_s lines each; the counts are in every status message.
+    // New region threads, or ones just woken, get a moment before the health check expects
+    // them to have run.
+    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
+      regions_since_ns = now;
+      health_reconfigurations = loop.reconfigurations();
+    }
+    health_asleep = loop.asleep();
     auto line_due = [&](std::int64_t last_line_ns) {
       return (now - last_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
     };
@@ -581,7 +588,10 @@ int Serve(const Arguments& args) {
       }
     }
     if (control) {
-      while (std::optional<ControlRequest> request = control->Next(now)) {
+      // A bounded number a tick: a flood must not keep the supervisor (and the watchdog) here.
+      for (std::size_t k = 0; k < ControlServer::kMaxPending; ++k) {
+        std::optional<ControlRequest> request = control->Next(now);
+        if (!request) break;
         std::string error;
         const std::string who = "hapticsim ctl (pid " + std::to_string(request->peer.pid) +
                                 ", uid " + std::to_string(request->peer.uid) + ")";
@@ -765,11 +775,6 @@ int Serve(const Arguments& args) {
     // thread (no force computed, or none reaching the device) stops the watchdog pings, so
     // systemd restarts the daemon; a stalled secondary is rendered around (the primary holds its
     // boundary, every answer flagged boundary stale); a job that never ends is reported.
-    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
-      regions_since_ns = now;  // new region threads, or ones just woken: give them a moment
-      health_reconfigurations = loop.reconfigurations();
-    }
-    health_asleep = loop.asleep();
     const std::vector<Stall> stalls = StalledThreads(
         HealthBeats(loop, primary_period_s, io_alive_ns.load(std::memory_order_relaxed),
                     regions_since_ns, chooser.running_since_ns(), mover.running_since_ns()),

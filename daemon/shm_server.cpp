@@ -61,7 +61,7 @@ void ShmServer::EndSessionIfGone() {
 
 void ShmServer::Admit(shm::Connection connection) {
   const shm::PeerIdentity& peer = connection.peer;
-  std::string refusal = shm::PeerRefusal(peer, geteuid(), listener_.allowed_gid());
+  std::string refusal = listener_.Refusal(peer);
   if (refusal.empty() && session_) {
     refusal = "a driver (pid " + std::to_string(session_peer_.pid) +
               ") holds the session; one driver at a time";
@@ -80,6 +80,7 @@ void ShmServer::Admit(shm::Connection connection) {
     mapping_.reset();  // says the previous session's daemon is gone (daemon_pid = 0)
     mapping_.emplace(std::move(fresh));
     inputs_ = shm::ShmInputReader();
+    intake_.Reset();  // a new driver's first seq and tip are not "old" or "a jump"
     session_ = std::move(connection.socket);
     session_peer_ = peer;
     counters_.shm_sessions.fetch_add(1);

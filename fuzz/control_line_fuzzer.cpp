@@ -16,7 +16,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!command) {
     if (error.empty()) __builtin_trap();
     for (const char c : error) {  // the answer and the log get printable text only
-      if (static_cast<unsigned char>(c) < 0x20 && c != '\n') __builtin_trap();
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) {
+        __builtin_trap();
+      }
     }
     return 0;
   }

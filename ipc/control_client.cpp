@@ -14,16 +14,16 @@ std::string SendControlRequest(const std::string& path, const std::string& line,
       ConnectToDaemon(path,
                       "is hapticsimd running with [control] socket = \"" + path +
                           "\", and is this user root, the daemon's or in its control.group?",
-                      &daemon);
-  // A refusal may come before the request is sent (the daemon refuses by credentials at once,
-  // and hangs up): then sending fails, and the refusal is the answer.
+                      timeout_ms, &daemon);
+  // The daemon may hang up with its answer before reading a request it will not take (too many
+  // at once): then sending fails, and that answer is still read.
   const bool sent = SendMessage(connection.get(), line);
   pollfd ready{connection.get(), POLLIN, 0};
   HAPTICSIM_THROW_UNLESS(
       poll(&ready, 1, timeout_ms) == 1,
       "hapticsimd at " + path + " did not answer within " + std::to_string(timeout_ms) + " ms");
   char text[512];
-  const ssize_t n = recv(connection.get(), text, sizeof text, 0);
+  const ssize_t n = recv(connection.get(), text, sizeof text, MSG_DONTWAIT);
   HAPTICSIM_THROW_UNLESS(
       n > 0, "hapticsimd at " + path + (sent ? " hung up without an answer" : " took no request"));
   std::string answer(text, static_cast<std::size_t>(n));

@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
+#include <thread>
 
 #include "core/error.hpp"
 
@@ -48,9 +50,24 @@ std::string DirectoryOf(const std::string& path) {
 
 /** Whether a live process answers at `address` (a socket a dead daemon left does not). */
 bool SomeoneListens(const sockaddr_un& address) {
-  UniqueFd probe(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  UniqueFd probe(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   if (!probe) return false;
-  return connect(probe.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0;
+  // Non-blocking: a full backlog (EAGAIN) is a live listener too, and never a wait.
+  return connect(probe.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 ||
+         errno == EAGAIN;
+}
+
+// Connects without ever blocking longer than `timeout_ms`: a Unix socket whose listen backlog is
+// full (a flood, a stopped daemon) makes a blocking connect wait for good.
+bool ConnectWithin(int socket, const sockaddr_un& address, int timeout_ms) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (true) {
+    if (connect(socket, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0) {
+      return true;
+    }
+    if (errno != EAGAIN || std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 }  // namespace
@@ -78,19 +95,18 @@ PeerIdentity PeerOf(int fd) {
   return peer;  // no supplementary groups known: only the primary group counts
 }
 
-std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid) {
+std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid,
+                        const std::string& group_name) {
   if (peer.uid == 0 || peer.uid == daemon_uid || peer.gid == allowed_gid) return "";
   if (std::find(peer.groups.begin(), peer.groups.end(), allowed_gid) != peer.groups.end()) {
     return "";
   }
-  const struct group* entry = getgrgid(allowed_gid);
   return "pid " + std::to_string(peer.pid) + " (uid " + std::to_string(peer.uid) +
-         ") is not in group " +
-         (entry ? std::string(entry->gr_name) : std::to_string(allowed_gid)) +
-         ": add that user to the group";
+         ") is not in group " + group_name + ": add that user to the group";
 }
 
-std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server) {
+std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server,
+                                  uid_t client_uid) {
   struct stat info {};
   if (lstat(path.c_str(), &info) != 0) return path + " cannot be examined: " + Why();
   if (!S_ISSOCK(info.st_mode)) return path + " is not a socket";
@@ -99,29 +115,42 @@ std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& s
            std::to_string(server.uid) + " (pid " + std::to_string(server.pid) +
            "): not the service that made it";
   }
-  // The socket's own directory: nobody but its owner may create names in it, or someone else
-  // could have bound the name before the daemon did.
+  const std::string uids = "root, the service (uid " + std::to_string(server.uid) +
+                           ") or this user (uid " + std::to_string(client_uid) + ")";
+  // From the socket's own directory up to /, each examined itself (lstat: no symbolic link
+  // can be re-pointed between the connection and this check).
   std::string directory = DirectoryOf(path);
-  bool own_directory = true;
-  while (true) {
-    if (stat(directory.c_str(), &info) != 0) return directory + " cannot be examined: " + Why();
-    if (info.st_uid != 0 && info.st_uid != server.uid) {
-      return directory + " is owned by uid " + std::to_string(info.st_uid) +
-             ", neither root nor the service (uid " + std::to_string(server.uid) +
-             "): that user could have put " + path + " there";
+  uid_t below_owner = 0;  // the owner of the directory one level down the path
+  for (bool own_directory = true;; own_directory = false) {
+    if (lstat(directory.c_str(), &info) != 0) return directory + " cannot be examined: " + Why();
+    if (S_ISLNK(info.st_mode)) {
+      return directory + " is a symbolic link: give the socket's real path";
     }
-    const bool others_write = info.st_mode & (S_IWGRP | S_IWOTH);
-    // Above the socket's own directory a sticky one (like /tmp) is safe: others can add names,
-    // but not move or remove the service's directory.
-    if (others_write && (own_directory || !(info.st_mode & S_ISVTX))) {
-      return directory + " (mode " + Octal(info.st_mode) +
-             ") can be written by users other than its owner: any of them could have put " + path +
-             " there; serve the socket from a directory only the service writes, e.g. "
-             "/run/hapticsim";
+    if (info.st_uid != 0 && info.st_uid != server.uid && info.st_uid != client_uid) {
+      return directory + " is owned by uid " + std::to_string(info.st_uid) + ", not " + uids +
+             ": that user could have put " + path + " there";
+    }
+    if (info.st_mode & (S_IWGRP | S_IWOTH)) {
+      // Others may create names here. In the socket's own directory that is enough to squat
+      // the socket. Above it, a sticky directory (like /tmp) keeps them from moving what is
+      // not theirs, so the directory below is safe if root or this user made it; not if anyone
+      // else did, the service's user included (a squatter serves its own socket).
+      const bool made_by_trusted = below_owner == 0 || below_owner == client_uid;
+      if (own_directory || !(info.st_mode & S_ISVTX) || !made_by_trusted) {
+        return directory + " (mode " + Octal(info.st_mode) +
+               ") can be written by users other than its owner" +
+               (own_directory || !(info.st_mode & S_ISVTX)
+                    ? ""
+                    : ", and the directory below it was made by uid " +
+                          std::to_string(below_owner)) +
+               ": any of them could have put " + path +
+               " there; serve the socket from a directory only the service writes, e.g. "
+               "/run/hapticsim";
+      }
     }
     if (directory == "/") return "";
+    below_owner = info.st_uid;
     directory = DirectoryOf(directory);
-    own_directory = false;
   }
 }
 
@@ -135,12 +164,23 @@ ServiceListener::ServiceListener(const std::string& path, const std::string& gro
     HAPTICSIM_THROW_UNLESS(entry, section + ".group = \"" + group + "\": no such group");
     allowed_gid_ = entry->gr_gid;
   }
+  // Named once here: getgrgid is neither thread-safe nor sure to be quick (a directory service).
+  const struct group* named = getgrgid(allowed_gid_);
+  group_name_ = named ? std::string(named->gr_name) : std::to_string(allowed_gid_);
   const std::string directory = DirectoryOf(path);
   struct stat info {};
   HAPTICSIM_THROW_UNLESS(stat(directory.c_str(), &info) == 0 && S_ISDIR(info.st_mode),
                          key + " = \"" + path + "\": " + directory +
                              " is not a directory: create it, only writable by the daemon's "
                              "user (systemd: RuntimeDirectory=hapticsim), or choose another path");
+  // Anyone else who may write there could swap the socket between bind and chmod, or take the
+  // name while the daemon is down; and drivers would refuse it (ServerIdentityProblem).
+  HAPTICSIM_THROW_UNLESS(!(info.st_mode & (S_IWGRP | S_IWOTH)),
+                         key + " = \"" + path + "\": " + directory + " (mode " +
+                             Octal(info.st_mode) +
+                             ") can be written by other users: use a directory only the daemon's "
+                             "user can write (systemd: RuntimeDirectory=hapticsim), e.g. "
+                             "mkdir -m 700");
   if (lstat(path.c_str(), &info) == 0) {
     HAPTICSIM_THROW_UNLESS(S_ISSOCK(info.st_mode), key + " = \"" + path +
                                                        "\": a file that is not a socket is in "
@@ -214,13 +254,14 @@ MappedSegment ReadSessionAnswer(int connection, const std::string& path, int tim
       "hapticsimd at " + path + " did not answer within " + std::to_string(timeout_ms) + " ms");
   char text[256];
   iovec part{text, sizeof text - 1};
-  alignas(cmsghdr) char control[CMSG_SPACE(4 * sizeof(int))];
+  alignas(cmsghdr) char control[CMSG_SPACE(4 * sizeof(int))] = {};
   msghdr message{};
   message.msg_iov = &part;
   message.msg_iovlen = 1;
   message.msg_control = control;
   message.msg_controllen = sizeof control;
   const ssize_t length = recvmsg(connection, &message, MSG_DONTWAIT | MSG_CMSG_CLOEXEC);
+  HAPTICSIM_THROW_UNLESS(length >= 0, "cannot read hapticsimd's answer at " + path + ": " + Why());
   // Every descriptor that came, owned at once, so none leaks whatever is wrong with the message.
   std::vector<UniqueFd> passed;
   for (cmsghdr* h = CMSG_FIRSTHDR(&message); h; h = CMSG_NXTHDR(&message, h)) {
@@ -249,27 +290,29 @@ MappedSegment ReadSessionAnswer(int connection, const std::string& path, int tim
   return MappedSegment::Adopt(passed[0].release(), path);
 }
 
-UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint,
+UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint, int timeout_ms,
                          PeerIdentity* daemon) {
   const sockaddr_un address = AddressOf(path, "the daemon's socket");
-  UniqueFd connection(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  UniqueFd connection(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   HAPTICSIM_THROW_UNLESS(connection, "cannot make a socket: " + Why());
-  HAPTICSIM_THROW_UNLESS(
-      connect(connection.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0,
-      "cannot connect to hapticsimd at " + path + ": " + Why() + " (" + hint + ")");
+  HAPTICSIM_THROW_UNLESS(ConnectWithin(connection.get(), address, timeout_ms),
+                         "cannot connect to hapticsimd at " + path + ": " +
+                             (errno == EAGAIN ? std::string("it takes no connection (busy or "
+                                                            "stalled) within the timeout")
+                                              : Why()) +
+                             " (" + hint + ")");
   *daemon = PeerOf(connection.get());
-  const std::string problem = ServerIdentityProblem(path, *daemon);
+  const std::string problem = ServerIdentityProblem(path, *daemon, geteuid());
   HAPTICSIM_THROW_UNLESS(problem.empty(), "refusing the daemon at " + path + ": " + problem);
   return connection;
 }
 
 ServiceSession ConnectToService(const std::string& path, int timeout_ms) {
   PeerIdentity daemon;
-  UniqueFd connection = ConnectToDaemon(
-      path,
-      "is it running with [shm] enabled = true and socket = \"" + path +
-          "\", and is this user in its shm.group?",
-      &daemon);
+  UniqueFd connection = ConnectToDaemon(path,
+                                        "is it running with [shm] enabled = true and socket = \"" +
+                                            path + "\", and is this user in its shm.group?",
+                                        timeout_ms, &daemon);
   MappedSegment segment = ReadSessionAnswer(connection.get(), path, timeout_ms);
   return ServiceSession{std::move(connection), std::move(daemon), std::move(segment)};
 }

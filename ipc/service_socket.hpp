@@ -12,6 +12,7 @@
 // a directory nobody else can write, so no other local user can have put it there first.
 
 #include <sys/types.h>
+#include <unistd.h>
 
 #include <optional>
 #include <string>
@@ -41,15 +42,19 @@ PeerIdentity PeerOf(int fd);
  * member of `allowed_gid` (as its primary or a supplementary group). Empty when it may, else why
  * not, in words for the log.
  */
-std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid);
+std::string PeerRefusal(const PeerIdentity& peer, uid_t daemon_uid, gid_t allowed_gid,
+                        const std::string& group_name);
 
 /**
- * Why the socket at `path`, served by `server`, is not to be trusted; empty when it is. It must
- * be a socket owned by the serving user, in a directory that only that user or root owns and that
- * no one else can write; every directory above it must be writable only by its owner (root or
- * that user), or be sticky (like /tmp).
+ * Why the socket at `path`, served by `server`, is not to be trusted by a client running as
+ * `client_uid`; empty when it is. The socket must be owned by the serving user. Every directory
+ * from the socket's up to / must be a real directory (no symbolic link), owned by root, the
+ * serving user or the client's, and writable by no one else — except that a sticky directory
+ * above the socket's own (like /tmp) may be, when the directory below it on the path was made by
+ * root or the client: so no other user can have put the socket there first.
  */
-std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server);
+std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& server,
+                                  uid_t client_uid);
 
 /** A connection the daemon accepted: the socket and who is at the other end. */
 struct Connection {
@@ -76,11 +81,17 @@ class ServiceListener {
   std::optional<Connection> Accept();
   const std::string& path() const { return path_; }
   gid_t allowed_gid() const { return allowed_gid_; }
+  const std::string& group_name() const { return group_name_; }
+  /** Why `peer` may not connect here (PeerRefusal); empty when it may. */
+  std::string Refusal(const PeerIdentity& peer) const {
+    return PeerRefusal(peer, geteuid(), allowed_gid_, group_name_);
+  }
 
  private:
   std::string path_;
   UniqueFd socket_;
   gid_t allowed_gid_;
+  std::string group_name_;
   ino_t inode_ = 0;  // of the socket file bound, so only that one is removed at the end
 };
 
@@ -102,11 +113,12 @@ struct ServiceSession {
 };
 
 /**
- * A client's side: connects to the daemon's socket at `path` and checks that the daemon is the
- * service (ServerIdentityProblem), filling `daemon`. `hint` says what to check when nothing
- * answers there. @throws Error naming the problem.
+ * A client's side: connects to the daemon's socket at `path` within `timeout_ms` and checks that
+ * the daemon is the service (ServerIdentityProblem), filling `daemon`. `hint` says what to check
+ * when nothing answers there. The connection is non-blocking. @throws Error naming the problem.
  */
-UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint, PeerIdentity* daemon);
+UniqueFd ConnectToDaemon(const std::string& path, const std::string& hint, int timeout_ms,
+                         PeerIdentity* daemon);
 
 /**
  * The driver's side of the answer: waits at most `timeout_ms` for the daemon's message on

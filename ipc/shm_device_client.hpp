@@ -16,8 +16,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <climits>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -43,7 +45,10 @@ class ShmDeviceClient {
    * segment that is not the daemon's.
    */
   explicit ShmDeviceClient(const std::string& socket_path = kDefaultSocket)
-      : socket_path_(socket_path), session_(ConnectToService(socket_path, kConnectTimeout_ms)) {}
+      : socket_path_(socket_path) {
+    sessions_.push_back(ConnectToService(socket_path, kConnectTimeout_ms));
+    segment_.store(&sessions_.back().segment.segment(), std::memory_order_release);
+  }
 
   /**
    * kLive while the daemon that made the segment runs and its newest answer is at most
@@ -61,21 +66,24 @@ class ShmDeviceClient {
   }
 
   /**
-   * Not wait-free (it connects: system calls, allocation, up to 200 ms): call it off the
-   * device's real-time thread, now and then, while Source says kNone. Starts a new session with
-   * the daemon at the same socket (a restarted service) and maps its segment; true when it did.
-   * Writes go on into the new segment. @throws nothing: no daemon, a refusal or a foreign
-   * socket just leaves the old session.
+   * Not wait-free (it connects: system calls, allocation, up to 400 ms): call it from one
+   * thread off the device's real-time thread, now and then, while Source says kNone; the
+   * real-time thread may go on calling the others meanwhile. Starts a new session with the daemon
+   * at the same socket (a restarted service) and maps its segment; true when it did. Writes go on
+   * into the new segment; the old one stays mapped (a real-time call may still be reading it)
+   * until kKeptSessions newer ones have come. @throws nothing: no daemon, a refusal or a
+   * foreign socket just leaves the old session.
    */
   bool Reconnect() {
     try {
-      ServiceSession fresh = ConnectToService(socket_path_, 200);
-      session_.reset();
-      session_.emplace(std::move(fresh));
-      return true;
+      sessions_.push_back(ConnectToService(socket_path_, 200));
     } catch (const std::exception&) {
       return false;
     }
+    segment_.store(&sessions_.back().segment.segment(), std::memory_order_release);
+    sessions_[sessions_.size() - 2].connection.reset();  // that session is over
+    if (sessions_.size() > kKeptSessions) sessions_.pop_front();
+    return true;
   }
 
   /**
@@ -118,14 +126,18 @@ class ShmDeviceClient {
   bool DaemonRunning() const { return segment().header.daemon_pid.load() != 0; }
 
   /** The daemon this session is with, as the kernel reported it when connecting. */
-  const PeerIdentity& daemon() const { return session_->daemon; }
+  const PeerIdentity& daemon() const { return sessions_.back().daemon; }
   /** The mapped segment itself: for tools and tests that look inside; drivers need not. */
-  ShmSegment& segment() { return session_->segment.segment(); }
-  const ShmSegment& segment() const { return session_->segment.segment(); }
+  ShmSegment& segment() { return *segment_.load(std::memory_order_acquire); }
+  const ShmSegment& segment() const { return *segment_.load(std::memory_order_acquire); }
+
+  /** Sessions kept mapped after newer ones replaced them (Reconnect). */
+  static constexpr std::size_t kKeptSessions = 8;
 
  private:
   std::string socket_path_;
-  std::optional<ServiceSession> session_;  // always holds one (reset only to replace it)
+  std::deque<ServiceSession> sessions_;        // newest last (a deque: the others never move)
+  std::atomic<ShmSegment*> segment_{nullptr};  // the newest session's, for the wait-free calls
 };
 
 }  // namespace hapticsim::shm

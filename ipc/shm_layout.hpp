@@ -37,13 +37,13 @@ struct ShmDeviceInput {
 
 /** The force, written by the daemon every primary period. */
 struct ShmForceOutput {
-  std::int64_t period = -1;   ///< the daemon's primary period, counting every one from 0
-  std::int64_t seq = -1;      ///< the newest input it answers (-1: none yet)
+  std::int64_t period = -1;     ///< the daemon's primary period, counting every one from 0
+  std::int64_t seq = -1;        ///< the newest input it answers (-1: none yet)
   std::int64_t first_seq = -1;  ///< the oldest it answers: all from first_seq to seq were used
-  std::int64_t utime = 0;     ///< daemon's CLOCK_MONOTONIC, µs
-  double force_n[3] = {};     ///< force on the user, N
-  double error_percent = -1;  ///< looked-up error, % (-1: no map)
-  std::int32_t flags = 0;     ///< force_feedback_t::FLAG_* bits
+  std::int64_t utime = 0;       ///< daemon's CLOCK_MONOTONIC, µs
+  double force_n[3] = {};       ///< force on the user, N
+  double error_percent = -1;    ///< looked-up error, % (-1: no map)
+  std::int32_t flags = 0;       ///< force_feedback_t::FLAG_* bits
 };
 
 /**
@@ -112,8 +112,8 @@ class ShmInputReader {
     }
     // How many writes since the last read, in unsigned arithmetic (no overflow), at most the
     // ring less the slot that may be being written.
-    const std::uint64_t behind = static_cast<std::uint64_t>(newest) -
-                                 static_cast<std::uint64_t>(last_ < 0 ? -1 : last_);
+    const std::uint64_t behind =
+        static_cast<std::uint64_t>(newest) - static_cast<std::uint64_t>(last_ < 0 ? -1 : last_);
     const std::uint64_t count = behind < kInputSlots - 1 ? behind : kInputSlots - 1;
     int read = 0;
     for (std::uint64_t k = count; k > 0; --k) {

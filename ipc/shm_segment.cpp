@@ -1,6 +1,7 @@
 #include "ipc/shm_segment.hpp"
 
 #include <fcntl.h>
+#include <linux/falloc.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -105,7 +106,13 @@ MappedSegment::~MappedSegment() {
   if (!segment_) return;
   if (owner_) segment_->header.daemon_pid.store(0);
   munmap(segment_, sizeof(ShmSegment));
-  if (fd_ >= 0) close(fd_);
+  if (fd_ >= 0) {
+    // The driver may keep its descriptor for ever: the pages go back now, or a driver that
+    // starts session after session and keeps each would pile them up in the daemon's memory.
+    // What it reads after this is zeros: no signature, daemon_pid 0, "no force source".
+    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, 0, sizeof(ShmSegment));
+    close(fd_);
+  }
 }
 
 }  // namespace hapticsim::shm

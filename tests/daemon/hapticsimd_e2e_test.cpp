@@ -538,13 +538,7 @@ TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSai
   EXPECT_EQ(daemon.Wait(10), 0) << daemon.Log();
 }
 
-int ThreadsOf(int pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(status, line);) {
-    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
-  }
-  return -1;
-}
+using testing::ThreadsOf;
 
 // A flood of commands from any local process: pins at 1 kHz of a configuration whose
 // verification takes many seconds (1000:999 Hz). The daemon made a thread per command (6 → 28

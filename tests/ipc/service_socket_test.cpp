@@ -30,25 +30,36 @@ std::string DirectoryOf(const std::string& path) {
   return std::filesystem::path(path).parent_path().string();
 }
 
-// A server at `path` that answers the first driver to connect with `answer(connection)`.
+// A server at `path` that answers the first driver to connect with `answer(connection)`. Raw
+// socket calls, as a squatter would make them (ServiceListener refuses directories others can
+// write).
 class FakeServer {
  public:
   FakeServer(const std::string& path, std::function<void(int)> answer)
-      : listener_(path, ""), thread_([this, answer] {
-          for (int n = 0; n < 2000; ++n) {
-            if (auto connection = listener_.Accept()) {
-              answer(connection->socket.get());
-              // Held open until the driver has read the answer.
-              std::this_thread::sleep_for(std::chrono::milliseconds(100));
-              return;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-          }
-        }) {}
+      : listener_(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0)) {
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof address.sun_path, "%s", path.c_str());
+    unlink(path.c_str());
+    EXPECT_EQ(bind(listener_.get(), reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    EXPECT_EQ(listen(listener_.get(), 8), 0);
+    thread_ = std::thread([this, answer] {
+      for (int n = 0; n < 2000; ++n) {
+        UniqueFd connection(accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC));
+        if (connection) {
+          answer(connection.get());
+          // Held open until the driver has read the answer.
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          return;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+  }
   ~FakeServer() { thread_.join(); }
 
  private:
-  ServiceListener listener_;
+  UniqueFd listener_;
   std::thread thread_;
 };
 
@@ -164,6 +175,68 @@ TEST(ServiceSocket, ADriverRefusesASocketThatOthersCouldHavePutThere) {
   std::filesystem::remove_all(directory);
 }
 
+// The squatter's better try: a directory of its own (0755, nobody else can write it) inside one
+// everybody can write (sticky, like /tmp), e.g. /tmp/hsim before the user's `mkdir -p` ran. The
+// socket, its directory and the server are all the squatter's; what gives it away is that the
+// directory below the sticky one was made by another user than root or the driver's.
+TEST(ServiceSocket, ADriverRefusesASocketInADirectoryAnotherUserMadeUnderAStickyOne) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to make a directory as another user";
+  const std::string sticky = DirectoryOf(testing::PrivateSocketPath());
+  ASSERT_EQ(chmod(sticky.c_str(), 01777), 0);
+  const std::string squatted = sticky + "/hsim";
+  ASSERT_EQ(mkdir(squatted.c_str(), 0755), 0);
+  if (chown(squatted.c_str(), 65534, 65534) != 0) {
+    std::filesystem::remove_all(sticky);
+    GTEST_SKIP() << "uid 65534 is not mapped here (a user namespace)";
+  }
+  // Inside it, a root-owned private directory with the socket: every check on the socket's
+  // own directory passes.
+  const std::string inner = squatted + "/run";
+  ASSERT_EQ(mkdir(inner.c_str(), 0700), 0);
+  const std::string path = inner + "/hapticsimd.sock";
+  MappedSegment squatter = MappedSegment::CreateSealed("squatter");
+  {
+    FakeServer server(path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), squatter.fd()); });
+    const std::string verdict = DriverVerdict(path);
+    EXPECT_NE(verdict.find(squatted + " is owned by uid 65534"), std::string::npos) << verdict;
+  }
+  // Owned by the driver's user instead (the user's own mkdir): trusted.
+  ASSERT_EQ(chown(squatted.c_str(), geteuid(), getegid()), 0);
+  {
+    FakeServer server(path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), squatter.fd()); });
+    EXPECT_EQ(DriverVerdict(path), "");
+  }
+  std::filesystem::remove_all(sticky);
+}
+
+TEST(ServiceSocket, ADriverRefusesASymbolicLinkOnThePath) {
+  const std::string path = testing::PrivateSocketPath();
+  const std::string directory = DirectoryOf(path);
+  const std::string link = directory + "-link";
+  std::filesystem::create_directory_symlink(directory, link);
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test");
+  {
+    FakeServer server(path,
+                      [&](int socket) { SendMessage(socket, SessionGreeting(), daemon.fd()); });
+    const std::string verdict = DriverVerdict(link + "/hapticsimd.sock");
+    EXPECT_NE(verdict.find(link + " is a symbolic link"), std::string::npos) << verdict;
+  }
+  std::filesystem::remove(link);
+  std::filesystem::remove_all(directory);
+}
+
+TEST(ServiceSocket, TheDaemonWillNotListenInADirectoryOthersCanWrite) {
+  const std::string path = testing::PrivateSocketPath();
+  const std::string directory = DirectoryOf(path);
+  ASSERT_EQ(chmod(directory.c_str(), 01777), 0);
+  EXPECT_NE(ListenerRefusal(path).find("(mode 1777) can be written by other users"),
+            std::string::npos)
+      << ListenerRefusal(path);
+  std::filesystem::remove_all(directory);
+}
+
 TEST(ServiceSocket, ADriverRefusesASocketNotOwnedByTheProcessServingIt) {
   if (geteuid() != 0) GTEST_SKIP() << "needs root to give the socket to another user";
   const std::string path = testing::PrivateSocketPath();
@@ -203,17 +276,18 @@ TEST(ServiceSocket, TheDaemonAdmitsRootItsOwnUserAndItsGroupOnly) {
   peer.pid = 1234;
   peer.uid = 1000;
   peer.gid = 1000;
-  EXPECT_EQ(PeerRefusal(peer, 1000, 2000), "");  // the daemon's own user
+  EXPECT_EQ(PeerRefusal(peer, 1000, 2000, "hapticsim"), "");  // the daemon's own user
   peer.uid = 0;
-  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // root
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000, "hapticsim"), "");  // root
   peer.uid = 1001;
-  EXPECT_NE(PeerRefusal(peer, 999, 2000).find("pid 1234 (uid 1001) is not in group"),
+  EXPECT_NE(PeerRefusal(peer, 999, 2000, "hapticsim")
+                .find("pid 1234 (uid 1001) is not in group hapticsim: add that user"),
             std::string::npos);
   peer.gid = 2000;
-  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // primary group
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000, "hapticsim"), "");  // primary group
   peer.gid = 1001;
   peer.groups = {5, 2000};
-  EXPECT_EQ(PeerRefusal(peer, 999, 2000), "");  // supplementary group
+  EXPECT_EQ(PeerRefusal(peer, 999, 2000, "hapticsim"), "");  // supplementary group
 }
 
 TEST(ServiceSocket, TheDaemonReplacesADeadDaemonsSocketButNotALiveOneOrAFile) {

@@ -1,21 +1,26 @@
-// Hostile neighbours on the command channels (issue "Hostile neighbours", point 4): any local
-// process could RESET the simulation, pin a configuration or change the error target over LCM.
-// Now state-changing commands come from the control socket (hapticsim ctl), from root, the
+// Hostile neighbours on the command channels (issue "Hostile neighbours", points 2 and 4): any
+// local process could RESET the simulation, pin a configuration or change the error target over
+// LCM. Now state-changing commands come from the control socket (hapticsim ctl), from root, the
 // daemon's user and control.group only; LCM commands are refused unless lcm.accept_commands.
 #include <grp.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/error.hpp"
 #include "hapticsim/command_t.hpp"
 #include "ipc/control_client.hpp"
+#include "ipc/unique_fd.hpp"
 #include "tests/security/hostile_neighbour.hpp"
 
 namespace hapticsim {
@@ -103,6 +108,66 @@ TEST_F(HostileNeighbour, AUserOutsideTheControlGroupCannotCommandTheDaemon) {
   EXPECT_EQ(after.error_target_percent, before.error_target_percent);
   EXPECT_NE(daemon_->Log().find("control socket: refused pid"), std::string::npos)
       << daemon_->Log();
+}
+
+// Point 2, through the control socket: a flood of connections that say nothing and of pins
+// whose verification takes seconds (1000:999 Hz). At most ControlServer::kMaxPending wait, the
+// rest are refused and counted; no request makes a thread; a driver is still served; and the
+// daemon stops within 2 s.
+TEST_F(HostileNeighbour, AFloodOfControlRequestsMakesNoThreadAndTheDaemonStopsWithinTwoSeconds) {
+  const std::int64_t quiet = MissesOver(Quiet);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const int threads_before = testing::ThreadsOf(daemon_->pid());
+  ASSERT_GT(threads_before, 0);
+  int most_threads = threads_before;
+  std::int64_t longest_status_gap_us = 0;
+  pid_t flooder = -1;
+  const std::int64_t attacked = MissesOver([&] {
+    flooder = Spawn([&] {
+      std::vector<shm::UniqueFd> silent;  // held open for the window, never asking anything
+      for (int k = 0; k < 32; ++k) {
+        shm::UniqueFd connection(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+        sockaddr_un address{};
+        address.sun_family = AF_UNIX;
+        std::snprintf(address.sun_path, sizeof address.sun_path, "%s", control_.c_str());
+        if (connect(connection.get(), reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) {
+          silent.push_back(std::move(connection));
+        }
+      }
+      int answered = 0;
+      const auto end = Clock::now() + kWindow;
+      while (Clock::now() < end) {
+        try {
+          shm::SendControlRequest(control_, "pin 1 2 999", 2000);
+          ++answered;
+        } catch (const Error&) {
+        }
+      }
+      return answered > 0 ? 0 : 1;
+    });
+    // The supervisor keeps ticking through the flood: its status (20 a second) keeps coming.
+    std::int64_t last_utime = monitor_.LastStatus()->utime;
+    for (int k = 0; k < 32; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      most_threads = std::max(most_threads, testing::ThreadsOf(daemon_->pid()));
+      const std::int64_t utime = monitor_.LastStatus()->utime;
+      longest_status_gap_us = std::max(longest_status_gap_us, utime - last_utime);
+      last_utime = utime;
+    }
+  });
+  EXPECT_EQ(ExitStatusOf(flooder), 0) << "no request of the flood was answered at all";
+  ASSERT_TRUE(daemon_->running()) << daemon_->Log();
+  EXPECT_EQ(most_threads, threads_before) << "a request made a thread";
+  // A supervisor held in the flood would also hold back the watchdog: systemd restarts at 2 s.
+  EXPECT_LT(longest_status_gap_us, 500'000) << "the supervisor stopped ticking in the flood";
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
+  ASSERT_TRUE(monitor_.WaitForStatus([](const status_t& s) { return s.commands_refused >= 10; }, 2))
+      << daemon_->Log();
+  ExpectADriverIsServed();
+  const auto stop = Clock::now();
+  daemon_->Signal(SIGTERM);
+  EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - stop).count(), 2.0) << daemon_->Log();
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Hostile neighbours on the shared-memory interface (issue "Hostile neighbours", points 1 and 5):
+// Hostile neighbours on the shared-memory interface (issue "Hostile neighbours", points 1, 3, 5):
 // a real hapticsimd, attacked by a separate local process. Each test asserts that the attack is
 // refused and counted (status over a real LCM bus, in the private network namespace the suite runs
 // in), that the daemon keeps serving a real driver, and that the primary misses no more deadlines
@@ -154,10 +154,12 @@ TEST_F(HostileNeighbour, ADriverCannotTakeOverOrReachIntoAnotherDriversSession) 
     std::string answer;
     const pid_t intruder = Spawn([&] {
       int connection = -1;
-      return TakeSegment(socket_, &connection, &answer) < 0 ? 0 : 1;
+      if (TakeSegment(socket_, &connection, &answer) >= 0) return 1;  // handed a segment
+      return answer.find("holds the session; one driver at a time") != std::string::npos ? 0 : 2;
     });
     hold_above();
-    EXPECT_EQ(ExitStatusOf(intruder), 0) << "the intruder was handed a segment";
+    EXPECT_EQ(ExitStatusOf(intruder), 0) << "1: the intruder was handed a segment; 2: refused "
+                                            "without saying why (or not connected at all)";
   });
   EXPECT_EQ(ExitStatusOf(former), 0) << "10/12: no session; 13: the old mapping was not told";
   EXPECT_EQ(largest_force, 0.0) << "the former driver's input reached the daemon";
@@ -196,6 +198,51 @@ TEST_F(HostileNeighbour, AUserOutsideTheGroupIsRefusedEvenWhenTheSocketIsOpenToA
   ExpectADriverIsServed();
 }
 
+// Point 3, through shared memory: a driver process writes numbers at the edges — a seq near 2⁶²
+// (the tool tip used to go NaN), NaN, infinite and huge positions — between ordinary inputs. Each
+// is refused and counted, no force is non-finite, and the ordinary press goes on being felt.
+TEST_F(HostileNeighbour, ADriversNumbersAtTheEdgesAreRefusedCountedAndNeverReachTheForce) {
+  const std::int64_t quiet = MissesOver(Quiet);
+  pid_t driver = -1;
+  const std::int64_t attacked = MissesOver([&] {
+    driver = Spawn([&] {
+      try {
+        shm::ShmDeviceClient client(socket_);
+        const double wild[][3] = {{NAN, kEdge / 2, 0.001},
+                                  {kEdge / 2, INFINITY, 0.001},
+                                  {kEdge / 2, kEdge / 2, 1e300},
+                                  {-1e9, kEdge / 2, 0.001}};
+        std::int64_t seq = 1, nonfinite = 0, pushing = 0;
+        const auto end = Clock::now() + kWindow;
+        for (int n = 0; Clock::now() < end; ++n, ++seq) {
+          const double z = n < 50 ? -0.002 : std::min(0.005, 1e-5 * (n - 50));
+          client.WriteInput(seq, 0, {kEdge / 2, kEdge / 2, z});
+          if (n % 10 == 5) {  // every tenth period, something at an edge
+            const auto& w = wild[(n / 10) % 4];
+            client.WriteInput(n % 20 == 5 ? (std::int64_t{1} << 62) : ++seq, 0, {w[0], w[1], w[2]});
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          shm::ShmForceOutput out;
+          if (!client.ReadForce(&out)) continue;
+          if (!std::isfinite(out.force_n[0] + out.force_n[1] + out.force_n[2])) ++nonfinite;
+          if (out.force_n[2] < -0.2) ++pushing;
+        }
+        return nonfinite == 0 && pushing > 100 ? 0 : 1;
+      } catch (const std::exception&) {
+        return 2;
+      }
+    });
+    std::this_thread::sleep_for(kWindow + std::chrono::milliseconds(200));
+  });
+  EXPECT_EQ(ExitStatusOf(driver), 0) << "1: a non-finite force, or the press was not felt";
+  ASSERT_TRUE(daemon_->running()) << daemon_->Log();
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
+  ASSERT_TRUE(monitor_.WaitForStatus([](const status_t& s) { return s.inputs_rejected >= 50; }, 2))
+      << daemon_->Log();
+  EXPECT_NE(daemon_->Log().find("device input rejected"), std::string::npos);
+  ExpectADriverIsServed();
+}
+
 // Point 5: a process that sets up a socket before the daemon, where others can write, and hands
 // out a segment with a force of its own in it. The driver refuses it and says why; it never
 // reads that force.
@@ -206,7 +253,15 @@ TEST(Squatting, ADriverRefusesASocketAnotherUserCouldHavePutThereAndSaysWhy) {
   int ready[2];
   ASSERT_EQ(pipe(ready), 0);
   const pid_t squatter = Spawn([&] {
-    shm::ServiceListener listener(path, "");
+    // Raw calls, as a squatter makes them (hapticsimd's own listener refuses such a directory).
+    shm::UniqueFd listener(socket(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof address.sun_path, "%s", path.c_str());
+    if (bind(listener.get(), reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+        listen(listener.get(), 8) != 0) {
+      return 2;
+    }
     shm::MappedSegment forged = shm::MappedSegment::CreateSealed("hapticsim");
     shm::ShmForceOutput push;
     push.period = 0;
@@ -216,9 +271,8 @@ TEST(Squatting, ADriverRefusesASocketAnotherUserCouldHavePutThereAndSaysWhy) {
     if (write(ready[1], "x", 1) != 1) return 1;
     const auto end = Clock::now() + std::chrono::seconds(3);
     while (Clock::now() < end) {
-      if (auto connection = listener.Accept()) {
-        shm::SendMessage(connection->socket.get(), shm::SessionGreeting(), forged.fd());
-      }
+      shm::UniqueFd connection(accept4(listener.get(), nullptr, nullptr, SOCK_CLOEXEC));
+      if (connection) shm::SendMessage(connection.get(), shm::SessionGreeting(), forged.fd());
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     return 0;

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <cstdint>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
@@ -34,6 +35,15 @@ inline void WaitUntilServing(BackgroundProcess& daemon) {
     ASSERT_TRUE(daemon.running()) << daemon.Log();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+}
+
+// How many threads process `pid` has now (-1: it is gone).
+inline int ThreadsOf(int pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  }
+  return -1;
 }
 
 // The client side: what a device driver and a monitoring tool see.

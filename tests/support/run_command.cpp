@@ -81,7 +81,9 @@ BackgroundProcess::~BackgroundProcess() {
   }
 }
 
-void BackgroundProcess::Signal(int signal) const { kill(pid_, signal); }
+void BackgroundProcess::Signal(int signal) const {
+  if (status_ < 0) kill(pid_, signal);  // once reaped, its pid may be another process's
+}
 
 bool BackgroundProcess::running() {
   if (status_ >= 0) return false;
