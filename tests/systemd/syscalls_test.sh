@@ -63,7 +63,10 @@ fi
 
 # "PID name(args" or "PID <... name resumed>": the name of every call the daemon made.
 used=$(sed -nE 's/^[0-9]+ +(<\.\.\. )?([a-z0-9_]+)(\(| resumed>).*/\2/p' "$work/trace" | sort -u)
-for call in sched_setscheduler mlockall memfd_create 'f\?chown' accept4 sendmsg; do
+required=(sched_setscheduler mlockall memfd_create 'f\?chown' accept4 sendmsg)
+# AddressSanitizer turns mlockall into a no-op that makes no system call.
+grep -q __asan_init "$daemon" && required=(sched_setscheduler memfd_create 'f\?chown' accept4 sendmsg)
+for call in "${required[@]}"; do
   echo "$used" | grep -qx "$call" ||
     { echo "FAIL: no $call traced: the run did not exercise what the filter must allow"; exit 1; }
 done
