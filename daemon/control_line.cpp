@@ -6,6 +6,8 @@
 #include <sstream>
 #include <vector>
 
+#include "ipc/service_socket.hpp"
+
 namespace hapticsim {
 namespace {
 
@@ -36,13 +38,7 @@ std::optional<std::int32_t> WholeNumber(const std::string& word) {
 
 // A word of the requester's, as it may be shown in an answer or the log: at most 40 characters,
 // printable ones only (no terminal escapes).
-std::string Shown(const std::string& word) {
-  std::string shown = word.substr(0, 40);
-  for (char& c : shown) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-  }
-  return shown;
-}
+std::string Shown(const std::string& word) { return shm::Printable(word.substr(0, 40)); }
 
 }  // namespace
 

@@ -26,11 +26,7 @@ std::string SendControlRequest(const std::string& path, const std::string& line,
   const ssize_t n = recv(connection.get(), text, sizeof text, MSG_DONTWAIT);
   HAPTICSIM_THROW_UNLESS(
       n > 0, "hapticsimd at " + path + (sent ? " hung up without an answer" : " took no request"));
-  std::string answer(text, static_cast<std::size_t>(n));
-  for (char& c : answer) {  // the daemon's text, shown on a terminal: printable only
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-  }
-  return answer;
+  return Printable(std::string(text, static_cast<std::size_t>(n)));  // shown on a terminal
 }
 
 }  // namespace hapticsim::shm

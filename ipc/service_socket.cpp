@@ -277,10 +277,7 @@ MappedSegment ReadSessionAnswer(int connection, const std::string& path, int tim
   const std::string answer(text, static_cast<std::size_t>(length));
   if (answer.rfind(kRefusedPrefix, 0) == 0) {
     // The reason is the server's text: printable characters only reach the driver's log.
-    std::string why = answer.substr(std::strlen(kRefusedPrefix));
-    for (char& c : why) {
-      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-    }
+    const std::string why = Printable(answer.substr(std::strlen(kRefusedPrefix)));
     throw Error("hapticsimd at " + path + " refused this driver: " + why);
   }
   HAPTICSIM_THROW_UNLESS(answer == kSessionGreeting && passed.size() == 1 &&

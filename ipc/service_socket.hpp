@@ -101,6 +101,17 @@ class ServiceListener {
  */
 bool SendMessage(int socket, const std::string& text, int fd_to_pass = -1);
 
+/**
+ * `text` as it may be shown on a terminal or in a log when someone else wrote it: every byte
+ * outside printable ASCII becomes '?' (no terminal escapes).
+ */
+inline std::string Printable(std::string text) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  }
+  return text;
+}
+
 /** The daemon's answers: a session (sent with the segment attached), or a refusal and why. */
 std::string SessionGreeting();
 std::string Refusal(const std::string& why);
