@@ -411,6 +411,18 @@ int Serve(const Arguments& args) {
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
+  // Every thread's newest sign of life. New region threads, or ones just woken, get a moment
+  // before the check expects them to have run: read here, just before each check, so a command
+  // that woke the regions earlier in the same tick does not make them look stalled since sleep.
+  auto health_beats = [&](std::int64_t now) {
+    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
+      regions_since_ns = now;
+      health_reconfigurations = loop.reconfigurations();
+    }
+    health_asleep = loop.asleep();
+    return HealthBeats(loop, primary_period_s, io_alive_ns.load(std::memory_order_relaxed),
+                       regions_since_ns, chooser.running_since_ns(), mover.running_since_ns());
+  };
   // A checked command, from LCM or hapticsim ctl: acted on, and what happened in words (the
   // answer ctl prints; the log says it too).
   auto apply_command = [&](const command_t& command, const std::string& from) -> std::string {
@@ -420,9 +432,18 @@ int Serve(const Arguments& args) {
         target = checked.error_target_percent;
         decision.target_met = decision.have_map && decision.error_percent <= target;
         report_error();
-        spdlog::info(
-            "error target set to {} % by {}: the active configuration's {} % {}; choosing again",
-            target, from, decision.error_percent, decision.target_met ? "meets it" : "EXCEEDS it");
+        if (decision.have_map && decision.error_percent >= 0) {
+          spdlog::info(
+              "error target set to {} % by {}: the active configuration's {} % {}; choosing "
+              "again",
+              target, from, decision.error_percent,
+              decision.target_met ? "meets it" : "EXCEEDS it");
+        } else {
+          spdlog::info(
+              "error target set to {} % by {}: the active configuration's error is unknown (no "
+              "error map, or none for this node); choosing again",
+              target, from);
+        }
         choose_again(pinned);
         return "ok: error target " + FormatReal(target) + " %; choosing again";
       case CheckedCommand::Kind::kPinConfiguration:
@@ -532,13 +553,6 @@ int Serve(const Arguments& args) {
       }
     }
     // Rejections: at most log.max_lines_per_s lines each; the counts are in every status message.
-    // New region threads, or ones just woken, get a moment before the health check expects
-    // them to have run.
-    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
-      regions_since_ns = now;
-      health_reconfigurations = loop.reconfigurations();
-    }
-    health_asleep = loop.asleep();
     auto line_due = [&](std::int64_t last_line_ns) {
       return (now - last_line_ns) * 1e-9 >= 1.0 / config.max_log_lines_per_s;
     };
@@ -763,11 +777,7 @@ int Serve(const Arguments& args) {
         status_t status =
             MakeStatus(loop, snapshots, shown, target, pinned.has_value(), map.path, &counters);
         status.input_owner = DeviceInputOf(config);
-        status.stalled_threads = DescribeStalls(
-            StalledThreads(HealthBeats(loop, primary_period_s, io_alive_ns.load(),
-                                       regions_since_ns, chooser.running_since_ns(),
-                                       mover.running_since_ns()),
-                           now));
+        status.stalled_threads = DescribeStalls(StalledThreads(health_beats(now), now));
         bridge->PostStatus(status);
       }
     }
@@ -775,10 +785,7 @@ int Serve(const Arguments& args) {
     // thread (no force computed, or none reaching the device) stops the watchdog pings, so
     // systemd restarts the daemon; a stalled secondary is rendered around (the primary holds its
     // boundary, every answer flagged boundary stale); a job that never ends is reported.
-    const std::vector<Stall> stalls = StalledThreads(
-        HealthBeats(loop, primary_period_s, io_alive_ns.load(std::memory_order_relaxed),
-                    regions_since_ns, chooser.running_since_ns(), mover.running_since_ns()),
-        now);
+    const std::vector<Stall> stalls = StalledThreads(health_beats(now), now);
     // Said when the set of stalled threads changes, and every 10 s while it lasts.
     std::string stalled_names;
     for (const Stall& stall : stalls) stalled_names += stall.name + ";";
