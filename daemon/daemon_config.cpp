@@ -72,6 +72,7 @@ const std::map<std::string, Setter>& Setters() {
     text("lcm.status_channel", &DaemonConfig::status_channel);
     text("lcm.command_channel", &DaemonConfig::command_channel);
     flag("lcm.accept_commands", &DaemonConfig::lcm_accept_commands);
+    text("lcm.command_key_file", &DaemonConfig::lcm_command_key_file);
     flag("control.enabled", &DaemonConfig::control_enabled);
     text("control.socket", &DaemonConfig::control_socket);
     text("control.group", &DaemonConfig::control_group);
@@ -223,6 +224,12 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
                 " must be an absolute path of a socket file, at most 107 bytes (a Unix "
                 "socket's limit), e.g. \"/run/hapticsim/hapticsimd.sock\"");
   }
+  require(!(c.lcm_enabled && c.lcm_accept_commands) || !c.lcm_command_key_file.empty(),
+          "lcm.accept_commands = true needs lcm.command_key_file: commands on LCM are taken only "
+          "when signed with a key the sender shares (make one with `hapticsim ctl --make-key "
+          "FILE`), or use hapticsim ctl over the control socket instead");
+  require(c.lcm_command_key_file.empty() || c.lcm_command_key_file[0] == '/',
+          "lcm.command_key_file must be an absolute path");
   require(!(c.shm_enabled && c.control_enabled && c.shm_socket == c.control_socket),
           "shm.socket and control.socket must be different files");
   const std::string url_problem = LcmUrlProblem(c.lcm_url, c.lcm_allow_network);
@@ -378,7 +385,9 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "status_channel = " << quote(c.status_channel) << "\n"
       << "command_channel = " << quote(c.command_channel) << "\n"
       << "accept_commands = " << (c.lcm_accept_commands ? "true" : "false")
-      << "  # commands come from hapticsim ctl ([control]); true: from anyone on the bus too\n\n"
+      << "  # commands come from hapticsim ctl ([control]); true: signed LCM commands too\n"
+      << "command_key_file = " << quote(c.lcm_command_key_file)
+      << "  # the key signed LCM commands share (hapticsim ctl --make-key FILE)\n\n"
       << "[control]  # hapticsim ctl: reset, pin, release, set-error-target\n"
       << "enabled = " << (c.control_enabled ? "true" : "false") << "\n"
       << "socket = " << quote(c.control_socket) << "\n"

@@ -29,7 +29,10 @@ struct DaemonConfig {
   std::string command_channel = "HAPTIC_COMMAND";
   /// Commands on command_channel are refused unless this is set: anyone who can send on the bus
   /// could otherwise reset the simulation or pin a configuration. `hapticsim ctl` uses [control].
+  /// Set, only commands signed with the key in lcm_command_key_file are taken
+  /// (ipc/command_signature.hpp).
   bool lcm_accept_commands = false;
+  std::string lcm_command_key_file;  ///< the shared key of signed LCM commands (64 hex digits)
   // [control]: hapticsim ctl's Unix socket, where state-changing commands come from
   bool control_enabled = true;
   std::string control_socket = "/run/hapticsim/control.sock";

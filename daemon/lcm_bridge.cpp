@@ -8,12 +8,14 @@
 
 namespace hapticsim {
 
-LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters)
+LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters,
+                     std::optional<SignedCommandGate> gate)
     : config_(config),
       counters_(counters),
       lcm_(config.lcm_url),
       intake_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s, loop,
-              counters, DeviceInputOf(config) == "lcm") {
+              counters, DeviceInputOf(config) == "lcm"),
+      gate_(std::move(gate)) {
   if (!lcm_.good()) {
     throw Error("LCM could not start on " + config.lcm_url +
                 " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
@@ -39,8 +41,22 @@ void LcmBridge::OnCommand(const lcm::ReceiveBuffer* buffer, const std::string&) 
     return;
   }
   counters_.commands_received.fetch_add(1);
+  std::string refusal = gate_ ? gate_->Refusal(command, CommandClockUs())
+                              : "lcm.accept_commands is false (use hapticsim ctl)";
   std::lock_guard lock(mutex_);
-  if (commands_.size() < 100) commands_.push_back(command);
+  if (refusal.empty() && commands_.size() >= 100) refusal = "more than 100 commands waiting";
+  if (!refusal.empty()) {
+    counters_.commands_refused.fetch_add(1);
+    ++refusals_.count;
+    refusals_.last_reason = std::move(refusal);
+    return;
+  }
+  commands_.push_back(command);
+}
+
+LcmBridge::Refusals LcmBridge::CommandRefusals() {
+  std::lock_guard lock(mutex_);
+  return refusals_;
 }
 
 void LcmBridge::Publish(const ForceRecord& record) {

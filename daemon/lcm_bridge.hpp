@@ -5,6 +5,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <optional>
+#include <string>
 
 #include "daemon/daemon_config.hpp"
 #include "daemon/haptic_loop.hpp"
@@ -12,20 +13,27 @@
 #include "daemon/input_intake.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "ipc/command_signature.hpp"
 
 namespace hapticsim {
 
 /**
  * The LCM side of the I/O thread: decodes device inputs and commands itself (so a malformed
  * message or one with the wrong fingerprint is counted, not just printed by LCM), checks inputs
- * through its InputIntake, publishes forces and the status
- * the supervisor posts. Poll/Publish are called from the I/O thread only; PostStatus and
- * PopCommand from the supervisor.
+ * through its InputIntake, publishes forces and the status the supervisor posts. Commands pass
+ * the signature gate here, as they arrive: one that is refused (unsigned, forged, replayed, or
+ * any when commands on LCM are off) is counted and dropped before it can take a place in the
+ * queue, so a flood of forgeries cannot crowd out a signed command. Poll/Publish are called from
+ * the I/O thread only; PostStatus, PopCommand and Refusals from the supervisor.
  */
 class LcmBridge {
  public:
-  /** @throws Error when LCM cannot be set up on the URL (the message says what to check). */
-  LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters);
+  /**
+   * `gate`: the commands to take (lcm.accept_commands); none, every command is refused.
+   * @throws Error when LCM cannot be set up on the URL (the message says what to check).
+   */
+  LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters,
+            std::optional<SignedCommandGate> gate);
 
   /** Handles the messages that arrive within `timeout`. */
   void Poll(const timespec& timeout);
@@ -35,6 +43,13 @@ class LcmBridge {
   void PostStatus(const status_t& status);
   std::optional<command_t> PopCommand();
 
+  /** Commands refused so far, and why the newest was. */
+  struct Refusals {
+    std::int64_t count = 0;
+    std::string last_reason;
+  };
+  Refusals CommandRefusals();
+
  private:
   void OnDevice(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void OnCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel);
@@ -43,9 +58,11 @@ class LcmBridge {
   InputCounters& counters_;
   lcm::LCM lcm_;
   InputIntake intake_;
-  std::mutex mutex_;  // guards the two queues below (never touched by real-time threads)
+  std::optional<SignedCommandGate> gate_;  // the I/O thread's alone
+  std::mutex mutex_;  // guards what follows (never touched by real-time threads)
   std::optional<status_t> status_;
   std::deque<command_t> commands_;
+  Refusals refusals_;
 };
 
 }  // namespace hapticsim

@@ -25,6 +25,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -49,6 +50,7 @@
 #include "daemon/supervisor.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "daemon/thread_health.hpp"
+#include "ipc/command_signature.hpp"
 
 namespace hapticsim {
 namespace {
@@ -133,6 +135,18 @@ std::int32_t DecisionFlags(const SupervisorDecision& d) {
   return flags;
 }
 
+// With lcm.accept_commands, the gate that takes signed LCM commands only; without, none.
+// @throws Error when the key file is missing, readable by others or malformed.
+std::optional<SignedCommandGate> LcmCommandGateOf(const DaemonConfig& config) {
+  if (!config.lcm_enabled || !config.lcm_accept_commands) return std::nullopt;
+  try {
+    return SignedCommandGate(ReadCommandKey(config.lcm_command_key_file), config.command_channel,
+                             CommandClockUs());
+  } catch (const Error& e) {
+    throw Error(std::string("lcm.command_key_file: ") + e.what());
+  }
+}
+
 int Serve(const Arguments& args) {
   DaemonConfig config;
   const bool default_missing =
@@ -152,6 +166,7 @@ int Serve(const Arguments& args) {
           throw Error(std::string("supervisor.error_map: ") + e.what());
         }
       }
+      (void)LcmCommandGateOf(config);  // and the key of signed LCM commands
       std::cout << "hapticsimd: configuration "
                 << (default_missing ? "(built-in defaults; " + args.config + " does not exist)"
                                     : args.config)
@@ -200,7 +215,7 @@ int Serve(const Arguments& args) {
   InputCounters counters;
   std::unique_ptr<LcmBridge> bridge;
   if (config.lcm_enabled) {
-    bridge = std::make_unique<LcmBridge>(config, loop, counters);
+    bridge = std::make_unique<LcmBridge>(config, loop, counters, LcmCommandGateOf(config));
     spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
                  config.device_channel, config.force_channel, config.status_channel,
                  config.command_channel);
@@ -230,11 +245,11 @@ int Serve(const Arguments& args) {
       spdlog::warn("no hapticsim ctl: {}; serving on without commands", e.what());
     }
   }
-  if (config.lcm_enabled && config.lcm_accept_commands) {
+  if (bridge && config.lcm_accept_commands) {
     spdlog::warn(
-        "commands on {} are ACCEPTED from anyone who can send on the LCM bus "
-        "(lcm.accept_commands = true)",
-        config.command_channel);
+        "commands on {} are accepted when signed with the key in {} (lcm.accept_commands = "
+        "true): whoever can read that file can command the daemon",
+        config.command_channel, config.lcm_command_key_file);
   }
   if (bridge || shm) {
     spdlog::info(
@@ -309,7 +324,7 @@ int Serve(const Arguments& args) {
   std::string reported_stalls;  // the stalled threads' names as last logged and told to systemd
   std::int64_t wrong_transport_seen = 0;
   CommandRateLimit command_limit, ctl_limit;  // one each: an LCM flood cannot crowd out ctl
-  std::int64_t last_command_refusal_ns = 0, lcm_commands_refused = 0;
+  std::int64_t last_command_refusal_ns = 0, lcm_refusals_logged = 0;
   std::int64_t control_refused_seen = 0, control_refused_logged = 0;
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
@@ -576,19 +591,14 @@ int Serve(const Arguments& args) {
           InputRejectionName(rejection), counters.inputs_rejected.load());
     }
     if (bridge) {
+      if (const LcmBridge::Refusals refusals = bridge->CommandRefusals();
+          refusals.count != lcm_refusals_logged && line_due(last_command_refusal_ns)) {
+        last_command_refusal_ns = now;
+        lcm_refusals_logged = refusals.count;
+        spdlog::warn("command on {} refused: {}; {} refused so far", config.command_channel,
+                     refusals.last_reason, refusals.count);
+      }
       while (std::optional<command_t> command = bridge->PopCommand()) {
-        if (!config.lcm_accept_commands) {
-          ++lcm_commands_refused;
-          counters.commands_refused.fetch_add(1);
-          if (line_due(last_command_refusal_ns)) {
-            last_command_refusal_ns = now;
-            spdlog::warn(
-                "command on {} refused: lcm.accept_commands is false (use hapticsim ctl); {} "
-                "refused so far",
-                config.command_channel, lcm_commands_refused);
-          }
-          continue;
-        }
         if (!command_limit.Admit(now)) {
           counters.commands_refused.fetch_add(1);
           if (line_due(last_command_refusal_ns)) {

@@ -1,6 +1,7 @@
 // Fuzz target: what the daemon does with the bytes of an LCM message. The first byte picks the
 // channel (device input or command); the rest is decoded by the generated code exactly as
-// LcmBridge does, then checked as the daemon checks it (InputGuard, CheckCommand).
+// LcmBridge does, then checked as the daemon checks it (the signature gate, InputGuard,
+// CheckCommand).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include "daemon/input_guard.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"
+#include "ipc/command_signature.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
@@ -33,6 +35,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } else {
     hapticsim::command_t command{};
     if (command.decode(bytes, 0, length) < 0) return 0;
+    // Fuzzed bytes do not know the key: the gate must refuse them all, with a reason.
+    static hapticsim::SignedCommandGate gate(hapticsim::CommandKey{1, 2, 3}, "HAPTIC_COMMAND", 0);
+    if (gate.Refusal(command, command.utime).empty()) __builtin_trap();
     const hapticsim::CheckedCommand checked = hapticsim::CheckCommand(command, 1000.0);
     using Kind = hapticsim::CheckedCommand::Kind;
     if (checked.kind == Kind::kSetErrorTarget &&

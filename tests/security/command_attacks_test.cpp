@@ -19,6 +19,7 @@
 
 #include "core/error.hpp"
 #include "hapticsim/command_t.hpp"
+#include "ipc/command_signature.hpp"
 #include "ipc/control_client.hpp"
 #include "ipc/unique_fd.hpp"
 #include "tests/security/hostile_neighbour.hpp"
@@ -72,6 +73,95 @@ TEST_F(HostileNeighbour, CommandsOnLcmAreRefusedByDefaultAndCounted) {
             "ok: the simulation restarts from rest");
   EXPECT_TRUE(monitor_.WaitForStatus(
       [&](const status_t& s) { return s.reconfigurations > before.reconfigurations; }, 2));
+}
+
+// Commands on LCM switched on (lcm.accept_commands, lcm.command_key_file): the daemon takes only
+// commands signed with its key, fresh, and each once. The attacker on the bus sends unsigned
+// commands, commands signed with its own key, and plays back every command it overhears, as it
+// was and with a field changed. The operator's `hapticsim ctl --lcm` gets through, once.
+class SignedLcmCommands : public HostileNeighbour {
+ protected:
+  std::string MoreLcmKeys() override {
+    if (key_.empty()) {  // one key for the daemon's life
+      key_ = security::Temp(Name() + ".key");
+      std::filesystem::remove(key_);
+      WriteNewCommandKey(key_);
+    }
+    return "accept_commands = true\ncommand_key_file = \"" + key_ + "\"\n";
+  }
+  std::string key_;
+};
+
+TEST_F(SignedLcmCommands, OnlyFreshCommandsSignedWithTheKeyAreTakenAndEachOnce) {
+  const std::int64_t quiet = MissesOver(Quiet);
+  const status_t before = *monitor_.LastStatus();
+  pid_t attacker = -1;
+  testing::CommandResult reset, target;
+  const std::int64_t attacked = MissesOver([&] {
+    attacker = Spawn([] {
+      lcm::LCM bus("udpm://239.255.76.67:7667?ttl=0");
+      if (!bus.good()) return 10;
+      std::vector<command_t> overheard;
+      struct Ear {
+        std::vector<command_t>* heard;
+        void On(const lcm::ReceiveBuffer*, const std::string&, const command_t* c) {
+          heard->push_back(*c);
+        }
+      } ear{&overheard};
+      bus.subscribe("HAPTIC_COMMAND", &Ear::On, &ear);
+      CommandKey own{};  // the attacker's key: not the daemon's
+      own.fill(0x5a);
+      command_t reset{};
+      reset.command = command_t::RESET;
+      int replays = 0;
+      const auto end = Clock::now() + kWindow;
+      for (int k = 0; Clock::now() < end; ++k) {
+        while (bus.handleTimeout(0) > 0) {
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        command_t forged = reset;
+        forged.utime = CommandClockUs();
+        if (k % 2) SignCommand(&forged, "HAPTIC_COMMAND", own);
+        bus.publish("HAPTIC_COMMAND", &forged);
+        for (std::size_t h = 0; h < overheard.size() && h < 8; ++h) {
+          command_t again = overheard[h];
+          if (again.mac[0] == 0 && again.mac[1] == 0) continue;  // its own unsigned ones
+          bus.publish("HAPTIC_COMMAND", &again);                 // as heard
+          again.error_target_percent = 50;                       // and changed
+          bus.publish("HAPTIC_COMMAND", &again);
+          ++replays;
+        }
+      }
+      return replays > 0 ? 0 : 11;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    reset = testing::RunCommand({HAPTICSIM_PATH, "ctl", "--lcm", "--key-file", key_, "reset"});
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    target = testing::RunCommand(
+        {HAPTICSIM_PATH, "ctl", "--lcm", "--key-file", key_, "set-error-target", "12"});
+    std::this_thread::sleep_for(kWindow);
+  });
+  ASSERT_EQ(reset.exit_status, 0) << reset.err;
+  ASSERT_EQ(target.exit_status, 0) << target.err;
+  EXPECT_NE(reset.out.find("sent, signed, on HAPTIC_COMMAND"), std::string::npos) << reset.out;
+  ASSERT_EQ(ExitStatusOf(attacker), 0) << "the attacker overheard nothing to play back";
+  ASSERT_TRUE(daemon_->running()) << daemon_->Log();
+  EXPECT_LE(attacked, MissBound(quiet)) << "quiet: " << quiet;
+  ASSERT_TRUE(monitor_.WaitForStatus(
+      [](const status_t& s) { return s.error_target_percent == 12 && s.commands_refused >= 50; },
+      2))
+      << daemon_->Log();
+  const status_t after = *monitor_.LastStatus();
+  EXPECT_EQ(after.reconfigurations - before.reconfigurations, 1)
+      << "the operator's RESET once, and none of the attacker's or of its replays";
+  const std::string log = daemon_->Log();
+  // The RESET woke the sleeping regions within a supervisor tick: that is not a stall since the
+  // regions went to sleep (the health check said so, 2.2 s, until it read the wake first).
+  EXPECT_EQ(daemon_->Log().find("health: stalled"), std::string::npos) << daemon_->Log();
+  // The log names the refusals at a limited rate: the replays' own lines may be crowded out.
+  for (const char* said : {"accepted when signed with the key in", "signature does not match"}) {
+    EXPECT_NE(log.find(said), std::string::npos) << said << "\n" << log;
+  }
 }
 
 // Even with the control socket opened to everyone by mistake, another user is refused: the

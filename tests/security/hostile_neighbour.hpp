@@ -54,13 +54,10 @@ class HostileNeighbour : public ::testing::Test {
   void SetUp() override {
     socket_ = testing::PrivateSocketPath();
     control_ = std::filesystem::path(socket_).parent_path() / "control.sock";
-    const std::string config = Temp(Name() + ".toml");
-    std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
-                          << "[supervisor]\nstatus_rate_hz = 20\n"
-                          << "[shm]\nenabled = true\nsocket = \"" << socket_ << "\"\n"
-                          << "[control]\nsocket = \"" << control_ << "\"\n";
+    config_ = Temp(Name() + ".toml");
+    WriteConfig();
     daemon_ = std::make_unique<testing::BackgroundProcess>(
-        std::vector<std::string>{HAPTICSIMD_PATH, "--config", config}, Temp(Name() + ".log"));
+        std::vector<std::string>{HAPTICSIMD_PATH, "--config", config_}, Temp(Name() + ".log"));
     ASSERT_NO_FATAL_FAILURE(testing::WaitUntilServing(*daemon_));
     ASSERT_TRUE(monitor_.WaitForStatus([](const status_t&) { return true; }, 10)) << daemon_->Log();
   }
@@ -69,6 +66,18 @@ class HostileNeighbour : public ::testing::Test {
     EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
     std::filesystem::remove_all(std::filesystem::path(socket_).parent_path());
   }
+  // The daemon's config: sockets in the private directory, status at 20 Hz, and what is given.
+  void WriteConfig(const std::string& lcm_url = "udpm://239.255.76.67:7667?ttl=0",
+                   const std::string& supervisor_keys = "", const std::string& tables = "") {
+    std::ofstream(config_) << "[lcm]\nurl = \"" << lcm_url << "\"\n"
+                           << MoreLcmKeys() << "[supervisor]\nstatus_rate_hz = 20\n"
+                           << supervisor_keys << "[shm]\nenabled = true\nsocket = \"" << socket_
+                           << "\"\n"
+                           << "[control]\nsocket = \"" << control_ << "\"\n"
+                           << tables;
+  }
+  /** Keys added to the daemon's [lcm] table, one "key = value\n" each. */
+  virtual std::string MoreLcmKeys() { return ""; }
   static std::string Name() {
     return ::testing::UnitTest::GetInstance()->current_test_info()->name();
   }
@@ -119,6 +128,7 @@ class HostileNeighbour : public ::testing::Test {
 
   std::string socket_;   // shm.socket
   std::string control_;  // control.socket, beside it
+  std::string config_;   // the daemon's config file
   testing::Client monitor_;
   std::unique_ptr<testing::BackgroundProcess> daemon_;
 };

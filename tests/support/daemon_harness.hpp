@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "hapticsim/command_t.hpp"
+#include "ipc/command_signature.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
@@ -72,7 +73,14 @@ class Client {
   void SendRaw(const std::string& bytes) {
     lcm_.publish("HAPTIC_DEVICE", bytes.data(), static_cast<unsigned>(bytes.size()));
   }
+  /** Sends `command` as it is (signed or not). */
   void Command(const command_t& command) { lcm_.publish("HAPTIC_COMMAND", &command); }
+  /** Stamps `command` with the wall clock and signs it with `key`, as hapticsim ctl --lcm does. */
+  void SignedCommand(command_t command, const CommandKey& key) {
+    command.utime = CommandClockUs();
+    SignCommand(&command, "HAPTIC_COMMAND", key);
+    Command(command);
+  }
 
   std::vector<force_feedback_t> Forces() {
     std::lock_guard lock(mutex_);
