@@ -30,13 +30,21 @@ namespace hapticsim {
  *
  * At destruction the thread is asked to stop and joined; a job still running after
  * kJoinWait_s (an estimate can take a minute) is left to the process's exit, so that shutdown
- * never waits for it. Jobs must therefore own everything they touch (capture by value). (Not
- * yet: cancelling a running estimate. A job left running while the process exits may still read
- * a static the exit is destroying — the scene's key table — a small window, not closed.)
+ * never waits for it. Jobs must therefore own everything they touch (capture by value). A job
+ * so left may still read statics (the scene's key table), so the process must then end without
+ * destroying them: AJobWasLeftRunning() tells main to leave by std::_Exit. (Not yet: cancelling
+ * a running estimate.)
  *
  * Submit and Take are for one thread (the supervisor's); they take a mutex the worker holds only
  * to hand jobs and outcomes over.
  */
+/** Whether a BackgroundWorker was destroyed with its job still running (see below). */
+inline std::atomic<bool>& JobLeftRunningFlag() {
+  static std::atomic<bool> left{false};  // trivially destructible: safe to read at exit
+  return left;
+}
+inline bool AJobWasLeftRunning() { return JobLeftRunningFlag().load(); }
+
 template <typename Result>
 class BackgroundWorker {
  public:
@@ -71,6 +79,7 @@ class BackgroundWorker {
       thread_.join();
     } else {
       thread_.detach();  // the shared state outlives us; the process's exit ends the job
+      JobLeftRunningFlag().store(true);
     }
   }
 

@@ -20,6 +20,8 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -854,7 +856,15 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    return hapticsim::Serve(args);
+    const int status = hapticsim::Serve(args);
+    if (hapticsim::AJobWasLeftRunning()) {
+      // A stability estimate still runs on a worker that shutdown did not wait for: leave
+      // without running static destructors under it (the log is flushed first).
+      spdlog::shutdown();
+      std::fflush(nullptr);
+      std::_Exit(status);
+    }
+    return status;
   } catch (const hapticsim::Error& e) {
     std::cerr << "hapticsimd: error: " << e.what() << "\n";
     return 2;

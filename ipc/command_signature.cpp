@@ -145,9 +145,13 @@ std::string SignedCommandGate::Refusal(const command_t& command, std::int64_t no
     return "its signature does not match lcm.command_key_file (unsigned, another key, or "
            "changed on the way)";
   }
-  const std::int64_t age_us = now_us - command.utime;
+  // In long double: a utime near either end of int64 must not overflow the difference.
+  const long double age_us =
+      static_cast<long double>(now_us) - static_cast<long double>(command.utime);
   if (age_us > kCommandFreshnessUs || age_us < -kCommandFreshnessUs) {
-    return "signed " + std::to_string(age_us / 1000) + " ms from the daemon's clock (at most " +
+    char age_ms[32];
+    std::snprintf(age_ms, sizeof age_ms, "%.0Lf", age_us / 1000);
+    return std::string("signed ") + age_ms + " ms from the daemon's clock (at most " +
            std::to_string(kCommandFreshnessUs / 1000) +
            " ms either way): stale, replayed, or a clock to set";
   }

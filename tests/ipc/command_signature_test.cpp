@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,13 @@ TEST(CommandSignature, TheGateTakesAFreshSignedCommandOnceAndNothingElse) {
       << "from the future";
   EXPECT_EQ(gate.Refusal(signed_at(now + kCommandFreshnessUs, CountingKey()), now), "")
       << "at the edge of the window";
+  // A signed utime at either end of int64: refused, without overflow (UBSan checks the build).
+  for (std::int64_t utime :
+       {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()}) {
+    EXPECT_NE(gate.Refusal(signed_at(utime, CountingKey()), now).find("ms from the daemon's clock"),
+              std::string::npos)
+        << utime;
+  }
   // Recorded before the daemon started, played within the window after a restart: refused.
   SignedCommandGate restarted(CountingKey(), "HAPTIC_COMMAND", start);
   EXPECT_NE(restarted.Refusal(signed_at(start - 1, CountingKey()), start + 1000).find("a replay"),

@@ -90,6 +90,8 @@ TEST(BackgroundWorker, DestructionDoesNotWaitForALongJob) {
   }
   const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_LT(waited_s, BackgroundWorker<int>::kJoinWait_s + 0.5);
+  // The daemon is told, so that it leaves by _Exit instead of destroying statics the job reads.
+  EXPECT_TRUE(AJobWasLeftRunning());
   // An idle worker is joined at once.
   const auto idle_start = Clock::now();
   { BackgroundWorker<int> idle("test-worker"); }
