@@ -1,12 +1,49 @@
 #include "daemon/lcm_bridge.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdlib>
 
 #include "core/error.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 
 namespace hapticsim {
+
+std::string MulticastSourceOffLoopback(const std::string& url) {
+  const std::string scheme = "udpm://";
+  if (url.rfind(scheme, 0) != 0) return "";
+  const std::string rest = url.substr(scheme.size());
+  const std::size_t host_end = rest.find_first_of(":?/");
+  std::string group = rest.substr(0, host_end);
+  int port = 7667;  // LCM's defaults
+  if (group.empty()) group = "239.255.76.67";
+  if (host_end != std::string::npos && rest[host_end] == ':') {
+    port = std::atoi(rest.c_str() + host_end + 1);
+  }
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port > 0 && port < 65536 ? port : 7667));
+  if (inet_pton(AF_INET, group.c_str(), &to.sin_addr) != 1) return "";
+  const int probe = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (probe < 0) return "";
+  sockaddr_in from{};
+  socklen_t length = sizeof from;
+  const bool routed = connect(probe, reinterpret_cast<sockaddr*>(&to), sizeof to) == 0 &&
+                      getsockname(probe, reinterpret_cast<sockaddr*>(&from), &length) == 0;
+  close(probe);
+  // 0.0.0.0: no source chosen yet (a route on lo without one; the kernel picks 127.0.0.1 when
+  // sending), so nothing to say.
+  const std::uint32_t source = ntohl(from.sin_addr.s_addr);
+  if (!routed || source == INADDR_ANY || (source >> 24) == 127) return "";
+  char text[INET_ADDRSTRLEN] = "";
+  inet_ntop(AF_INET, &from.sin_addr, text, sizeof text);
+  return text;
+}
 
 LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters& counters,
                      std::optional<SignedCommandGate> gate)

@@ -18,6 +18,16 @@
 namespace hapticsim {
 
 /**
+ * For a udpm:// URL, the source address this host's multicast to the group carries, when that is
+ * not a loopback address: the group is then routed through another interface, so machines on
+ * that network can send to the daemon, and a unit whose IP filter admits only localhost
+ * (IPAddressAllow=localhost) drops local clients' packets too, which carry that address. Empty
+ * when the group is routed through loopback, for other providers, or when it cannot be told.
+ * Sends nothing (a connected UDP socket only asks the kernel for the route).
+ */
+std::string MulticastSourceOffLoopback(const std::string& url);
+
+/**
  * The LCM side of the I/O thread: decodes device inputs and commands itself (so a malformed
  * message or one with the wrong fingerprint is counted, not just printed by LCM), checks inputs
  * through its InputIntake, publishes forces and the status the supervisor posts. Commands pass

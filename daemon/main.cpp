@@ -221,6 +221,14 @@ int Serve(const Arguments& args) {
     spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
                  config.device_channel, config.force_channel, config.status_channel,
                  config.command_channel);
+    if (const std::string source = MulticastSourceOffLoopback(config.lcm_url); !source.empty()) {
+      spdlog::warn(
+          "LCM's multicast group is routed off loopback (source address {}): machines on that "
+          "network can send device input to the daemon, and under the systemd unit, whose IP "
+          "filter admits only localhost, local LCM clients' packets (source {}) are dropped. "
+          "Route the group through loopback: ip route add 224.0.0.0/4 dev lo",
+          source, source);
+    }
     if (LcmUrlLeavesHost(config.lcm_url)) {
       spdlog::warn(
           "LCM traffic LEAVES THIS HOST (lcm.url = {}, allowed by lcm.allow_network = true): any "

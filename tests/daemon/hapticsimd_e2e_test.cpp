@@ -541,6 +541,31 @@ TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSai
   EXPECT_EQ(daemon.Wait(10), 0) << daemon.Log();
 }
 
+// LCM joins its group on whatever interface the multicast route names. On a desktop that is the
+// Ethernet card: machines on the LAN can then send device input to the daemon, and the systemd
+// unit's IP filter (localhost only, by source address) drops local clients' packets, which carry
+// the card's address. Said at start, naming the address; not said when the route is on lo. Each
+// run is in a network namespace of its own, inside the test's: lo also holds 10.9.0.1, the
+// source the route gives, as an Ethernet card's address would be.
+TEST(HapticsimdConfig, AMulticastGroupRoutedOffLoopbackIsSaidAtStart) {
+  const std::string daemon = std::string("exec ") + HAPTICSIMD_PATH + " --duration 1";
+  const auto off = testing::RunCommand({"/usr/bin/unshare", "-rn", "/bin/sh", "-c",
+                                        "ip link set lo up && ip addr add 10.9.0.1/32 dev lo && "
+                                        "ip route add 224.0.0.0/4 dev lo src 10.9.0.1 && " +
+                                            daemon});
+  EXPECT_EQ(off.exit_status, 0) << off.err;
+  EXPECT_NE(off.err.find("multicast group is routed off loopback (source address 10.9.0.1)"),
+            std::string::npos)
+      << off.err;
+  EXPECT_NE(off.err.find("ip route add 224.0.0.0/4 dev lo"), std::string::npos) << off.err;
+  const auto on =
+      testing::RunCommand({"/usr/bin/unshare", "-rn", "/bin/sh", "-c",
+                           "ip link set lo up && ip route add 224.0.0.0/4 dev lo && " + daemon});
+  EXPECT_EQ(on.exit_status, 0) << on.err;
+  EXPECT_NE(on.err.find("serving"), std::string::npos) << on.err;
+  EXPECT_EQ(on.err.find("routed off loopback"), std::string::npos) << on.err;
+}
+
 using testing::ThreadsOf;
 
 // A flood of commands from any local process: pins at 1 kHz of a configuration whose
