@@ -440,13 +440,15 @@ int Serve(const Arguments& args) {
   // before the check expects them to have run: read here, just before each check, so a command
   // that woke the regions earlier in the same tick does not make them look stalled since sleep.
   auto health_beats = [&](std::int64_t now) {
-    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !loop.asleep())) {
+    const bool asleep = loop.asleep();  // read once: a wake between two reads would be missed
+    if (loop.reconfigurations() != health_reconfigurations || (health_asleep && !asleep)) {
       regions_since_ns = now;
       health_reconfigurations = loop.reconfigurations();
     }
-    health_asleep = loop.asleep();
+    health_asleep = asleep;
     return HealthBeats(loop, primary_period_s, io_alive_ns.load(std::memory_order_relaxed),
-                       regions_since_ns, chooser.running_since_ns(), mover.running_since_ns());
+                       regions_since_ns, asleep, chooser.running_since_ns(),
+                       mover.running_since_ns());
   };
   // A checked command, from LCM or hapticsim ctl: acted on, and what happened in words (the
   // answer ctl prints; the log says it too).

@@ -9,7 +9,8 @@ namespace hapticsim {
 
 std::vector<ThreadBeat> HealthBeats(HapticLoop& loop, double primary_period_s,
                                     std::int64_t io_alive_ns, std::int64_t regions_since_ns,
-                                    std::int64_t choice_since_ns, std::int64_t verify_since_ns) {
+                                    bool regions_asleep, std::int64_t choice_since_ns,
+                                    std::int64_t verify_since_ns) {
   std::vector<ThreadBeat> beats;
   beats.push_back({"primary (hsim-primary)", loop.primary_alive_ns(),
                    std::max(0.1, 50 * primary_period_s), true, true});
@@ -18,7 +19,7 @@ std::vector<ThreadBeat> HealthBeats(HapticLoop& loop, double primary_period_s,
   for (int r = 1; r < regions.num_regions(); ++r) {
     beats.push_back({regions.partition().RegionName(r) + " (hsim-region" + std::to_string(r) + ")",
                      std::max(loop.monitor(r).last_done_ns(), regions_since_ns), 0.5,
-                     !loop.asleep(), false});
+                     !regions_asleep, false});
   }
   constexpr double kLongestJob_s = 300;
   beats.push_back({"hsim-choose", choice_since_ns, kLongestJob_s, choice_since_ns != 0, false});

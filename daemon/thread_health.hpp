@@ -30,12 +30,14 @@ class HapticLoop;
 /**
  * The daemon's threads as beats: the primary (0.1 s or 50 periods), the I/O thread (0.5 s,
  * `io_alive_ns`), each secondary while the regions are awake (0.5 s, counted from
- * `regions_since_ns` at the latest: new or just-woken threads get that long to run), and the
+ * `regions_since_ns` at the latest: new or just-woken threads get that long to run; the caller
+ * reads `regions_asleep` once, with the same read that decides regions_since_ns), and the
  * two background workers while a job runs (300 s: a stability estimate takes up to a minute).
  */
 std::vector<ThreadBeat> HealthBeats(HapticLoop& loop, double primary_period_s,
                                     std::int64_t io_alive_ns, std::int64_t regions_since_ns,
-                                    std::int64_t choice_since_ns, std::int64_t verify_since_ns);
+                                    bool regions_asleep, std::int64_t choice_since_ns,
+                                    std::int64_t verify_since_ns);
 
 /** The expected beats silent for longer than they may be at `now_ns`, in the order given. */
 std::vector<Stall> StalledThreads(const std::vector<ThreadBeat>& beats, std::int64_t now_ns);

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <optional>
 #include <vector>
 
 #include "core/error.hpp"
@@ -30,7 +31,10 @@ std::string Octal(mode_t mode) {
   return text;
 }
 
-Mac MacOf(const command_t& command, const std::string& channel, const CommandKey& key) {
+// The MAC of `command` as signed for `channel`; nothing when it cannot be computed, so that no
+// failure can make an all-zero MAC (an unsigned command's) count as valid.
+std::optional<Mac> MacOf(const command_t& command, const std::string& channel,
+                         const CommandKey& key) {
   command_t unsigned_copy = command;
   std::memset(unsigned_copy.mac, 0, sizeof unsigned_copy.mac);
   // The channel, a NUL, then the LCM encoding: a command signed for one channel is not valid on
@@ -38,12 +42,16 @@ Mac MacOf(const command_t& command, const std::string& channel, const CommandKey
   std::vector<unsigned char> message(channel.begin(), channel.end());
   message.push_back(0);
   const std::size_t head = message.size();
-  message.resize(head + static_cast<std::size_t>(unsigned_copy.getEncodedSize()));
-  unsigned_copy.encode(message.data() + head, 0, static_cast<int>(message.size() - head));
+  const int size = unsigned_copy.getEncodedSize();
+  message.resize(head + static_cast<std::size_t>(size));
+  if (unsigned_copy.encode(message.data() + head, 0, size) != size) return std::nullopt;
   Mac mac{};
   unsigned int length = 0;
-  HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), message.data(), message.size(),
-       mac.data(), &length);
+  if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), message.data(), message.size(),
+           mac.data(), &length) == nullptr ||
+      length != mac.size()) {
+    return std::nullopt;
+  }
   return mac;
 }
 
@@ -58,14 +66,28 @@ int HexDigit(char c) {
 
 CommandKey ReadCommandKey(const std::string& path) {
   const std::string what = "the command key file " + path;
-  shm::UniqueFd fd(open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK));
+  shm::UniqueFd fd(open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY));
   if (!fd) {
-    throw Error(what + " cannot be opened (" + std::strerror(errno) +
-                "); make one with `hapticsim ctl --make-key " + path + "`");
+    const int error = errno;
+    if (error == ENOENT) {
+      throw Error(what + " does not exist; make one with `hapticsim ctl --make-key " + path + "`");
+    }
+    if (error == EACCES) {
+      throw Error(what + " cannot be read by this process (uid " + std::to_string(geteuid()) +
+                  "); under systemd (DynamicUser) hand it to the service with LoadCredential= "
+                  "and name the copy in /run/credentials (docs/operations.md)");
+    }
+    if (error == ELOOP) throw Error(what + " is a symbolic link: name the file itself");
+    throw Error(what + " cannot be opened (" + std::strerror(error) + ")");
   }
   struct stat info {};
   if (fstat(fd.get(), &info) != 0 || !S_ISREG(info.st_mode)) {
     throw Error(what + " is not a regular file");
+  }
+  if (info.st_uid != 0 && info.st_uid != geteuid()) {
+    throw Error(what + " is owned by uid " + std::to_string(info.st_uid) +
+                ": only root or this process's user (uid " + std::to_string(geteuid()) +
+                ") may own it, as its owner can replace the key");
   }
   if (info.st_mode & 0027) {
     throw Error(what + " has mode " + Octal(info.st_mode) +
@@ -81,13 +103,16 @@ CommandKey ReadCommandKey(const std::string& path) {
     if (!std::isspace(static_cast<unsigned char>(text[k]))) digits += text[k];
   }
   CommandKey key{};
-  const bool hex = digits.size() == 2 * key.size() && got < static_cast<ssize_t>(sizeof text);
-  for (std::size_t k = 0; hex && k < key.size(); ++k) {
+  bool whole = digits.size() == 2 * key.size() && got < static_cast<ssize_t>(sizeof text);
+  for (std::size_t k = 0; whole && k < key.size(); ++k) {
     const int high = HexDigit(digits[2 * k]), low = HexDigit(digits[2 * k + 1]);
-    if (high < 0 || low < 0) break;
+    whole = high >= 0 && low >= 0;
     key[k] = static_cast<unsigned char>(high * 16 + low);
-    if (k + 1 == key.size()) return key;
   }
+  OPENSSL_cleanse(text, sizeof text);  // no copy of the key left behind but the one returned
+  OPENSSL_cleanse(digits.data(), digits.size());
+  if (whole) return key;
+  OPENSSL_cleanse(key.data(), key.size());
   throw Error(what + " must hold 64 hexadecimal digits (a 256-bit key), e.g. from `openssl " +
               "rand -hex 32` or `hapticsim ctl --make-key FILE`");
 }
@@ -111,9 +136,12 @@ void WriteNewCommandKey(const std::string& path) {
   }
   text += "\n";
   OPENSSL_cleanse(key.data(), key.size());
-  if (write(fd.get(), text.data(), text.size()) != static_cast<ssize_t>(text.size()) ||
-      fsync(fd.get()) != 0) {
-    const std::string reason = std::strerror(errno);
+  const bool written =
+      write(fd.get(), text.data(), text.size()) == static_cast<ssize_t>(text.size()) &&
+      fsync(fd.get()) == 0;
+  const std::string reason = std::strerror(errno);
+  OPENSSL_cleanse(text.data(), text.size());
+  if (!written) {
     unlink(path.c_str());
     throw Error("cannot write the key file " + path + " (" + reason + ")");
   }
@@ -126,18 +154,19 @@ std::int64_t CommandClockUs() {
 }
 
 void SignCommand(command_t* command, const std::string& channel, const CommandKey& key) {
-  const Mac mac = MacOf(*command, channel, key);
-  std::memcpy(command->mac, mac.data(), mac.size());
+  const std::optional<Mac> mac = MacOf(*command, channel, key);
+  if (!mac) throw Error("the command could not be signed (OpenSSL's HMAC-SHA256 failed)");
+  std::memcpy(command->mac, mac->data(), mac->size());
 }
 
 bool SignatureMatches(const command_t& command, const std::string& channel, const CommandKey& key) {
-  const Mac mac = MacOf(command, channel, key);
-  return CRYPTO_memcmp(mac.data(), command.mac, mac.size()) == 0;
+  const std::optional<Mac> mac = MacOf(command, channel, key);
+  return mac && CRYPTO_memcmp(mac->data(), command.mac, mac->size()) == 0;
 }
 
 SignedCommandGate::SignedCommandGate(const CommandKey& key, std::string channel,
                                      std::int64_t start_us)
-    : key_(key), channel_(std::move(channel)), last_accepted_us_(start_us) {}
+    : key_(key), channel_(std::move(channel)), start_us_(start_us) {}
 
 std::string SignedCommandGate::Refusal(const command_t& command, std::int64_t now_us) {
   // The signature first: nothing about an unsigned command may change what the gate remembers.
@@ -155,10 +184,23 @@ std::string SignedCommandGate::Refusal(const command_t& command, std::int64_t no
            std::to_string(kCommandFreshnessUs / 1000) +
            " ms either way): stale, replayed, or a clock to set";
   }
-  if (command.utime <= last_accepted_us_) {
-    return "not later than the last command taken (or the daemon's start): a replay";
+  if (command.utime <= start_us_) {
+    return "signed before the daemon started: a replay (or the wall clock stepped back)";
   }
-  last_accepted_us_ = command.utime;
+  // Only commands still within the window need remembering: older ones fail the check above.
+  std::erase_if(taken_, [&](const Taken& t) { return t.utime_us < now_us - kCommandFreshnessUs; });
+  for (const Taken& t : taken_) {
+    if (CRYPTO_memcmp(t.mac.data(), command.mac, t.mac.size()) == 0) {
+      return "taken before: a replay";
+    }
+  }
+  if (taken_.size() >= kMaxRemembered) {
+    return "more than " + std::to_string(kMaxRemembered) + " signed commands within " +
+           std::to_string(kCommandFreshnessUs / 1000) + " ms";
+  }
+  Taken taken{command.utime, {}};
+  std::memcpy(taken.mac.data(), command.mac, taken.mac.size());
+  taken_.push_back(taken);
   return "";
 }
 

@@ -52,7 +52,8 @@ std::string TempPath(const std::string& name) {
 // The wire format a sender in another language must reproduce, pinned by a value computed apart
 // from this code: Python's hmac over the LCM big-endian encoding written out by hand,
 //   struct.pack('>qqidiid', fingerprint, utime, 2, 0.0, 3, 2, 1000.0) + bytes(32),
-// after b"HAPTIC_COMMAND\0", with the key 00 01 02 … 1f (docs/operations.md shows the script).
+// the fingerprint as a signed int64, after b"HAPTIC_COMMAND\0", with the key 00 01 02 … 1f
+// (tools/sign_command.py, a sender's signing in Python, checks the same value).
 TEST(CommandSignature, MatchesAnHmacSha256ComputedApartOverTheChannelAndTheLcmEncoding) {
   command_t pin = APin(1765000000123456);
   std::vector<std::uint8_t> wire(static_cast<std::size_t>(pin.getEncodedSize()));
@@ -108,12 +109,13 @@ TEST(CommandSignature, TheGateTakesAFreshSignedCommandOnceAndNothingElse) {
             std::string::npos);
   EXPECT_NE(gate.Refusal(APin(now), now).find("signature does not match"), std::string::npos);
   EXPECT_EQ(gate.Refusal(signed_at(now - 1000, CountingKey()), now), "");
-  EXPECT_NE(gate.Refusal(signed_at(now - 1000, CountingKey()), now).find("a replay"),
-            std::string::npos)
+  EXPECT_EQ(gate.Refusal(signed_at(now - 1000, CountingKey()), now), "taken before: a replay")
       << "the same command again";
-  EXPECT_NE(gate.Refusal(signed_at(now - 2000, CountingKey()), now).find("a replay"),
-            std::string::npos)
-      << "an older one";
+  EXPECT_EQ(gate.Refusal(signed_at(now - 1000, CountingKey()), now + 1'500'000),
+            "taken before: a replay")
+      << "again, later within the window";
+  // Two senders whose commands cross on the bus: an older, different one is still taken.
+  EXPECT_EQ(gate.Refusal(signed_at(now - 2000, CountingKey()), now), "") << "an older one";
   EXPECT_EQ(gate.Refusal(signed_at(now - 999, CountingKey()), now), "") << "a later one";
   EXPECT_NE(gate.Refusal(signed_at(now - kCommandFreshnessUs - 1, CountingKey()), now)
                 .find("stale, replayed, or a clock to set"),
@@ -133,8 +135,31 @@ TEST(CommandSignature, TheGateTakesAFreshSignedCommandOnceAndNothingElse) {
   }
   // Recorded before the daemon started, played within the window after a restart: refused.
   SignedCommandGate restarted(CountingKey(), "HAPTIC_COMMAND", start);
-  EXPECT_NE(restarted.Refusal(signed_at(start - 1, CountingKey()), start + 1000).find("a replay"),
+  EXPECT_NE(restarted.Refusal(signed_at(start - 1, CountingKey()), start + 1000)
+                .find("signed before the daemon started: a replay"),
             std::string::npos);
+}
+
+// The gate remembers what it took only within the window, and at most kMaxRemembered of them:
+// past that, a flood of signed commands (a key holder's) is refused until the oldest expire.
+TEST(CommandSignature, TheGateRemembersAtMostItsWindowsWorth) {
+  const std::int64_t start = 1765000000000000, now = start + 10'000'000;
+  SignedCommandGate gate(CountingKey(), "HAPTIC_COMMAND", start);
+  auto signed_at = [](std::int64_t utime) {
+    command_t pin = APin(utime);
+    SignCommand(&pin, "HAPTIC_COMMAND", CountingKey());
+    return pin;
+  };
+  for (std::size_t k = 0; k < SignedCommandGate::kMaxRemembered; ++k) {
+    ASSERT_EQ(gate.Refusal(signed_at(now + static_cast<std::int64_t>(k)), now), "") << k;
+  }
+  EXPECT_NE(gate.Refusal(signed_at(now + 100'000), now).find("more than 256 signed commands"),
+            std::string::npos);
+  const std::int64_t later = now + kCommandFreshnessUs + 1000;  // the first ones expired
+  EXPECT_EQ(gate.Refusal(signed_at(later), later), "");
+  EXPECT_NE(gate.Refusal(signed_at(now), later).find("ms from the daemon's clock"),
+            std::string::npos)
+      << "forgotten, but stale";
 }
 
 TEST(CommandKeyFile, AMadeKeyIsPrivateRandomAndNeverOverwritten) {
@@ -165,7 +190,8 @@ TEST(CommandKeyFile, AKeyOthersCanReadOrChangeOrThatIsMalformedIsRefusedByName) 
       return std::string(e.what());
     }
   };
-  EXPECT_NE(refusal().find("make one with `hapticsim ctl --make-key " + path), std::string::npos)
+  EXPECT_NE(refusal().find("does not exist; make one with `hapticsim ctl --make-key " + path),
+            std::string::npos)
       << "missing";
   std::ofstream(path) << "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f\n";
   for (mode_t mode : {0644, 0604, 0620, 0660}) {
@@ -179,6 +205,13 @@ TEST(CommandKeyFile, AKeyOthersCanReadOrChangeOrThatIsMalformedIsRefusedByName) 
     EXPECT_EQ(refusal(), "accepted") << std::oct << mode;
   }
   EXPECT_EQ(ReadCommandKey(path), CountingKey());
+  if (geteuid() == 0) {  // another user's key could be replaced by that user
+    ASSERT_EQ(chown(path.c_str(), 65534, 65534), 0);
+    EXPECT_NE(refusal().find("is owned by uid 65534: only root or this process's user"),
+              std::string::npos)
+        << refusal();
+    ASSERT_EQ(chown(path.c_str(), 0, 0), 0);
+  }
   for (const char* text :
        {"", "0001", "zz0102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f",
         "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f00"}) {
@@ -194,7 +227,9 @@ TEST(CommandKeyFile, AKeyOthersCanReadOrChangeOrThatIsMalformedIsRefusedByName) 
     ReadCommandKey(link);
     ADD_FAILURE() << "a key read through a symbolic link";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot be opened"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is a symbolic link: name the file itself"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -44,19 +44,20 @@ int SendSignedOnLcm(const CtlOptions& o, const std::string& line) {
         "ctl --lcm needs --key-file: the daemon takes only commands signed with the key "
         "in its lcm.command_key_file");
   }
-  if (const std::string problem = LcmUrlProblem(o.lcm_url, false); !problem.empty()) {
-    std::string why = problem.substr(problem.find(':') + 2);  // without "lcm.url: "
-    why = why.substr(0, why.find(": keep it on this host"));  // the daemon's advice
-    throw Error("ctl --lcm-url: " + why + "; hapticsim ctl sends on this host only");
+  const bool bus = o.lcm_url.rfind("udpm://", 0) == 0 || o.lcm_url.rfind("tcpq://", 0) == 0;
+  if (const std::string problem = LcmUrlProblem(o.lcm_url, false); !bus || !problem.empty()) {
+    throw Error("ctl --lcm-url " + o.lcm_url +
+                ": hapticsim ctl sends on a udpm:// or tcpq:// bus on this host only" +
+                (problem.empty() ? "" : " (" + problem.substr(0, problem.find(": keep it")) + ")"));
   }
   std::string error;
   std::optional<command_t> command = ParseControlLine(line, &error);
   if (!command) throw Error("ctl: " + error);
   const CommandKey key = ReadCommandKey(o.key_file);
-  command->utime = CommandClockUs();
+  lcm::LCM lcm(o.lcm_url);
+  command->utime = CommandClockUs();  // stamped last: the daemon takes it within 2 s
   SignCommand(&*command, o.channel, key);
-  lcm::LCM bus(o.lcm_url);
-  if (!bus.good() || bus.publish(o.channel, &*command) != 0) {
+  if (!lcm.good() || lcm.publish(o.channel, &*command) != 0) {
     throw Error("ctl: LCM could not send on " + o.lcm_url +
                 " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
                 "224.0.0.0/4 dev lo`)");
