@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "core/fnv1a.hpp"
 
 namespace hapticsim {
 
@@ -104,11 +105,8 @@ std::size_t ErrorMap::CountStatus(SampleStatus status) const {
 }
 
 std::uint64_t ErrorMap::ResultsChecksum() const {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  auto mix = [&hash](const void* data, size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 0x100000001b3ull;
-  };
+  Fnv1a hash;
+  auto mix = [&hash](const void* data, size_t size) { hash.Bytes(data, size); };
   for (const MapSample& s : samples) {
     mix(s.point.data(), sizeof s.point);
     for (double v : {s.l2_percent, s.max_magnitude_percent, s.max_direction_deg, s.reference_peak_n,
@@ -118,7 +116,7 @@ std::uint64_t ErrorMap::ResultsChecksum() const {
     mix(&s.status, sizeof s.status);
     mix(&s.status_region, sizeof s.status_region);
   }
-  return hash;
+  return hash.value();
 }
 
 }  // namespace hapticsim

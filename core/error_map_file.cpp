@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/fnv1a.hpp"
 
 namespace hapticsim {
 namespace {
@@ -32,17 +33,17 @@ constexpr int kDetailDoubles = kNumMapAxes + 2 + kMapCostRegions;
 // FNV-1a over 64-bit words (the tail zero-padded): fast enough that checking a lookup table
 // costs a fraction of reading it.
 std::uint64_t Checksum(const std::string& bytes) {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
+  Fnv1a hash;
   size_t i = 0;
   for (; i + 8 <= bytes.size(); i += 8) {
     std::uint64_t word;
     std::memcpy(&word, bytes.data() + i, 8);
-    hash = (hash ^ word) * 0x100000001b3ull;
+    hash.Word(word);
   }
   std::uint64_t word = 0;
   std::memcpy(&word, bytes.data() + i, bytes.size() - i);
-  hash = (hash ^ word ^ (static_cast<std::uint64_t>(bytes.size()) << 56)) * 0x100000001b3ull;
-  return hash;
+  hash.Word(word ^ (static_cast<std::uint64_t>(bytes.size()) << 56));
+  return hash.value();
 }
 
 template <typename T>

@@ -17,6 +17,7 @@
 #include "core/async_regions.hpp"
 #include "core/cube_scene.hpp"
 #include "core/error.hpp"
+#include "core/fnv1a.hpp"
 #include "core/force_error.hpp"
 #include "core/reference_trial.hpp"
 #include "core/region_partition.hpp"
@@ -334,17 +335,18 @@ std::string Fingerprint(const ErrorMap& map, const SweepGrid& grid, const SweepO
   text << map.provenance.scene_toml << map.provenance.model << map.provenance.code_version
        << grid.name << options.shard_index << '/' << options.shard_count << options.use_linearity
        << options.use_similarity;
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (unsigned char c : text.str()) hash = (hash ^ c) * 0x100000001b3ull;
+  Fnv1a hash;
+  const std::string words = text.str();
+  hash.Bytes(words.data(), words.size());
   for (const MapSample& s : map.samples) {
     for (double v : s.point) {
       std::uint64_t bits;
       std::memcpy(&bits, &v, sizeof bits);
-      hash = (hash ^ bits) * 0x100000001b3ull;
+      hash.Word(bits);
     }
   }
   std::ostringstream hex;
-  hex << std::hex << hash;
+  hex << std::hex << hash.value();
   return hex.str();
 }
 
