@@ -76,20 +76,19 @@ TEST(RealTimeSchedule, CompletesWithFiniteForcesWhateverTheTiming) {
   AsyncRegions regions(Adaptive(2, 2, 600));
   RealTimeSchedule dut(regions);
   const TrialResult threaded = dut.RunTrial();
-  ASSERT_NE(threaded.outcome, TrialOutcome::kDivergedEnergy);
-  if (threaded.outcome == TrialOutcome::kCompleted) {
-    EXPECT_EQ(threaded.samples.size(), 1001u);
-    EXPECT_GT(threaded.peak_force_n, 1.0);
-  }
+  // Whatever the timing the threads get, the interface controllers keep the coupling from gaining
+  // energy: the run completes, every period answered, and the press peaks near its on-time 1.3 N
+  // (3,500 N before them, above; 1.58–1.68 N under the injected faults below). 5 N leaves room
+  // for what a lag costs in accuracy, not for a growing coupling.
+  EXPECT_EQ(threaded.outcome, TrialOutcome::kCompleted) << TrialOutcomeName(threaded.outcome);
+  EXPECT_EQ(threaded.samples.size(), 1001u);
+  EXPECT_GT(threaded.peak_force_n, 1.0);
+  EXPECT_LT(threaded.peak_force_n, 5.0);
   long misses = 0;
   for (int r = 0; r < regions.num_regions(); ++r) misses += dut.stats(r).misses;
-  if (misses == 0) {
-    EXPECT_EQ(threaded.outcome, TrialOutcome::kCompleted);
-    EXPECT_LT(threaded.peak_force_n, 2.0);
-  } else {
-    std::printf("%ld deadline misses: peak force %.3g N (on time: 1.3 N)\n", misses,
-                threaded.peak_force_n);
-  }
+  if (misses == 0) EXPECT_LT(threaded.peak_force_n, 2.0) << "on time, near the virtual-time run";
+  std::printf("%ld deadline misses: peak force %.3g N (on time: 1.3 N)\n", misses,
+              threaded.peak_force_n);
 }
 
 // Injected timing faults (what `hapticsim stress --faults` runs): lags, stalls and late primary

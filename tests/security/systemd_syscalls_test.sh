@@ -6,7 +6,7 @@
 # the daemon needs is caught too, so this test can fail. Run inside a private network namespace
 # (LCM): tests/support/in_private_netns.sh --keep-users (run by root: real time is then granted
 # as the unit's LimitRTPRIO grants it, and checked).
-# Usage: syscalls_test.sh UNIT HAPTICSIMD SHM_CLIENT WORKDIR
+# Usage: systemd_syscalls_test.sh UNIT HAPTICSIMD SHM_CLIENT WORKDIR
 set -euo pipefail
 unit=$1 daemon=$2 client=$3 work=$4
 rm -rf "$work" && mkdir -p "$work" && chmod 700 "$work"

@@ -2,7 +2,7 @@
 # The shipped unit file passes `systemd-analyze verify` (with ExecStart pointed at the built
 # daemon, since verify checks that the executable exists), keeps the directives the daemon relies
 # on, and a broken copy is caught — so this test can fail.
-# Usage: verify_unit_test.sh UNIT HAPTICSIMD WORKDIR
+# Usage: systemd_unit_test.sh UNIT HAPTICSIMD WORKDIR
 set -euo pipefail
 unit=$1 daemon=$2 work=$3
 mkdir -p "$work"
