@@ -6,8 +6,6 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <cstdlib>
-
 #include "core/error.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
@@ -18,17 +16,13 @@ std::string MulticastSourceOffLoopback(const std::string& url) {
   const std::string scheme = "udpm://";
   if (url.rfind(scheme, 0) != 0) return "";
   const std::string rest = url.substr(scheme.size());
-  const std::size_t host_end = rest.find_first_of(":?/");
-  std::string group = rest.substr(0, host_end);
-  int port = 7667;  // LCM's defaults
-  if (group.empty()) group = "239.255.76.67";
-  if (host_end != std::string::npos && rest[host_end] == ':') {
-    port = std::atoi(rest.c_str() + host_end + 1);
-  }
+  std::string group = rest.substr(0, rest.find_first_of(":?/"));
+  if (group.empty()) group = "239.255.76.67";  // LCM's default
   sockaddr_in to{};
   to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>(port > 0 && port < 65536 ? port : 7667));
-  if (inet_pton(AF_INET, group.c_str(), &to.sin_addr) != 1) return "";
+  to.sin_port = htons(7667);  // any port: only the route matters
+  // inet_aton, as LCM reads the group (it takes forms inet_pton does not, e.g. 0xef.255.76.67).
+  if (inet_aton(group.c_str(), &to.sin_addr) == 0) return "";
   const int probe = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (probe < 0) return "";
   sockaddr_in from{};

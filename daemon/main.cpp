@@ -226,7 +226,7 @@ int Serve(const Arguments& args) {
           "LCM's multicast group is routed off loopback (source address {}): machines on that "
           "network can send device input to the daemon, and under the systemd unit, whose IP "
           "filter admits only localhost, local LCM clients' packets (source {}) are dropped. "
-          "Route the group through loopback: ip route add 224.0.0.0/4 dev lo",
+          "Route the group through loopback: ip route replace 224.0.0.0/4 dev lo",
           source, source);
     }
     if (LcmUrlLeavesHost(config.lcm_url)) {
@@ -865,21 +865,23 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
-  try {
-    const int status = hapticsim::Serve(args);
+  // A stability estimate may still run on a worker that shutdown did not wait for: then leave
+  // without running static destructors under it (the log flushed first).
+  auto leave = [](int status) {
     if (hapticsim::AJobWasLeftRunning()) {
-      // A stability estimate still runs on a worker that shutdown did not wait for: leave
-      // without running static destructors under it (the log is flushed first).
       spdlog::shutdown();
       std::fflush(nullptr);
       std::_Exit(status);
     }
     return status;
+  };
+  try {
+    return leave(hapticsim::Serve(args));
   } catch (const hapticsim::Error& e) {
     std::cerr << "hapticsimd: error: " << e.what() << "\n";
-    return 2;
+    return leave(2);
   } catch (const std::exception& e) {
     std::cerr << "hapticsimd: internal error: " << e.what() << "\n";
-    return 1;
+    return leave(1);
   }
 }

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -166,7 +167,7 @@ bool SignatureMatches(const command_t& command, const std::string& channel, cons
 
 SignedCommandGate::SignedCommandGate(const CommandKey& key, std::string channel,
                                      std::int64_t start_us)
-    : key_(key), channel_(std::move(channel)), start_us_(start_us) {}
+    : key_(key), channel_(std::move(channel)), start_us_(start_us), latest_now_us_(start_us) {}
 
 std::string SignedCommandGate::Refusal(const command_t& command, std::int64_t now_us) {
   // The signature first: nothing about an unsigned command may change what the gate remembers.
@@ -187,8 +188,16 @@ std::string SignedCommandGate::Refusal(const command_t& command, std::int64_t no
   if (command.utime <= start_us_) {
     return "signed before the daemon started: a replay (or the wall clock stepped back)";
   }
+  // A clock stepped back must not make a command forgotten below fresh again: older than the
+  // window on the latest clock reading seen is stale whatever the clock says now.
+  latest_now_us_ = std::max(latest_now_us_, now_us);
+  if (command.utime < latest_now_us_ - kCommandFreshnessUs) {
+    return "signed before the window of the latest clock reading: a replay (or the wall clock "
+           "stepped back)";
+  }
   // Only commands still within the window need remembering: older ones fail the check above.
-  std::erase_if(taken_, [&](const Taken& t) { return t.utime_us < now_us - kCommandFreshnessUs; });
+  std::erase_if(taken_,
+                [&](const Taken& t) { return t.utime_us < latest_now_us_ - kCommandFreshnessUs; });
   for (const Taken& t : taken_) {
     if (CRYPTO_memcmp(t.mac.data(), command.mac, t.mac.size()) == 0) {
       return "taken before: a replay";

@@ -82,6 +82,8 @@ class SignedCommandGate {
   CommandKey key_;
   std::string channel_;
   std::int64_t start_us_;
+  /** The latest clock reading seen: what is forgotten stays stale if the clock steps back. */
+  std::int64_t latest_now_us_;
   std::deque<Taken> taken_;  // the commands taken within the window, oldest first
 };
 

@@ -1,12 +1,16 @@
 // The one FNV-1a (core/fnv1a.hpp) against the published test vectors of the 64-bit FNV-1a
-// (Fowler, Noll, Vo: isthe.com/chongo/tech/comp/fnv, "FNV-1a 64" of "", "a" and "foobar"), and
-// the word-at-a-time way against the same arithmetic written out.
+// (Fowler, Noll, Vo: isthe.com/chongo/tech/comp/fnv, "FNV-1a 64" of "", "a" and "foobar"), the
+// word-at-a-time way against the same arithmetic written out, and the values of the hashes built
+// on it against those the copies it replaced gave.
 #include "core/fnv1a.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <string>
+
+#include "core/error_map.hpp"
+#include "core/error_map_file.hpp"
 
 namespace hapticsim {
 namespace {
@@ -32,6 +36,15 @@ TEST(Fnv1a, AWordIsOneStepOfTheSameArithmetic) {
   word.Word('a');
   byte.Bytes("a", 1);
   EXPECT_EQ(word.value(), byte.value());
+}
+
+// The hashes built on it kept their values through the move to one Fnv1a: a map file written
+// before it loads (its sections' checksums verified), and its results checksum is the one the
+// build before it computed for the same file.
+TEST(Fnv1a, AMapWrittenBeforeKeepsItsChecksums) {
+  const ErrorMap map = LoadErrorMap(HAPTICSIM_SMALL_MAP);
+  EXPECT_EQ(map.samples.size(), 64u);
+  EXPECT_EQ(map.ResultsChecksum(), 0xb1f00ec2307f9dd4ull);
 }
 
 }  // namespace

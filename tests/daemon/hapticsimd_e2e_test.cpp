@@ -548,7 +548,10 @@ TEST(HapticsimdConfig, AnLcmUrlThatLeavesTheHostIsRefusedUnlessAllowedAndThenSai
 // run is in a network namespace of its own, inside the test's: lo also holds 10.9.0.1, the
 // source the route gives, as an Ethernet card's address would be.
 TEST(HapticsimdConfig, AMulticastGroupRoutedOffLoopbackIsSaidAtStart) {
-  const std::string daemon = std::string("exec ") + HAPTICSIMD_PATH + " --duration 1";
+  const std::string config = Temp("multicast-route.toml");  // not /etc's, whatever it holds
+  std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n";
+  const std::string daemon =
+      std::string("exec ") + HAPTICSIMD_PATH + " --config " + config + " --duration 1";
   const auto off = testing::RunCommand({"/usr/bin/unshare", "-rn", "/bin/sh", "-c",
                                         "ip link set lo up && ip addr add 10.9.0.1/32 dev lo && "
                                         "ip route add 224.0.0.0/4 dev lo src 10.9.0.1 && " +
@@ -557,7 +560,7 @@ TEST(HapticsimdConfig, AMulticastGroupRoutedOffLoopbackIsSaidAtStart) {
   EXPECT_NE(off.err.find("multicast group is routed off loopback (source address 10.9.0.1)"),
             std::string::npos)
       << off.err;
-  EXPECT_NE(off.err.find("ip route add 224.0.0.0/4 dev lo"), std::string::npos) << off.err;
+  EXPECT_NE(off.err.find("ip route replace 224.0.0.0/4 dev lo"), std::string::npos) << off.err;
   const auto on =
       testing::RunCommand({"/usr/bin/unshare", "-rn", "/bin/sh", "-c",
                            "ip link set lo up && ip route add 224.0.0.0/4 dev lo && " + daemon});

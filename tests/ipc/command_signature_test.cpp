@@ -140,6 +140,22 @@ TEST(CommandSignature, TheGateTakesAFreshSignedCommandOnceAndNothingElse) {
             std::string::npos);
 }
 
+// A command taken, forgotten once the window passed, then played back after the wall clock
+// stepped back to its time (NTP, date -s, a restored VM): still refused.
+TEST(CommandSignature, AClockSteppedBackDoesNotMakeAForgottenCommandFreshAgain) {
+  const std::int64_t start = 1765000000000000, now = start + 10'000'000;
+  SignedCommandGate gate(CountingKey(), "HAPTIC_COMMAND", start);
+  command_t taken = APin(now);
+  SignCommand(&taken, "HAPTIC_COMMAND", CountingKey());
+  ASSERT_EQ(gate.Refusal(taken, now), "");
+  const std::int64_t later = now + 3 * kCommandFreshnessUs;  // a signed command purges it
+  command_t newer = APin(later);
+  SignCommand(&newer, "HAPTIC_COMMAND", CountingKey());
+  ASSERT_EQ(gate.Refusal(newer, later), "");
+  EXPECT_NE(gate.Refusal(taken, now + 1000).find("a replay (or the wall clock stepped back)"),
+            std::string::npos);
+}
+
 // The gate remembers what it took only within the window, and at most kMaxRemembered of them:
 // past that, a flood of signed commands (a key holder's) is refused until the oldest expire.
 TEST(CommandSignature, TheGateRemembersAtMostItsWindowsWorth) {

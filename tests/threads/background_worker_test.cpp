@@ -86,7 +86,9 @@ TEST(BackgroundWorker, DestructionDoesNotWaitForALongJob) {
       std::this_thread::sleep_for(std::chrono::seconds(5));  // a minute-long estimate, shorter
       return 0;
     });
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    while (worker.running_since_ns() == 0) {  // the job has started (not just been queued)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
   }
   const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_LT(waited_s, BackgroundWorker<int>::kJoinWait_s + 0.5);
