@@ -34,7 +34,7 @@ std::string MulticastSourceOffLoopback(const std::string& url);
  * the signature gate here, as they arrive: one that is refused (unsigned, forged, replayed, or
  * any when commands on LCM are off) is counted and dropped before it can take a place in the
  * queue, so a flood of forgeries cannot crowd out a signed command. Poll/Publish are called from
- * the I/O thread only; PostStatus, PopCommand and Refusals from the supervisor.
+ * the I/O thread only; PostStatus, PopCommand and CommandRefusals from the supervisor.
  */
 class LcmBridge {
  public:

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "ipc/file_mode.hpp"
 #include "ipc/unique_fd.hpp"
 
 namespace hapticsim {
@@ -25,12 +26,6 @@ namespace {
 
 using Mac = std::array<unsigned char, 32>;
 static_assert(sizeof(command_t::mac) == sizeof(Mac), "command_t.mac holds an HMAC-SHA256");
-
-std::string Octal(mode_t mode) {
-  char text[8];
-  std::snprintf(text, sizeof text, "%04o", static_cast<unsigned>(mode & 07777));
-  return text;
-}
 
 // The MAC of `command` as signed for `channel`; nothing when it cannot be computed, so that no
 // failure can make an all-zero MAC (an unsigned command's) count as valid.
@@ -91,7 +86,7 @@ CommandKey ReadCommandKey(const std::string& path) {
                 ") may own it, as its owner can replace the key");
   }
   if (info.st_mode & 0027) {
-    throw Error(what + " has mode " + Octal(info.st_mode) +
+    throw Error(what + " has mode " + shm::OctalMode(info.st_mode) +
                 ": other users could read or change the key; chmod 0600 (or 0640 for a group "
                 "of senders) " +
                 path);

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "ipc/file_mode.hpp"
 
 namespace hapticsim::shm {
 namespace {
@@ -35,12 +36,6 @@ sockaddr_un AddressOf(const std::string& path, const std::string& key) {
                              std::to_string(sizeof address.sun_path - 1) + " bytes)");
   std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
   return address;
-}
-
-std::string Octal(mode_t mode) {
-  char text[8];
-  std::snprintf(text, sizeof text, "%04o", static_cast<unsigned>(mode & 07777));
-  return text;
 }
 
 std::string DirectoryOf(const std::string& path) {
@@ -137,7 +132,7 @@ std::string ServerIdentityProblem(const std::string& path, const PeerIdentity& s
       // else did, the service's user included (a squatter serves its own socket).
       const bool made_by_trusted = below_owner == 0 || below_owner == client_uid;
       if (own_directory || !(info.st_mode & S_ISVTX) || !made_by_trusted) {
-        return directory + " (mode " + Octal(info.st_mode) +
+        return directory + " (mode " + OctalMode(info.st_mode) +
                ") can be written by users other than its owner" +
                (own_directory || !(info.st_mode & S_ISVTX)
                     ? ""
@@ -177,7 +172,7 @@ ServiceListener::ServiceListener(const std::string& path, const std::string& gro
   // name while the daemon is down; and drivers would refuse it (ServerIdentityProblem).
   HAPTICSIM_THROW_UNLESS(!(info.st_mode & (S_IWGRP | S_IWOTH)),
                          key + " = \"" + path + "\": " + directory + " (mode " +
-                             Octal(info.st_mode) +
+                             OctalMode(info.st_mode) +
                              ") can be written by other users: use a directory only the daemon's "
                              "user can write (systemd: RuntimeDirectory=hapticsim), e.g. "
                              "mkdir -m 700");
