@@ -60,6 +60,19 @@ class RegionWithInnerBand final : public StiffnessOperator {
 
 }  // namespace
 
+// The energy of the whole object at a uniform strain of kPortFloorStrain, ½ E ε² V. An exchange
+// at equal rates creates nothing, but its outer side steps first and takes in what the inner
+// side gives out only in its own step: for that one step the outer side's view of the observer
+// is a step's flow high. Early in a press the regions' energies are too small to cover that
+// (they start at zero while the flow does not), and a limit that then acted would break the
+// exact monolithic result. Measured on the default scene: a floor of 10⁻⁷ J (a strain of
+// 3.6 × 10⁻⁵) left every equal-rate press of the tests untouched, 10⁻⁹ J did not; 10⁻⁴ keeps a
+// margin above that.
+double AsyncRegions::PortFloorJ(const Material& material, double mass_kg) {
+  const double volume = mass_kg / material.density_kg_m3;
+  return 0.5 * material.youngs_modulus_pa * kPortFloorStrain * kPortFloorStrain * volume;
+}
+
 // Everything one region's thread touches. The link to the next region outwards (if any) is
 // stored here: `inward` is written by the outer region, `outward` by this one.
 struct AsyncRegions::Region {
@@ -77,8 +90,8 @@ struct AsyncRegions::Region {
   std::unique_ptr<BoundaryChannel> outward;   // this → outer: band displacements or Γ forces
   std::unique_ptr<ElementSetStiffness> band;  // this region's elements next to its outer Γ
   std::vector<int> band_layer;                // their DOFs off the outer Γ
-  BoundaryChannel::ReadPair outer;  // Γ from the outer region, read by this region's thread
-  std::vector<double> outward_values;                  // written by this region's thread
+  BoundaryChannel::ReadPair outer;     // Γ from the outer region, read by this region's thread
+  std::vector<double> outward_values;  // written by this region's thread
 
   // Link with the region inwards: this region is its outer side (owns that Γ).
   BoundaryChannel::ReadPair inner;  // the inner region's side, read by this region's thread
@@ -87,8 +100,13 @@ struct AsyncRegions::Region {
 
   // The energy balance (docs/regions.md, "Passive interfaces"), J since Reset. Written by
   // this region's thread; the *_published copies for the neighbours' threads to read.
-  double input_work = 0;          // the contact's work (primary)
-  double damping_dissipated = 0;  // material damping
+  double input_work = 0;                    // the contact's work (primary)
+  double damping_dissipated = 0;            // material damping
+  double port_refused = 0;                  // work the port limits kept out (PortWorkLimits)
+  std::atomic<double> energy_published{0};  // its discrete energy at its last step's start
+  // The largest port allowance each side has used and energy it has had since Reset, for the
+  // bound the port limits guarantee (EnergyAccount::backlog_bound_j).
+  double inward_allowance_peak = 0, outward_allowance_peak = 0, energy_peak = 0;
   // As the inner side of the link outwards:
   double outer_gamma_work = 0;  // work done on this region by moving its outer Γ
   double outward_taken = 0;     // what its controller took out for that link
@@ -100,6 +118,9 @@ struct AsyncRegions::Region {
   double inner_work_seen = 0, inner_taken_seen = 0;  // the inner side's, counted in it
   double unmet = 0;  // what its last step was asked to take out and could not
   std::atomic<double> unmet_published{0}, inner_taken_seen_published{0};
+  // The observer less the inner side's sums it has counted: the inner side adds its own sums
+  // (known exactly) to this one number to see the observer as it would be (InwardPortLimit).
+  std::atomic<double> excess_base_published{0};
 };
 
 AsyncRegions::~AsyncRegions() = default;
@@ -124,6 +145,7 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
       control_(control) {
   if (!(substep_safety > 0)) throw Error("substep safety must be positive");
   const RegionPartition& p = partition_;
+  port_floor_j_ = PortFloorJ(scene.material, p.dof_mass().sum() / 3.0);
   const int n = p.mesh().num_dofs();
   const int count = p.num_regions();
   std::vector<std::int64_t> rates;
@@ -193,6 +215,7 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
     // The outermost region's controller damps its inner Γ; a middle shell, with links on both
     // sides, and the primary (its last resort only), all their DOFs (ObserveInwardLink).
     if (a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
+    if (a + 1 < count) region->integrator->SetPortPrescribedFrom(region->outer_offset);
 
     if (a + 1 < count) {
       region->band = std::move(bands[a]);
@@ -340,18 +363,31 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     }
   }
   double asked_inward = 0, asked_outward = 0;
-  if (control_ == InterfaceControl::kPassive) {
-    if (a > 0) asked_inward = ObserveInwardLink(a);
-    if (region.inward) asked_outward = OutwardLinkExcess(a);
+  PortWorkLimits limits;
+  if (control_ != InterfaceControl::kOff) {
+    const bool limited = control_ == InterfaceControl::kPassive;
+    // An O(n) pass over the region's DOFs (K·u is cached for the step): the controllers' floor
+    // and the port limits follow the energy step by step.
+    const double energy = std::max(0.0, integrator.DiscreteEnergy());
+    region.energy_published.store(energy, std::memory_order_relaxed);
+    region.energy_peak = std::max(region.energy_peak, energy);
+    if (a > 0) {
+      asked_inward = ObserveInwardLink(a, energy);
+      if (limited) limits.load_work_j = InwardPortLimit(a, energy);
+    }
+    if (region.inward) {
+      asked_outward = OutwardLinkExcess(a);
+      if (limited) limits.prescribed_work_j = OutwardPortLimit(a, energy);
+    }
     // The primary keeps kPrimaryReserve of its energy in reserve: damping its DOFs is a viscous
     // force at the contact the user feels (measured: a loaded press peaked 14 % high when it took
     // every step's backlog), so it acts only on a backlog the shells have let grow past that.
-    // (Its energy is an O(n) pass: only worked out when there is a backlog at all.)
     if (a == kPrimaryRegion && asked_outward > 0) {
-      asked_outward = std::max(0.0, asked_outward - PrimaryReserve(integrator));
+      asked_outward = std::max(0.0, asked_outward - kPrimaryReserve * energy);
     }
   }
-  integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward);
+  integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward,
+                  limits);
   if (reaction != nullptr) {
     for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
   }
@@ -376,12 +412,13 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
 // then create an hour's worth before the controllers act. Since that floor only ever raises the
 // observer, created − taken out ≤ kDampingCredit × the secondaries' damping + the observers'
 // positive excess, whatever the timing. That excess is what the controllers have not yet
-// managed to take out: one step's worth while they keep up; a mode that outgrows them (the
-// stress test found such scenes) makes it grow, which is why the daemon still verifies the bare
-// exchange before it runs a configuration.
+// managed to take out: one step's worth while they keep up; where a mode outgrows them, the
+// port limits below bound it. (The daemon still verifies the bare exchange before it runs a
+// configuration: in some stiff scenes a region's own discrete energy is not positive, and then
+// no bound on it bounds the state — docs/regions.md, "The port limits".)
 
 // The outer side, before its step: folds in what the inner side published and returns the excess.
-double AsyncRegions::ObserveInwardLink(RegionIndex a) noexcept {
+double AsyncRegions::ObserveInwardLink(RegionIndex a, double energy) noexcept {
   Region& region = *regions_[a];
   const Region& inner = *regions_[a - 1];
   const double work = inner.outer_gamma_work_published.load(std::memory_order_relaxed);
@@ -390,17 +427,47 @@ double AsyncRegions::ObserveInwardLink(RegionIndex a) noexcept {
   region.inner_work_seen = work;
   region.inner_taken_seen = taken;
   if (region.excess < 0) {
-    // The floor follows the region's energy step by step (an O(n) pass over its DOFs, K·u
-    // already cached for the step): refreshed only every 16 steps it was measured to cost up to
-    // 0.27 points of accuracy, a stale small floor cutting the credit early in a press.
-    const double floor = -kCreditMemory * std::max(0.0, region.integrator->DiscreteEnergy());
-    region.excess = std::max(floor, region.excess);
+    // The floor follows the region's energy step by step: refreshed only every 16 steps it was
+    // measured to cost up to 0.27 points of accuracy, a stale small floor cutting the credit
+    // early in a press.
+    region.excess = std::max(-kCreditMemory * energy, region.excess);
   }
   return std::max(0.0, region.excess);
 }
 
 double AsyncRegions::PrimaryReserve(RegionIntegrator& primary) noexcept {
   return kPrimaryReserve * std::max(0.0, primary.DiscreteEnergy());
+}
+
+// The port limits: the last line, for what the controllers cannot take out in time (a mode that
+// outgrows one step's damping, a neighbour late or stalled). Each side of a link lets its port
+// do work only while the link's observer, as that side can know it, stays below the link's
+// allowance: kPortAllowance of the two regions' energies plus a floor (PortFloorJ). The outer side
+// knows the observer as of the inner side's last publication; the inner side knows it as of the
+// outer side's last publication plus its own sums since (exactly). Either view misses only what the
+// other side did since, and that side held itself to the allowance from its own view: so the
+// observer never exceeds two allowances plus the credit the floor keeps (kCreditMemory), whatever
+// the timing (docs/regions.md, "The port limits").
+double AsyncRegions::InwardPortLimit(RegionIndex a, double energy) noexcept {
+  Region& region = *regions_[a];
+  const Region& inner = *regions_[a - 1];
+  const double allowance =
+      kPortAllowance * (energy + inner.energy_published.load(std::memory_order_relaxed)) +
+      port_floor_j_;
+  region.inward_allowance_peak = std::max(region.inward_allowance_peak, allowance);
+  return std::max(0.0, allowance - region.excess);
+}
+
+double AsyncRegions::OutwardPortLimit(RegionIndex a, double energy) noexcept {
+  Region& region = *regions_[a];
+  const Region& outer = *regions_[a + 1];
+  const double allowance =
+      kPortAllowance * (energy + outer.energy_published.load(std::memory_order_relaxed)) +
+      port_floor_j_;
+  region.outward_allowance_peak = std::max(region.outward_allowance_peak, allowance);
+  const double observer = outer.excess_base_published.load(std::memory_order_relaxed) +
+                          region.outer_gamma_work - region.outward_taken;
+  return std::max(0.0, allowance - observer);
 }
 
 // The inner side, before its step: what the outer side's last step could not take out, less
@@ -418,6 +485,7 @@ void AsyncRegions::AccountStep(RegionIndex a, double asked_inward, double asked_
   Region& region = *regions_[a];
   const RegionIntegrator& integrator = *region.integrator;
   region.damping_dissipated += integrator.DampingDissipated();
+  region.port_refused += integrator.LoadWorkRefused() + integrator.PrescribedWorkRefused();
   // What the step took out, shared between the two links in proportion to what each asked.
   const double asked = asked_inward + asked_outward;
   const double taken = integrator.ControlledDissipated();
@@ -429,8 +497,8 @@ void AsyncRegions::AccountStep(RegionIndex a, double asked_inward, double asked_
     region.inner_gamma_load_work += integrator.LoadWork();
     region.inward_taken += taken_inward;
     region.unmet = std::max(0.0, asked_inward - taken_inward);
-    region.excess += integrator.LoadWork() - taken_inward -
-                     kDampingCredit * integrator.DampingDissipated();
+    region.excess +=
+        integrator.LoadWork() - taken_inward - kDampingCredit * integrator.DampingDissipated();
   }
   if (region.inward) {
     const size_t end = region.outer_offset + region.dofs->outer_interface.size();
@@ -447,21 +515,27 @@ void AsyncRegions::PublishEnergyAccount(Region& region) noexcept {
   region.outward_taken_published.store(region.outward_taken, std::memory_order_relaxed);
   region.unmet_published.store(region.unmet, std::memory_order_relaxed);
   region.inner_taken_seen_published.store(region.inner_taken_seen, std::memory_order_relaxed);
+  region.excess_base_published.store(
+      region.excess - (region.inner_work_seen - region.inner_taken_seen),
+      std::memory_order_relaxed);
 }
 
 void AsyncRegions::ResetEnergyAccount() noexcept {
   for (auto& region : regions_) {
-    region->input_work = region->damping_dissipated = 0;
+    region->input_work = region->damping_dissipated = region->port_refused = 0;
+    region->inward_allowance_peak = region->outward_allowance_peak = region->energy_peak = 0;
     region->outer_gamma_work = region->outward_taken = 0;
     region->inner_gamma_load_work = region->inward_taken = region->excess = region->unmet = 0;
     region->inner_work_seen = region->inner_taken_seen = 0;
+    region->energy_published.store(std::max(0.0, region->integrator->DiscreteEnergy()),
+                                   std::memory_order_relaxed);
     PublishEnergyAccount(*region);
   }
 }
 
 EnergyAccount AsyncRegions::Energies() noexcept {
   EnergyAccount account;
-  if (control_ == InterfaceControl::kPassive && num_regions() > 1) {
+  if (control_ != InterfaceControl::kOff && num_regions() > 1) {
     account.primary_reserve_j = PrimaryReserve(*regions_[kPrimaryRegion]->integrator);
   }
   for (int a = 0; a < num_regions(); ++a) {
@@ -469,11 +543,16 @@ EnergyAccount AsyncRegions::Energies() noexcept {
     account.stored_j += region.integrator->DiscreteEnergy();
     account.input_work_j += region.input_work;
     account.damping_dissipated_j += region.damping_dissipated;
+    account.port_refused_j += region.port_refused;
     if (a > 0) account.credited_damping_j += region.damping_dissipated;
     account.interface_created_j += region.outer_gamma_work + region.inner_gamma_load_work;
     account.interface_dissipated_j += region.inward_taken + region.outward_taken;
     if (a > 0) {
       const Region& inner = *regions_[a - 1];
+      if (control_ == InterfaceControl::kPassive) {
+        account.backlog_bound_j += inner.outward_allowance_peak + region.inward_allowance_peak +
+                                   kCreditMemory * region.energy_peak;
+      }
       account.pending_excess_j += region.excess +
                                   (inner.outer_gamma_work - region.inner_work_seen) -
                                   (inner.outward_taken - region.inner_taken_seen);
@@ -668,10 +747,10 @@ void AsyncRegions::ScaleAll(double factor) {
   }
   const double squared = factor * factor;
   for (auto& region : regions_) {
-    for (double* energy : {&region->input_work, &region->damping_dissipated,
-                           &region->outer_gamma_work, &region->outward_taken,
-                           &region->inner_gamma_load_work, &region->inward_taken, &region->excess,
-                           &region->unmet, &region->inner_work_seen, &region->inner_taken_seen}) {
+    for (double* energy :
+         {&region->input_work, &region->damping_dissipated, &region->outer_gamma_work,
+          &region->outward_taken, &region->inner_gamma_load_work, &region->inward_taken,
+          &region->excess, &region->unmet, &region->inner_work_seen, &region->inner_taken_seen}) {
       *energy *= squared;
     }
     PublishEnergyAccount(*region);

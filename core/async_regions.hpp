@@ -59,6 +59,15 @@ struct EnergyAccount {
   double pending_excess_j = 0;
   /** The backlog the primary leaves to the shells now (kPrimaryReserve of its energy). */
   double primary_reserve_j = 0;
+  /** Work the port limits kept out of the regions (PortWorkLimits), J (≥ 0). */
+  double port_refused_j = 0;
+  /**
+   * The most the observers can hold, by the port limits' construction, whatever the timing:
+   * over the links, the largest allowance each side has used plus kCreditMemory of the outer
+   * region's largest energy (docs/regions.md, "The port limits"). pending_excess_j ≤ this.
+   * 0 with the limits off (kDampingOnly, kOff): nothing is guaranteed then.
+   */
+  double backlog_bound_j = 0;
 };
 
 /**
@@ -105,14 +114,24 @@ class AsyncRegions {
   /** The backlog the primary's controller leaves to the shells, as a share of its own energy:
    *  beyond it, the primary damps too (its last resort; OutwardLinkExcess). */
   static constexpr double kPrimaryReserve = 0.1;
+  /** Each link's port allowance, as a share of its two regions' energies: a side's port does
+   *  work only while the link's observer, as that side knows it, stays below it
+   *  (InwardPortLimit, OutwardPortLimit). */
+  static constexpr double kPortAllowance = 0.02;
+  /** The strain at which the whole object's energy is the port allowance's floor (PortFloorJ). */
+  static constexpr double kPortFloorStrain = 1e-4;
+  /** The port allowance's floor: the object's energy at a uniform strain of kPortFloorStrain, J. */
+  static double PortFloorJ(const Material& material, double mass_kg);
+  double port_floor_j() const { return port_floor_j_; }
 
   /**
-   * kPassive: every interface's controller keeps the exchange from adding energy (always, in
-   * the daemon and the sweep). kOff: the bare exchange, for analysis only — what the controller
-   * costs in accuracy, and the lag's own instability (docs/regions.md); no configuration file
-   * can ask for it.
+   * kPassive: every interface's controller takes out what its exchange creates, and its port
+   * limits bound what the controllers cannot take out in time (always, in the daemon and the
+   * sweep). For analysis only — what each part costs and holds (docs/regions.md); no
+   * configuration file can ask for them: kDampingOnly, the controllers without the port limits;
+   * kOff, the bare exchange and the lag's own instability.
    */
-  enum class InterfaceControl { kPassive, kOff };
+  enum class InterfaceControl { kPassive, kDampingOnly, kOff };
 
   /** What an inner region sends the outer one for Γ. */
   enum class Coupling { kForce, kDisplacement };
@@ -245,7 +264,9 @@ class AsyncRegions {
   void PublishOutward(RegionIndex region) noexcept;
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction) noexcept;
-  double ObserveInwardLink(RegionIndex region) noexcept;
+  double ObserveInwardLink(RegionIndex region, double energy) noexcept;
+  double InwardPortLimit(RegionIndex region, double energy) noexcept;
+  double OutwardPortLimit(RegionIndex region, double energy) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
   static double PrimaryReserve(RegionIntegrator& primary) noexcept;
   void AccountStep(RegionIndex region, double asked_inward, double asked_outward) noexcept;
@@ -271,6 +292,7 @@ class AsyncRegions {
   std::vector<std::unique_ptr<Region>> regions_;
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};
+  double port_floor_j_ = 0;
 };
 
 /**

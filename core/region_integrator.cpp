@@ -36,6 +36,8 @@ void RegionIntegrator::Reset() {
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
   std::fill(prescribed_work_.begin(), prescribed_work_.end(), 0.0);
   load_work_ = damping_dissipated_ = controlled_dissipated_ = 0;
+  load_work_refused_ = prescribed_work_refused_ = 0;
+  load_scale_ = 1;
 }
 
 const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
@@ -46,8 +48,8 @@ const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
   return ku_;
 }
 
-void RegionIntegrator::Step(std::span<const double> prescribed_next,
-                            std::span<const double> load, double dissipate_j) noexcept {
+void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<const double> load,
+                            double dissipate_j, const PortWorkLimits& limits) noexcept {
   assert(prescribed_next.size() == prescribed_.size() && load.size() == loaded_.size());
   const Eigen::VectorXd& ku = Forces();
   for (size_t k = 0; k < loaded_.size(); ++k) external_[loaded_[k]] = load[k];
@@ -63,17 +65,26 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next,
     next[i] = (h2 / mass_[i] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
     swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
   }
+  load_scale_ = 1;
+  load_work_refused_ = 0;
+  if (limits.load_work_j < INFINITY && !loaded_.empty()) {
+    swept += LimitLoadWork(limits.load_work_j, load, plus, next, up);
+  }
   controlled_dissipated_ = 0;
   if (dissipate_j > 0 && !controlled_.empty()) swept += DampControlled(dissipate_j, plus, next, up);
   damping_dissipated_ = damping_ * swept / (4.0 * h_);
   load_work_ = 0;
   for (size_t k = 0; k < loaded_.size(); ++k) {
     const int i = loaded_[k];
-    load_work_ += load[k] * (next[i] - up[i]) / 2.0;
+    load_work_ += load_scale_ * load[k] * (next[i] - up[i]) / 2.0;
+  }
+  for (size_t k = 0; k < prescribed_.size(); ++k) next[prescribed_[k]] = prescribed_next[k];
+  prescribed_work_refused_ = 0;
+  if (limits.prescribed_work_j < INFINITY && port_prescribed_from_ < prescribed_.size()) {
+    LimitPrescribedWork(limits.prescribed_work_j, ku.data(), next, up);
   }
   for (size_t k = 0; k < prescribed_.size(); ++k) {
     const int i = prescribed_[k];
-    next[i] = prescribed_next[k];
     const double m = mass_[i];
     prescribed_reaction_[k] = ku[i] + m * (next[i] - 2.0 * u[i] + up[i]) / h2 +
                               damping_ * m * (next[i] - up[i]) / (2.0 * h_);
@@ -82,6 +93,64 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next,
   std::swap(u_previous_, u_);
   std::swap(u_, u_next_);
   ku_valid_ = false;
+}
+
+// The load f enters u⁺ of its DOF as c·f, c = h²/(m·b), b = 1 + d·h/2. Scaled by α, its work
+// ½ Σ f·(u⁺ − u⁻) is α·B + α²·A with A = ½ Σ c f² ≥ 0 and B = W(1) − A: zero at α = 0, so the
+// largest α ∈ [0, 1] with W(α) ≤ limit always exists; it is the positive root, in whichever form
+// does not cancel. The controlled damping after this only shrinks the Γ motion, and with it a
+// positive work. Returns the change of Σ m (u⁺ − u⁻)² over the loaded DOFs.
+double RegionIntegrator::LimitLoadWork(double limit_j, std::span<const double> load, double plus,
+                                       double* next, const double* up) noexcept {
+  double work = 0, a = 0;
+  for (size_t k = 0; k < loaded_.size(); ++k) {
+    const int i = loaded_[k];
+    work += load[k] * (next[i] - up[i]) / 2.0;
+    a += h_ * h_ / (mass_[i] * plus) * load[k] * load[k] / 2.0;
+  }
+  const double limit = std::max(0.0, limit_j);
+  if (!(work > limit)) return 0;
+  const double b = work - a;
+  const double root = std::sqrt(b * b + 4.0 * a * limit);
+  double alpha = 0;
+  if (b < 0) {
+    alpha = (root - b) / (2.0 * a);  // a > 0 here: work > 0 with b < 0
+  } else if (b + root > 0) {
+    alpha = 2.0 * limit / (b + root);
+  }
+  alpha = std::clamp(alpha, 0.0, 1.0);
+  double swept_change = 0;
+  for (size_t k = 0; k < loaded_.size(); ++k) {
+    const int i = loaded_[k];
+    const double before = next[i] - up[i];
+    next[i] -= (1.0 - alpha) * h_ * h_ / (mass_[i] * plus) * load[k];
+    const double after = next[i] - up[i];
+    swept_change += mass_[i] * (after * after - before * before);
+  }
+  load_scale_ = alpha;
+  load_work_refused_ = work - (alpha * b + alpha * alpha * a);
+  return swept_change;
+}
+
+// The port's work ½ Σ g·(u⁺ − u⁻), g = (K u) on its DOFs, is linear in u⁺: taking u⁺ back
+// towards u⁻ by the factor α scales it by α. Scaling (not a move along g, which would change u⁺
+// less but could make it move further than it was told) keeps the port's motion within what the
+// neighbour sent: the region's energy stays a sum its own limit keeps positive.
+void RegionIntegrator::LimitPrescribedWork(double limit_j, const double* ku, double* next,
+                                           const double* up) noexcept {
+  double work = 0;
+  for (size_t k = port_prescribed_from_; k < prescribed_.size(); ++k) {
+    const int i = prescribed_[k];
+    work += ku[i] * (next[i] - up[i]) / 2.0;
+  }
+  const double limit = std::max(0.0, limit_j);
+  if (!(work > limit)) return;
+  const double alpha = limit / work;
+  for (size_t k = port_prescribed_from_; k < prescribed_.size(); ++k) {
+    const int i = prescribed_[k];
+    next[i] = up[i] + alpha * (next[i] - up[i]);
+  }
+  prescribed_work_refused_ = work - limit;
 }
 
 // Extra damping β (1/s, on the mass) on the controlled DOFs scales their u⁺ − u⁻ by

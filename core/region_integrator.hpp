@@ -1,12 +1,28 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
 #include <span>
 #include <vector>
 
 #include "core/stiffness_operator.hpp"
 
 namespace hapticsim {
+
+/**
+ * The most work each of the region's two ports may do on it in one step, J (≥ 0; infinity:
+ * no limit). The ports are the interfaces with its neighbours: its load (the inner region's
+ * force on its inner Γ) and its port prescribed DOFs (its outer Γ, SetPortPrescribedFrom).
+ * A port that would do more is changed as little as it takes to do exactly the limit: the load
+ * scaled down (by α ∈ [0, 1]: its work is αB + α²A with A ≥ 0, so some α always fits), the
+ * prescribed values' motion u⁺ − u⁻ scaled down (work linear in it). Either way a port can
+ * always be made to do no work, so a limit always holds.
+ */
+struct PortWorkLimits {
+  double load_work_j = INFINITY;
+  double prescribed_work_j = INFINITY;
+};
 
 /**
  * Central difference for one region: the same per-DOF update as CentralDifferenceIntegrator,
@@ -49,9 +65,15 @@ class RegionIntegrator {
    * @param dissipate_j     energy to take out of the controlled DOFs in this step, J: extra
    *                        damping on them, as much of it as one step can take
    *                        (ControlledDissipated() says how much it did). 0: none.
+   * @param limits          the most work the ports may do in this step (PortWorkLimits)
    */
   void Step(std::span<const double> prescribed_next, std::span<const double> load,
-            double dissipate_j = 0) noexcept;
+            double dissipate_j = 0, const PortWorkLimits& limits = PortWorkLimits{}) noexcept;
+
+  /** Prescribed DOFs from index `first` on (in prescribed() order) are the port that
+   *  PortWorkLimits::prescribed_work_j limits; the ones before (contact, supports) never are.
+   *  Default: none. */
+  void SetPortPrescribedFrom(size_t first) { port_prescribed_from_ = first; }
 
   /*
    * The last step's terms of central difference's discrete energy balance. Multiplying the
@@ -68,6 +90,10 @@ class RegionIntegrator {
   double PrescribedWork(int k) const { return prescribed_work_[k]; }
   /** Σ over owned DOFs of d·m·(u⁺ − u⁻)²/(4h), J (≥ 0). */
   double DampingDissipated() const { return damping_dissipated_; }
+  /** Work the port limits kept the load and the port prescribed DOFs from doing in the last
+   *  step, J (≥ 0): what they would have done less what they did. */
+  double LoadWorkRefused() const { return load_work_refused_; }
+  double PrescribedWorkRefused() const { return prescribed_work_refused_; }
   /** What the step's dissipate_j actually took out, J (≥ 0; less when one step cannot). */
   double ControlledDissipated() const { return controlled_dissipated_; }
   /** The owned DOFs a dissipate_j damps (default: the loaded ones). */
@@ -102,6 +128,10 @@ class RegionIntegrator {
 
  private:
   double DampControlled(double dissipate_j, double plus, double* next, const double* up) noexcept;
+  double LimitLoadWork(double limit_j, std::span<const double> load, double plus, double* next,
+                       const double* up) noexcept;
+  void LimitPrescribedWork(double limit_j, const double* ku, double* next,
+                           const double* up) noexcept;
 
   const StiffnessOperator& stiffness_;
   const Eigen::VectorXd& mass_;
@@ -118,7 +148,10 @@ class RegionIntegrator {
   std::vector<double> prescribed_reaction_;
   std::vector<double> prescribed_work_;
   std::vector<int> controlled_;
+  size_t port_prescribed_from_ = SIZE_MAX;
+  double load_scale_ = 1;  // α the load limit applied in the last step
   double load_work_ = 0, damping_dissipated_ = 0, controlled_dissipated_ = 0;
+  double load_work_refused_ = 0, prescribed_work_refused_ = 0;
 };
 
 }  // namespace hapticsim

@@ -187,6 +187,7 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
     const EnergyAccount e = bare.Energies();
     out.energy_gain_j = EnergyAboveBound(e, start_energy);
     out.energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
+    out.backlog_bound_j = e.backlog_bound_j;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
@@ -237,6 +238,7 @@ FaultOutcome RunFaultCase(const StressOutcome& outcome, double run_s, const Timi
   out.max_force_step_n = LargestForceStep(trial);
   const EnergyAccount e = regions.Energies();
   out.energy_gain_j = EnergyAboveBound(e, 0.0);
+  out.backlog_bound_j = e.backlog_bound_j;
   out.diverged = trial.diverged() || !std::isfinite(e.stored_j) ||
                  e.stored_j > AsyncRegions::kEnergyGrowthFactor * out.energy_scale_j;
   return out;

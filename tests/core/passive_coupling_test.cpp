@@ -11,6 +11,7 @@
 #include "core/async_regions.hpp"
 #include "core/contact_trajectory.hpp"
 #include "core/force_error.hpp"
+#include "core/stability_stress.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
 namespace hapticsim {
@@ -22,8 +23,9 @@ Scene Adaptive(int r, int k, double rate_hz, double nu = 0.45) {
 
 struct BalanceRun {
   double worst_identity_j = 0;  // |stored − start − input + damping − created + taken out|
-  double worst_gain_j = -INFINITY;  // EnergyAboveBound, most
-  double worst_unbacked_j = -INFINITY;  // EnergyAboveBound − the controllers' backlog, most
+  double worst_gain_j = -INFINITY;         // EnergyAboveBound, most
+  double worst_unbacked_j = -INFINITY;     // EnergyAboveBound − the controllers' backlog, most
+  double worst_over_limits_j = -INFINITY;  // the backlog − what the port limits allow, most
   double peak_stored_j = 0;
   double peak_force_n = 0;
   EnergyAccount end;
@@ -42,13 +44,14 @@ BalanceRun PressChecked(AsyncRegions& dut, const Scene& scene) {
     const auto r = dut.StepPrimary(trajectory.DisplacementAt((n + 1) * scene.solver.dt_s));
     run.peak_force_n = std::max(run.peak_force_n, std::hypot(r[0], r[1], r[2]));
     const EnergyAccount e = dut.Energies();
-    const double identity = e.stored_j - start.stored_j - e.input_work_j +
-                            e.damping_dissipated_j - e.interface_created_j +
-                            e.interface_dissipated_j;
+    const double identity = e.stored_j - start.stored_j - e.input_work_j + e.damping_dissipated_j -
+                            e.interface_created_j + e.interface_dissipated_j;
     run.worst_identity_j = std::max(run.worst_identity_j, std::abs(identity));
     run.worst_gain_j = std::max(run.worst_gain_j, EnergyAboveBound(e, start.stored_j));
     run.worst_unbacked_j =
         std::max(run.worst_unbacked_j, EnergyAboveBound(e, start.stored_j) - e.pending_excess_j);
+    run.worst_over_limits_j =
+        std::max(run.worst_over_limits_j, e.pending_excess_j - e.backlog_bound_j);
     run.peak_stored_j = std::max(run.peak_stored_j, e.stored_j);
     run.end = e;
   }
@@ -83,6 +86,8 @@ TEST(PassiveCoupling, TheEnergyBalanceHoldsToRoundOffAtEveryStepAndTheGainIsTheC
     // Above the controllers' bound by no more than their backlog, whatever happens (an exact
     // consequence of the bookkeeping, to round-off) ...
     EXPECT_LT(run.worst_unbacked_j, 1e-12 * run.peak_stored_j * scene.num_steps()) << label;
+    // ... which the port limits bound, by construction.
+    EXPECT_LT(run.worst_over_limits_j, 1e-12 * run.peak_stored_j * scene.num_steps()) << label;
     // ... and that backlog small: one step's worth where the damping outweighs the lag (measured
     // below 5e-6 of the peak stored energy), more where the controllers must hold a growing
     // exchange (ν 0.49: measured up to 0.7 %).
@@ -154,6 +159,40 @@ TEST(PassiveCoupling, OnTheDefaultMaterialTheControllersCostAtMostATenthOfAPoint
         EXPECT_LT(with - without, 0.1) << "k " << k << " r " << r << " " << rate << " Hz";
       }
     }
+  }
+}
+
+// What outgrew the controllers alone (docs/regions.md, "The port limits"): the force exchange with
+// an outer shell faster than the one inside it, stress seed 1's cases 20 and 202. Run as the
+// stress test runs them — from a random state under their extreme input, every region within
+// its own limit — the controllers alone let them diverge; with the port limits each ends with
+// less energy than it started with plus the input's work, and the observers within what the
+// limits allow.
+TEST(PassiveCoupling, ThePortLimitsHoldWhatOutgrewTheControllers) {
+  StressRanges ranges;
+  ranges.max_nodes = 7;
+  for (int index : {20, 202}) {
+    const StressCase drawn = DrawStressCase(1, index, ranges);
+    const std::string label = DescribeStressCase(drawn);
+    Scene scene = drawn.scene;
+    scene.input.periods = 3;
+    AsyncRegions damped(scene, AsyncRegions::kSubstepSafety,
+                        AsyncRegions::InterfaceControl::kDampingOnly);
+    EXPECT_TRUE(damped.RunTrialFromRandomState(scene.input, drawn.state_seed).diverged()) << label;
+
+    AsyncRegions guarded(scene);
+    guarded.SetRandomState(drawn.state_seed);
+    const double at_start = guarded.Energy();
+    const TrialResult result = guarded.RunTrialFromRandomState(scene.input, drawn.state_seed);
+    ASSERT_EQ(result.outcome, TrialOutcome::kCompleted) << label;
+    const EnergyAccount e = guarded.Energies();
+    EXPECT_GT(e.port_refused_j, 0) << label;
+    EXPECT_LT(guarded.Energy(), at_start + e.input_work_j) << label;
+    EXPECT_LE(e.pending_excess_j, e.backlog_bound_j * (1 + 1e-9)) << label;
+    std::printf(
+        "%s\n  energy %.3g J at the end (%.3g J at the start, input work %.3g J); the "
+        "port limits refused %.3g J\n",
+        label.c_str(), guarded.Energy(), at_start, e.input_work_j, e.port_refused_j);
   }
 }
 

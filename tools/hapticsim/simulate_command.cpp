@@ -115,9 +115,8 @@ int Run(const SimulateOptions& options) {
         "--threads runs the asynchronous regions on real threads: set "
         "adaptivity.primary_size >= 1 too");
   }
-  const TrialResult result =
-      adaptive ? RunAdaptive(scene, options.threads, &report)
-               : RunReferenceTrial(CubeScene(scene), trial_options);
+  const TrialResult result = adaptive ? RunAdaptive(scene, options.threads, &report)
+                                      : RunReferenceTrial(CubeScene(scene), trial_options);
   std::optional<ForceError> error;
   std::optional<TrialResult> reference;
   if (options.compare_reference && !result.samples.empty()) {
@@ -181,7 +180,8 @@ int Run(const SimulateOptions& options) {
                          {"input_work", e.input_work_j},
                          {"damping_dissipated", e.damping_dissipated_j},
                          {"interface_created", e.interface_created_j},
-                         {"interface_dissipated", e.interface_dissipated_j}};
+                         {"interface_dissipated", e.interface_dissipated_j},
+                         {"port_refused", e.port_refused_j}};
       for (size_t i = 0; i < report.regions.size(); ++i) {
         const RegionReport& r = report.regions[i];
         out["regions"].push_back({{"name", r.name},
@@ -241,7 +241,8 @@ int Run(const SimulateOptions& options) {
                                             "interface controllers hold it)")
                 << "\n  energy: the exchange between the regions created "
                 << Quantity(e.interface_created_j, "J") << " and the interface controllers took "
-                << "out " << Quantity(e.interface_dissipated_j, "J") << " (the input did "
+                << "out " << Quantity(e.interface_dissipated_j, "J") << "; the port limits kept "
+                << Quantity(e.port_refused_j, "J") << " of work out (the input did "
                 << Quantity(e.input_work_j, "J") << " of work)\n";
     } else {
       std::cout << "  stability: critical dt " << Duration(result.stability.critical_dt_s)
