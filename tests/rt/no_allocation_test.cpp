@@ -62,6 +62,26 @@ TEST(RegionSteps, NeverAllocate) {
   }
 }
 
+// The same while the port limits act: a configuration whose bare exchange grows (ν 0.49, k 1
+// r 2 at 900 Hz) from a random state (every mode excited), stepped until they have refused work.
+TEST(RegionSteps, NeverAllocateWhileThePortLimitsAct) {
+  Scene scene;
+  scene.material.poisson_ratio = 0.49;
+  scene.adaptivity.primary_size = 2;
+  scene.adaptivity.secondary_lod = 1;
+  scene.adaptivity.secondary_rate_hz = 900;
+  AsyncRegions dut(scene);
+  dut.SetRandomState(5);
+  std::array<double, 3> contact{0, 0, 0};
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 1000; ++n) {
+    dut.AdvanceSecondariesTo(dut.state_ticks(kPrimaryRegion) + dut.period_ticks(kPrimaryRegion));
+    contact[2] = 2e-5 * n;
+    ASSERT_TRUE(std::isfinite(dut.StepPrimary(contact)[2]));
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_GT(dut.Energies().port_refused_j, 0) << "the limits never acted: the test saw nothing";
+}
 
 }  // namespace
 }  // namespace hapticsim
@@ -96,7 +116,6 @@ TEST(ErrorLookup, NeverAllocates) {
   EXPECT_EQ(count.count(), 0u);
   EXPECT_GT(sum, 0);
 }
-
 
 }  // namespace
 }  // namespace hapticsim
@@ -140,8 +159,6 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
   EXPECT_TRUE(pushed_back);
   EXPECT_TRUE(record.flags & force_flags::kInputStale);
 }
-
-
 
 // The port guard acting in the primary period: the envelope saturating, the engagement ramp, the
 // passivity controller and a fault latching (a fault_force_n below the press's force) cost no
