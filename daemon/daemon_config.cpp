@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/scene_toml.hpp"
+#include "daemon/supervisor.hpp"
 
 namespace hapticsim {
 namespace {
@@ -135,11 +136,13 @@ const std::map<std::string, Setter>& Setters() {
 }
 
 // The adaptive configuration the daemon starts from (before the supervisor chooses one) is
-// given by the scene file's [adaptivity]; without one, a small stable default.
+// given by the scene file's [adaptivity]; without one, the scene's default spacing factor at
+// the default primary size, with the secondary at the primary rate: equal rates are exactly
+// monolithic, so a daemon without a map starts from a configuration whose coupling is stable by
+// construction. The other adaptivity settings (shells, outer_rate, …) stay the scene's.
 void DefaultAdaptivity(Scene* scene) {
   if (scene->adaptivity.primary_size > 0) return;
-  scene->adaptivity.primary_size = 3;
-  scene->adaptivity.secondary_lod = 2;
+  scene->adaptivity.primary_size = RegionConfiguration::kDaemonPrimarySize;
   scene->adaptivity.secondary_rate_hz = PrimaryRateHz(*scene);
 }
 
@@ -170,30 +173,27 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
               value(p.max_force_n));
   // A release from the ceiling to zero within a second: a fault must not hold force for longer.
   require(std::isfinite(p.max_force_rate_n_per_ms) &&
-              p.max_force_rate_n_per_ms >= p.max_force_n / 1000 &&
-              p.max_force_rate_n_per_ms <= 100,
+              p.max_force_rate_n_per_ms >= p.max_force_n / 1000 && p.max_force_rate_n_per_ms <= 100,
           "device.max_force_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
               FormatReal(p.max_force_n / 1000) + ") to 100 N per ms" +
               value(p.max_force_rate_n_per_ms));
-  require(std::isfinite(p.engage_rate_n_per_ms) &&
-              p.engage_rate_n_per_ms >= p.max_force_n / 1000 &&
+  require(std::isfinite(p.engage_rate_n_per_ms) && p.engage_rate_n_per_ms >= p.max_force_n / 1000 &&
               p.engage_rate_n_per_ms <= p.max_force_rate_n_per_ms,
           "device.engage_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
               FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
-              FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" +
-              value(p.engage_rate_n_per_ms));
-  require(std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n &&
-              p.fault_force_n <= 1000,
-          "device.fault_force_n must be from device.max_force_n (" + FormatReal(p.max_force_n) +
-              ") to 1000 N" + value(p.fault_force_n));
+              FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" + value(p.engage_rate_n_per_ms));
+  require(
+      std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n && p.fault_force_n <= 1000,
+      "device.fault_force_n must be from device.max_force_n (" + FormatReal(p.max_force_n) +
+          ") to 1000 N" + value(p.fault_force_n));
   require(std::isfinite(p.watchdog_s) && p.watchdog_s >= 0.05 && p.watchdog_s <= 10,
           "device.watchdog_s must be from 0.05 to 10 s (a loaded desktop stalls a process for "
           "up to 0.1 s)" +
               value(p.watchdog_s));
-  require(std::isfinite(p.max_damping_n_s_per_m) && p.max_damping_n_s_per_m >= 0 &&
-              p.max_damping_n_s_per_m <= 1000,
-          "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m" +
-              value(p.max_damping_n_s_per_m));
+  require(
+      std::isfinite(p.max_damping_n_s_per_m) && p.max_damping_n_s_per_m >= 0 &&
+          p.max_damping_n_s_per_m <= 1000,
+      "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m" + value(p.max_damping_n_s_per_m));
   require(c.device_input.empty() || c.device_input == "lcm" || c.device_input == "shm",
           "device.input must be \"lcm\" or \"shm\" (it is \"" + c.device_input + "\")");
   require(c.device_input != "shm" || c.shm_enabled,
@@ -217,8 +217,8 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
-  for (const auto& [key, path] : {std::pair{"shm.socket", &c.shm_socket},
-                                  {"control.socket", &c.control_socket}}) {
+  for (const auto& [key, path] :
+       {std::pair{"shm.socket", &c.shm_socket}, {"control.socket", &c.control_socket}}) {
     require(path->size() > 1 && (*path)[0] == '/' && path->back() != '/' && path->size() <= 107,
             std::string(key) +
                 " must be an absolute path of a socket file, at most 107 bytes (a Unix "

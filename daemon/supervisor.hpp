@@ -9,12 +9,18 @@
 
 namespace hapticsim {
 
-/** An adaptive configuration the supervisor can choose. */
+/**
+ * An adaptive configuration the supervisor can choose: the three of the scene's adaptivity
+ * settings it varies (the rest — shells, outer_rate, support layers, the exchange — stay the
+ * scene's). Defaults: the scene's own (AdaptivitySettings), so that one quantity has one default.
+ */
 struct RegionConfiguration {
-  int primary_size = 3;
-  int secondary_lod = 2;
-  double secondary_rate_hz = 1000;
+  int primary_size = kDaemonPrimarySize;
+  int secondary_lod = AdaptivitySettings{}.secondary_lod;
+  double secondary_rate_hz = AdaptivitySettings{}.secondary_rate_hz;
   bool operator==(const RegionConfiguration&) const = default;
+  /** The primary size the daemon starts from when its scene names none. */
+  static constexpr int kDaemonPrimarySize = 3;
 };
 
 /** "primary_size 3, secondary_lod 2, secondary_rate 1000 Hz": as logs and errors name it. */

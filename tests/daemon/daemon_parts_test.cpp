@@ -7,6 +7,7 @@
 #include <limits>
 #include <tuple>
 
+#include "core/async_regions.hpp"
 #include "core/error.hpp"
 #include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
@@ -178,6 +179,33 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 
 // LCM traffic stays on this host unless the config says, in a key of its own, that it may leave:
 // ttl=255 and a TCP provider to another machine were accepted as any URL with "://".
+// What the scene's adaptivity does in the daemon: the supervisor chooses primary_size,
+// secondary_lod and secondary_rate; everything else — here two shells with the outer one at
+// adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
+// main.cpp builds its HapticLoop). Without [adaptivity] the daemon starts from the default size
+// at equal rates.
+TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {
+  const std::string scene_path = ::testing::TempDir() + "hapticsimd_outer_rate_scene.toml";
+  std::ofstream(scene_path) << "[adaptivity]\nprimary_size = 2\nsecondary_lod = 2\n"
+                               "secondary_rate = 800\nsecondary_regions = 2\nouter_rate = 500\n";
+  const std::string path = ConfigTestPath();
+  std::ofstream(path) << "[scene]\nfile = \"" << scene_path << "\"\n";
+  const DaemonConfig config = LoadDaemonConfig(path);
+  EXPECT_EQ(config.scene.adaptivity.outer_rate_hz, 500);
+  const SupervisorDecision decision = ChooseConfiguration(config.scene, nullptr, 7.0, std::nullopt);
+  EXPECT_EQ(decision.configuration, (RegionConfiguration{2, 2, 800}));
+  const AsyncRegions regions(SceneWith(config.scene, decision.configuration));
+  ASSERT_EQ(regions.num_regions(), 3);
+  EXPECT_EQ(regions.schedule(1).rate_hz, 800);
+  EXPECT_EQ(regions.schedule(2).rate_hz, 500);
+
+  const DaemonConfig defaults = DefaultDaemonConfig();
+  EXPECT_EQ(defaults.scene.adaptivity.primary_size, RegionConfiguration::kDaemonPrimarySize);
+  EXPECT_EQ(defaults.scene.adaptivity.secondary_lod, AdaptivitySettings{}.secondary_lod);
+  EXPECT_EQ(defaults.scene.adaptivity.secondary_rate_hz, PrimaryRateHz(defaults.scene));
+  EXPECT_EQ(RegionConfiguration{}.secondary_rate_hz, AdaptivitySettings{}.secondary_rate_hz);
+}
+
 TEST(DaemonConfig, AnLcmUrlThatLeavesTheHostNeedsAllowNetwork) {
   for (const char* url : {"udpm://239.255.76.67:7667?ttl=0", "udpm://239.255.76.68:7700?ttl=0",
                           "udpm://239.255.76.67:7667?recv_buf_size=2097152&ttl=0", "memq://",
