@@ -363,8 +363,9 @@ int Run(const StressOptions& o) {
         << " s; slowest case " << slowest_case_s << " s)\n"
         << "  predicted stable            " << predicted_stable << ", of which diverged "
         << stable_diverged << "\n"
-        << "  energy above the bound      " << energy_violations
-        << " cases by more than the port limits allow (worst: above the controllers' bound by "
+        << "  energy bound                " << energy_violations
+        << " cases above it by more than the port limits allow (worst: above the controllers' "
+           "bound by "
         << worst_energy_gain << " of the case's energy)\n"
         << "  held by the controllers     " << passive
         << " (production margin, displacement exchange; bare exchange unstable "
