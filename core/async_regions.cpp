@@ -60,14 +60,12 @@ class RegionWithInnerBand final : public StiffnessOperator {
 
 }  // namespace
 
-// The energy of the whole object at a uniform strain of kPortFloorStrain, ½ E ε² V. An exchange
-// at equal rates creates nothing, but its outer side steps first and takes in what the inner
-// side gives out only in its own step: for that one step the outer side's view of the observer
-// is a step's flow high. Early in a press the regions' energies are too small to cover that
-// (they start at zero while the flow does not), and a limit that then acted would break the
-// exact monolithic result. Measured on the default scene: a floor of 10⁻⁷ J (a strain of
-// 3.6 × 10⁻⁵) left every equal-rate press of the tests untouched, 10⁻⁹ J did not; 10⁻⁴ keeps a
-// margin above that.
+// The energy of the whole object at a uniform strain of kPortFloorStrain, ½ E ε² V: the
+// allowance when both regions' energies are still zero. Early in a press they are, while a
+// lagged exchange already moves energy across Γ; with no floor every first step of a multirate
+// press would be refused. (At equal rates lock-step covers that; before lock-step was
+// recognised, a floor of 10⁻⁷ J — a strain of 3.6 × 10⁻⁵ on the default scene — left every
+// equal-rate press of the tests untouched, 10⁻⁹ J did not.)
 double AsyncRegions::PortFloorJ(const Material& material, double mass_kg) {
   const double volume = mass_kg / material.density_kg_m3;
   return 0.5 * material.youngs_modulus_pa * kPortFloorStrain * kPortFloorStrain * volume;
@@ -107,6 +105,13 @@ struct AsyncRegions::Region {
   // The largest port allowance each side has used and energy it has had since Reset, for the
   // bound the port limits guarantee (EnergyAccount::backlog_bound_j).
   double inward_allowance_peak = 0, outward_allowance_peak = 0, energy_peak = 0;
+  // In lock-step (InwardPortLimit) the load is not limited: the largest work it did so, J.
+  double lockstep_load_peak = 0;
+  bool lockstep_step = false;  // this step's load went unlimited
+  // As the inner side: the end tick of its latest step whose outer Γ did not follow the outer
+  // region's snapshot at that time (held for a late outer region, or port-limited). Stored
+  // before the band is published (release), read after it (acquire).
+  std::atomic<std::int64_t> last_inexact_follow_ticks{INT64_MIN};
   // As the inner side of the link outwards:
   double outer_gamma_work = 0;  // work done on this region by moving its outer Γ
   double outward_taken = 0;     // what its controller took out for that link
@@ -320,6 +325,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   const double h = integrator.substep();
   const auto& outer_gamma = region.dofs->outer_interface;
   const auto& inner_gamma = region.dofs->inner_interface;
+  bool followed = true;  // this step's outer Γ is the outer region's own at the step's end
 
   if (contact_next != nullptr) {
     for (int c = 0; c < 3; ++c) region.prescribed_values[c] = (*contact_next)[c];
@@ -329,6 +335,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     (void)region.inward->TryReadLatestTwo(&region.outer);
     // The outer region is ahead: interpolate. If it is late, hold its newest state.
     const double t = std::min(t0 + h, region.outer.newer.time_s);
+    followed = region.outer.newer.time_s >=
+               static_cast<double>(region.state_ticks + region.period_ticks) / ticks_per_second_;
     if (a == kPrimaryRegion) {
       primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
     }
@@ -373,7 +381,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     region.energy_peak = std::max(region.energy_peak, energy);
     if (a > 0) {
       asked_inward = ObserveInwardLink(a, energy);
-      if (limited) limits.load_work_j = InwardPortLimit(a, energy);
+      if (limited) limits.load_work_j = InwardPortLimit(a, energy, InLockStep(a));
     }
     if (region.inward) {
       asked_outward = OutwardLinkExcess(a);
@@ -393,6 +401,9 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   }
   AccountStep(a, asked_inward, asked_outward);
   region.state_ticks += region.period_ticks;
+  if (region.inward && (!followed || integrator.PrescribedWorkRefused() > 0)) {
+    region.last_inexact_follow_ticks.store(region.state_ticks, std::memory_order_release);
+  }
   if (a > 0) PublishInward(a);
   if (region.inward) PublishOutward(a);
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
@@ -442,20 +453,41 @@ double AsyncRegions::PrimaryReserve(RegionIntegrator& primary) noexcept {
 // The port limits: the last line, for what the controllers cannot take out in time (a mode that
 // outgrows one step's damping, a neighbour late or stalled). Each side of a link lets its port
 // do work only while the link's observer, as that side can know it, stays below the link's
-// allowance: kPortAllowance of the two regions' energies plus a floor (PortFloorJ). The outer side
-// knows the observer as of the inner side's last publication; the inner side knows it as of the
-// outer side's last publication plus its own sums since (exactly). Either view misses only what the
-// other side did since, and that side held itself to the allowance from its own view: so the
-// observer never exceeds two allowances plus the credit the floor keeps (kCreditMemory), whatever
-// the timing (docs/regions.md, "The port limits").
-double AsyncRegions::InwardPortLimit(RegionIndex a, double energy) noexcept {
+// allowance: kPortAllowance of the two regions' energies plus a floor (PortFloorJ). The outer
+// side knows the observer as of the inner side's last publication; the inner side knows it as of
+// the outer side's last publication plus its own sums since (exactly). Either view misses only
+// what the other side did since, and that side held itself to the allowance from its own view:
+// so EnergyAboveBound never exceeds the two allowances, the credit the floor keeps
+// (kCreditMemory) and what lock-step let in unlimited (InLockStep), whatever the timing
+// (docs/regions.md, "The port limits").
+double AsyncRegions::InwardPortLimit(RegionIndex a, double energy, bool lockstep) noexcept {
   Region& region = *regions_[a];
   const Region& inner = *regions_[a - 1];
   const double allowance =
       kPortAllowance * (energy + inner.energy_published.load(std::memory_order_relaxed)) +
       port_floor_j_;
   region.inward_allowance_peak = std::max(region.inward_allowance_peak, allowance);
+  region.lockstep_step = lockstep && region.excess <= allowance;
+  if (region.lockstep_step) return INFINITY;
   return std::max(0.0, allowance - region.excess);
+}
+
+// Lock-step: the inner region steps with this one's period, its newest band is at this step's
+// start, and its last two steps followed this region's Γ exactly. Then the exchange of this step
+// is monolithic central difference: the inner side's coming step gives out what this one takes
+// in (the load is the inner band's force at this step's start, on the Γ motion this step makes),
+// but this side, stepping first, cannot yet see it — one step's flow, which at equal rates can
+// exceed the allowance many times over (a 20 Hz sine on primary_size 1: 44 % of error when it
+// was limited). So the load goes unlimited in lock-step while the observer is under the
+// allowance. Should the inner side then not follow (a late thread holds Γ), what this step took
+// in unmatched is at most its load work, which lockstep_load_peak keeps for the bound.
+bool AsyncRegions::InLockStep(RegionIndex a) const noexcept {
+  const Region& region = *regions_[a];
+  const Region& inner = *regions_[a - 1];
+  return inner.period_ticks == region.period_ticks &&
+         region.inner.newer.time_s == static_cast<double>(region.state_ticks) / ticks_per_second_ &&
+         inner.last_inexact_follow_ticks.load(std::memory_order_acquire) <
+             region.state_ticks - region.period_ticks;
 }
 
 double AsyncRegions::OutwardPortLimit(RegionIndex a, double energy) noexcept {
@@ -494,6 +526,10 @@ void AsyncRegions::AccountStep(RegionIndex a, double asked_inward, double asked_
     for (int c = 0; c < 3; ++c) region.input_work += integrator.PrescribedWork(c);
   }
   if (a > 0) {
+    if (region.lockstep_step) {
+      region.lockstep_load_peak = std::max(region.lockstep_load_peak, integrator.LoadWork());
+      region.lockstep_step = false;
+    }
     region.inner_gamma_load_work += integrator.LoadWork();
     region.inward_taken += taken_inward;
     region.unmet = std::max(0.0, asked_inward - taken_inward);
@@ -524,6 +560,9 @@ void AsyncRegions::ResetEnergyAccount() noexcept {
   for (auto& region : regions_) {
     region->input_work = region->damping_dissipated = region->port_refused = 0;
     region->inward_allowance_peak = region->outward_allowance_peak = region->energy_peak = 0;
+    region->lockstep_load_peak = 0;
+    region->lockstep_step = false;
+    region->last_inexact_follow_ticks.store(INT64_MIN, std::memory_order_relaxed);
     region->outer_gamma_work = region->outward_taken = 0;
     region->inner_gamma_load_work = region->inward_taken = region->excess = region->unmet = 0;
     region->inner_work_seen = region->inner_taken_seen = 0;
@@ -551,7 +590,7 @@ EnergyAccount AsyncRegions::Energies() noexcept {
       const Region& inner = *regions_[a - 1];
       if (control_ == InterfaceControl::kPassive) {
         account.backlog_bound_j += inner.outward_allowance_peak + region.inward_allowance_peak +
-                                   kCreditMemory * region.energy_peak;
+                                   kCreditMemory * region.energy_peak + region.lockstep_load_peak;
       }
       account.pending_excess_j += region.excess +
                                   (inner.outer_gamma_work - region.inner_work_seen) -
@@ -750,9 +789,14 @@ void AsyncRegions::ScaleAll(double factor) {
     for (double* energy :
          {&region->input_work, &region->damping_dissipated, &region->outer_gamma_work,
           &region->outward_taken, &region->inner_gamma_load_work, &region->inward_taken,
-          &region->excess, &region->unmet, &region->inner_work_seen, &region->inner_taken_seen}) {
+          &region->excess, &region->unmet, &region->inner_work_seen, &region->inner_taken_seen,
+          &region->port_refused, &region->inward_allowance_peak, &region->outward_allowance_peak,
+          &region->energy_peak, &region->lockstep_load_peak}) {
       *energy *= squared;
     }
+    region->energy_published.store(
+        squared * region->energy_published.load(std::memory_order_relaxed),
+        std::memory_order_relaxed);
     PublishEnergyAccount(*region);
     region->integrator->ScaleState(factor);
     if (region->inward) region->inward->ScaleAll(factor);

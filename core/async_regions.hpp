@@ -62,10 +62,12 @@ struct EnergyAccount {
   /** Work the port limits kept out of the regions (PortWorkLimits), J (≥ 0). */
   double port_refused_j = 0;
   /**
-   * The most the observers can hold, by the port limits' construction, whatever the timing:
-   * over the links, the largest allowance each side has used plus kCreditMemory of the outer
-   * region's largest energy (docs/regions.md, "The port limits"). pending_excess_j ≤ this.
-   * 0 with the limits off (kDampingOnly, kOff): nothing is guaranteed then.
+   * What the port limits guarantee, whatever the timing: EnergyAboveBound ≤ this. Over the
+   * links, the largest allowance each side has used, kCreditMemory of the outer region's largest
+   * energy and the largest load work taken in lock-step (docs/regions.md, "The port limits").
+   * (The observers themselves, pending_excess_j, can pass it on real threads by a floor raise
+   * made on a stale view, which EnergyAboveBound does not count.) 0 with the limits off
+   * (kDampingOnly, kOff): nothing is guaranteed then.
    */
   double backlog_bound_j = 0;
 };
@@ -265,7 +267,8 @@ class AsyncRegions {
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
-  double InwardPortLimit(RegionIndex region, double energy) noexcept;
+  double InwardPortLimit(RegionIndex region, double energy, bool lockstep) noexcept;
+  bool InLockStep(RegionIndex region) const noexcept;
   double OutwardPortLimit(RegionIndex region, double energy) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
   static double PrimaryReserve(RegionIntegrator& primary) noexcept;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -98,17 +99,24 @@ struct StressOutcome {
   bool passive_but_diverged() const { return passive_expected && controlled_diverged(); }
   /**
    * A case run as the daemon runs it that ended with more energy than the controllers' bound
-   * (EnergyAboveBound) by more than the port limits let the observers hold (backlog_bound_j, to
-   * round-off) — whatever its regions and its exchange: that bound holds by construction — or,
-   * predicted stable, by more than the observer's one step.
+   * (EnergyAboveBound) by more than the port limits allow (backlog_bound_j, to round-off) —
+   * whatever its regions and its exchange: that bound holds by construction; or, held by the
+   * controllers (passive_expected), by more than kGrowingBacklog of its energy; or, predicted
+   * stable, by more than the observer's one step.
    */
   bool energy_balance_violated() const {
     if (!controlled_run) return false;
+    // A run whose energy overflowed diverged: the divergence checks report it.
+    if (!std::isfinite(energy_gain_j) || !std::isfinite(backlog_bound_j)) return false;
     if (energy_gain_j > backlog_bound_j + kRoundOff * energy_scale_j) return true;
+    if (passive_expected && energy_gain_j > kGrowingBacklog * energy_scale_j) return true;
     return predicted_stable && energy_gain_j > 1e-6 * energy_scale_j;
   }
   /** The energy sums' round-off, as a share of the case's energy. */
   static constexpr double kRoundOff = 1e-9;
+  /** What the controllers may leave where the bare exchange grows, as a share of the case's
+   *  energy: measured up to 0.11 % (seeds 1–4), far below what the port limits allow. */
+  static constexpr double kGrowingBacklog = 0.01;
   /** A predicted-stable case that diverged, bare or as run: the prediction failed. */
   bool stable_but_diverged() const {
     return predicted_stable && (diverged() || controlled_diverged());

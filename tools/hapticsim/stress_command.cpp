@@ -364,7 +364,8 @@ int Run(const StressOptions& o) {
         << "  predicted stable            " << predicted_stable << ", of which diverged "
         << stable_diverged << "\n"
         << "  energy bound                " << energy_violations
-        << " cases above it by more than the port limits allow (worst: above the controllers' "
+        << " cases above it by more than allowed (the port limits' backlog; 1 % where held by "
+           "the controllers; one step where predicted stable. Worst: above the controllers' "
            "bound by "
         << worst_energy_gain << " of the case's energy)\n"
         << "  held by the controllers     " << passive
