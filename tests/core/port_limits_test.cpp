@@ -115,6 +115,27 @@ TEST_F(PortLimitsTest, ALoadAskedToDoLessDoesExactlyTheLimitAndTheBalanceHolds) 
   }
 }
 
+// A load large enough that its own push dominates its work (A ≫ |B|) does positive work either
+// way round, and f and −f put B on either side of zero: both forms of the root.
+TEST_F(PortLimitsTest, ALoadLimitHoldsOnBothRootBranches) {
+  DrawInput(1);
+  for (double& f : load_) f *= 1e3;
+  for (int sign : {1, -1}) {
+    for (double& f : load_) f = -f;
+    auto free = MakeRegion(1);
+    free->Step(next_, load_);
+    const double unlimited = free->LoadWork();
+    ASSERT_GT(unlimited, 0) << sign;
+    auto region = MakeRegion(1);
+    const double before = region->DiscreteEnergy();
+    PortWorkLimits limits;
+    limits.load_work_j = 0.25 * unlimited;
+    region->Step(next_, load_, 0, limits);
+    EXPECT_NEAR(region->LoadWork(), 0.25 * unlimited, 1e-12 * unlimited) << sign;
+    EXPECT_NEAR(BalanceResidual(*region, before), 0, 1e-12 * unlimited) << sign;
+  }
+}
+
 TEST_F(PortLimitsTest, ALimitNotReachedChangesNothing) {
   DrawInput(1);
   auto free = MakeRegion(1);
@@ -125,6 +146,18 @@ TEST_F(PortLimitsTest, ALimitNotReachedChangesNothing) {
   limited->Step(next_, load_, 0, limits);
   EXPECT_EQ(free->u(), limited->u());  // bit for bit
   EXPECT_EQ(limited->LoadWorkRefused(), 0);
+}
+
+TEST_F(PortLimitsTest, APrescribedLimitNotReachedChangesNothing) {
+  DrawInput(kPrimaryRegion);
+  auto free = MakeRegion(kPrimaryRegion);
+  free->Step(next_, load_);
+  auto limited = MakeRegion(kPrimaryRegion);
+  PortWorkLimits limits;
+  limits.prescribed_work_j = std::abs(PortWork(*free)) + 1.0;
+  limited->Step(next_, load_, 0, limits);
+  EXPECT_EQ(free->u(), limited->u());  // bit for bit
+  EXPECT_EQ(limited->PrescribedWorkRefused(), 0);
 }
 
 TEST_F(PortLimitsTest, APrescribedPortAskedToDoLessDoesExactlyTheLimitAndTheContactStays) {
