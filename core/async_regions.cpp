@@ -107,7 +107,8 @@ struct AsyncRegions::Region {
   double inward_allowance_peak = 0, outward_allowance_peak = 0, energy_peak = 0;
   // In lock-step (InwardPortLimit) the load is not limited: the largest work it did so, J.
   double lockstep_load_peak = 0;
-  bool lockstep_step = false;  // this step's load went unlimited
+  bool lockstep_step = false;                 // this step's load went unlimited
+  std::int64_t no_lockstep_before_ticks = 0;  // after a skip: its u⁻ is older than its Γ
   // As the inner side: the end tick of its latest step whose outer Γ did not follow the outer
   // region's snapshot at that time (held for a late outer region, or port-limited). Stored
   // before the band is published (release), read after it (acquire).
@@ -288,6 +289,8 @@ void AsyncRegions::Reset() {
     if (region->outward) region->outward->Clear();
     region->state_ticks = 0;
     region->compute_s = 0;
+    region->last_inexact_follow_ticks.store(INT64_MIN, std::memory_order_relaxed);
+    region->no_lockstep_before_ticks = 0;
   }
   ResetEnergyAccount();
   primary_boundary_age_s_.store(0, std::memory_order_relaxed);
@@ -335,8 +338,10 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     (void)region.inward->TryReadLatestTwo(&region.outer);
     // The outer region is ahead: interpolate. If it is late, hold its newest state.
     const double t = std::min(t0 + h, region.outer.newer.time_s);
-    followed = region.outer.newer.time_s >=
-               static_cast<double>(region.state_ticks + region.period_ticks) / ticks_per_second_;
+    const double end =
+        static_cast<double>(region.state_ticks + region.period_ticks) / ticks_per_second_;
+    // On the line between the two snapshots, not held short of it nor clamped to a later one.
+    followed = region.outer.older.time_s <= end && end <= region.outer.newer.time_s;
     if (a == kPrimaryRegion) {
       primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
     }
@@ -373,7 +378,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   double asked_inward = 0, asked_outward = 0;
   PortWorkLimits limits;
   if (control_ != InterfaceControl::kOff) {
-    const bool limited = control_ == InterfaceControl::kPassive;
+    const bool limited = PortLimited();
     // An O(n) pass over the region's DOFs (K·u is cached for the step): the controllers' floor
     // and the port limits follow the energy step by step.
     const double energy = std::max(0.0, integrator.DiscreteEnergy());
@@ -423,8 +428,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
 // then create an hour's worth before the controllers act. Since that floor only ever raises the
 // observer, created − taken out ≤ kDampingCredit × the secondaries' damping + the observers'
 // positive excess, whatever the timing. That excess is what the controllers have not yet
-// managed to take out: one step's worth while they keep up; where a mode outgrows them, the
-// port limits below bound it. (The daemon still verifies the bare exchange before it runs a
+// managed to take out: one step's worth while they keep up; where a mode outgrows them (the
+// force exchange was measured to), the port limits below bound it. (The daemon still verifies the bare exchange before it runs a
 // configuration: in some stiff scenes a region's own discrete energy is not positive, and then
 // no bound on it bounds the state — docs/regions.md, "The port limits".)
 
@@ -484,7 +489,8 @@ double AsyncRegions::InwardPortLimit(RegionIndex a, double energy, bool lockstep
 bool AsyncRegions::InLockStep(RegionIndex a) const noexcept {
   const Region& region = *regions_[a];
   const Region& inner = *regions_[a - 1];
-  return inner.period_ticks == region.period_ticks &&
+  return region.state_ticks >= region.no_lockstep_before_ticks &&
+         inner.period_ticks == region.period_ticks &&
          region.inner.newer.time_s == static_cast<double>(region.state_ticks) / ticks_per_second_ &&
          inner.last_inexact_follow_ticks.load(std::memory_order_acquire) <
              region.state_ticks - region.period_ticks;
@@ -562,7 +568,6 @@ void AsyncRegions::ResetEnergyAccount() noexcept {
     region->inward_allowance_peak = region->outward_allowance_peak = region->energy_peak = 0;
     region->lockstep_load_peak = 0;
     region->lockstep_step = false;
-    region->last_inexact_follow_ticks.store(INT64_MIN, std::memory_order_relaxed);
     region->outer_gamma_work = region->outward_taken = 0;
     region->inner_gamma_load_work = region->inward_taken = region->excess = region->unmet = 0;
     region->inner_work_seen = region->inner_taken_seen = 0;
@@ -588,7 +593,7 @@ EnergyAccount AsyncRegions::Energies() noexcept {
     account.interface_dissipated_j += region.inward_taken + region.outward_taken;
     if (a > 0) {
       const Region& inner = *regions_[a - 1];
-      if (control_ == InterfaceControl::kPassive) {
+      if (PortLimited()) {
         account.backlog_bound_j += inner.outward_allowance_peak + region.inward_allowance_peak +
                                    kCreditMemory * region.energy_peak + region.lockstep_load_peak;
       }
@@ -617,6 +622,12 @@ void AsyncRegions::SkipRegion(RegionIndex a, std::int64_t steps) noexcept {
   // Published twice, one step apart, with the same values: a flat line, so a neighbour reading
   // between them holds the state instead of interpolating towards the time before the stall.
   region.state_ticks += (steps - 1) * region.period_ticks;
+  // Neither link is in lock-step across a skip: its band and Γ are the state before the stall.
+  if (region.inward) {
+    region.last_inexact_follow_ticks.store(region.state_ticks + region.period_ticks,
+                                           std::memory_order_release);
+  }
+  region.no_lockstep_before_ticks = region.state_ticks + 3 * region.period_ticks;
   for (int twice = 0; twice < 2; ++twice) {
     PublishInward(a);
     if (region.inward) PublishOutward(a);

@@ -127,11 +127,11 @@ class AsyncRegions {
   double port_floor_j() const { return port_floor_j_; }
 
   /**
-   * kPassive: every interface's controller takes out what its exchange creates, and its port
-   * limits bound what the controllers cannot take out in time (always, in the daemon and the
-   * sweep). For analysis only — what each part costs and holds (docs/regions.md); no
-   * configuration file can ask for them: kDampingOnly, the controllers without the port limits;
-   * kOff, the bare exchange and the lag's own instability.
+   * kPassive: every interface's controller takes out what its exchange creates, and — with the
+   * force exchange — its port limits bound what the controllers cannot take out in time (always,
+   * in the daemon and the sweep). For analysis only — what each part costs and holds
+   * (docs/regions.md); no configuration file can ask for them: kDampingOnly, the controllers
+   * without the port limits; kOff, the bare exchange and the lag's own instability.
    */
   enum class InterfaceControl { kPassive, kDampingOnly, kOff };
 
@@ -269,6 +269,11 @@ class AsyncRegions {
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
   double InwardPortLimit(RegionIndex region, double energy, bool lockstep) noexcept;
   bool InLockStep(RegionIndex region) const noexcept;
+  /** Whether the port limits act: controllers on (kPassive) and the force exchange (the only
+   *  one the controllers alone were measured not to hold; docs/regions.md, "The port limits"). */
+  bool PortLimited() const noexcept {
+    return control_ == InterfaceControl::kPassive && coupling_ == Coupling::kForce;
+  }
   double OutwardPortLimit(RegionIndex region, double energy) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
   static double PrimaryReserve(RegionIntegrator& primary) noexcept;

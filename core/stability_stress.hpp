@@ -99,16 +99,18 @@ struct StressOutcome {
   bool passive_but_diverged() const { return passive_expected && controlled_diverged(); }
   /**
    * A case run as the daemon runs it that ended with more energy than the controllers' bound
-   * (EnergyAboveBound) by more than the port limits allow (backlog_bound_j, to round-off) —
-   * whatever its regions and its exchange: that bound holds by construction; or, held by the
-   * controllers (passive_expected), by more than kGrowingBacklog of its energy; or, predicted
-   * stable, by more than the observer's one step.
+   * (EnergyAboveBound) by more than the port limits allow (backlog_bound_j, to round-off; the
+   * force exchange, where they act) — whatever its regions: that bound holds by construction;
+   * or, held by the controllers (passive_expected), by more than kGrowingBacklog of its energy;
+   * or, predicted stable, by more than the observer's one step.
    */
   bool energy_balance_violated() const {
     if (!controlled_run) return false;
     // A run whose energy overflowed diverged: the divergence checks report it.
     if (!std::isfinite(energy_gain_j) || !std::isfinite(backlog_bound_j)) return false;
-    if (energy_gain_j > backlog_bound_j + kRoundOff * energy_scale_j) return true;
+    if (backlog_bound_j > 0 && energy_gain_j > backlog_bound_j + kRoundOff * energy_scale_j) {
+      return true;
+    }
     if (passive_expected && energy_gain_j > kGrowingBacklog * energy_scale_j) return true;
     return predicted_stable && energy_gain_j > 1e-6 * energy_scale_j;
   }
@@ -155,9 +157,14 @@ struct FaultOutcome {
   double max_force_step_n = 0;  ///< largest force change between primary periods, N
   double nominal_force_step_n = 0;  ///< the same input on the virtual-time schedule, N
   FaultCounts faults;
-  /** Above the controllers' bound by more than the port limits allow: never, by construction. */
+  /** Above the controllers' bound by more than the port limits allow (never, by construction),
+   *  or, without them (the displacement exchange), by more than kGrowingBacklog. */
   bool energy_balance_violated() const {
-    return energy_gain_j > backlog_bound_j + StressOutcome::kRoundOff * energy_scale_j;
+    if (!std::isfinite(energy_gain_j) || !std::isfinite(backlog_bound_j)) return diverged;
+    if (backlog_bound_j > 0) {
+      return energy_gain_j > backlog_bound_j + StressOutcome::kRoundOff * energy_scale_j;
+    }
+    return energy_gain_j > StressOutcome::kGrowingBacklog * energy_scale_j;
   }
 };
 

@@ -47,19 +47,23 @@ TEST(AsyncRegions, EqualRatesReproduceTheReferenceUnderFastInputs) {
     const TrialResult reference = RunReferenceTrial(CubeScene(base));
     for (int shells : {1, 2}) {
       for (int r : {1, 2}) {
-        Scene scene = base;
-        scene.adaptivity.primary_size = r;
-        scene.adaptivity.secondary_lod = 1;
-        scene.adaptivity.secondary_rate_hz = 1000;
-        scene.adaptivity.secondary_regions = shells;
-        scene.adaptivity.outer_rate_hz = 1000;
-        AsyncRegions dut(scene);
-        const TrialResult result = dut.RunTrial();
-        const std::string label = std::to_string(frequency) + " Hz, r " + std::to_string(r) + ", " +
-                                  std::to_string(shells) + " shell(s)";
-        ASSERT_EQ(result.outcome, TrialOutcome::kCompleted) << label;
-        EXPECT_LT(CompareForces(result.samples, reference.samples).l2_percent, 1e-9) << label;
-        EXPECT_EQ(dut.Energies().port_refused_j, 0) << label;
+        for (bool displacement : {true, false}) {
+          Scene scene = base;
+          scene.adaptivity.displacement_coupling = displacement;
+          scene.adaptivity.primary_size = r;
+          scene.adaptivity.secondary_lod = 1;
+          scene.adaptivity.secondary_rate_hz = 1000;
+          scene.adaptivity.secondary_regions = shells;
+          scene.adaptivity.outer_rate_hz = 1000;
+          AsyncRegions dut(scene);
+          const TrialResult result = dut.RunTrial();
+          const std::string label = std::to_string(frequency) + " Hz, r " + std::to_string(r) +
+                                    ", " + std::to_string(shells) + " shell(s), " +
+                                    (displacement ? "displacement" : "force");
+          ASSERT_EQ(result.outcome, TrialOutcome::kCompleted) << label;
+          EXPECT_LT(CompareForces(result.samples, reference.samples).l2_percent, 1e-9) << label;
+          EXPECT_EQ(dut.Energies().port_refused_j, 0) << label;
+        }
       }
     }
   }
