@@ -27,10 +27,13 @@ constexpr double kEdge = 0.25;                             // the default cube
 constexpr auto kWindow = std::chrono::milliseconds(1500);  // quiet, then attacked
 /**
  * The most deadline misses an attacked window may have, given the quiet one's: scheduling noise
- * alone (no real-time privileges, 2 cores) gave 0–18 misses in a quiet 1.5 s window here, and
- * about 600 when the machine was busy with other work during both windows.
+ * alone (no real-time privileges, 2 cores) gave 0–18 misses in a quiet 1.5 s window here, once 26
+ * in an attacked window after a quiet 0 (an attack the daemon refused at once, in a full-suite
+ * run), and about 600 when the machine was busy with other work during both windows. An attack
+ * that stalls the primary costs a miss per period it stalls, so 40 (under 3 % of the window's
+ * 1,500 periods) still tells one from noise.
  */
-inline std::int64_t MissBound(std::int64_t quiet) { return 2 * quiet + 20; }
+inline std::int64_t MissBound(std::int64_t quiet) { return 2 * quiet + 40; }
 
 inline std::string Temp(const std::string& name) {
   return ::testing::TempDir() + "hapticsim_security_" + name;
