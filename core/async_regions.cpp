@@ -429,9 +429,9 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
 // observer, created − taken out ≤ kDampingCredit × the secondaries' damping + the observers'
 // positive excess, whatever the timing. That excess is what the controllers have not yet
 // managed to take out: one step's worth while they keep up; where a mode outgrows them (the
-// force exchange was measured to), the port limits below bound it. (The daemon still verifies the bare exchange before it runs a
-// configuration: in some stiff scenes a region's own discrete energy is not positive, and then
-// no bound on it bounds the state — docs/regions.md, "The port limits".)
+// force exchange was measured to), the port limits below bound it. (The daemon still verifies the
+// bare exchange before it runs a configuration: in some stiff scenes a region's own discrete energy
+// is not positive, and then no bound on it bounds the state — docs/regions.md, "The port limits".)
 
 // The outer side, before its step: folds in what the inner side published and returns the excess.
 double AsyncRegions::ObserveInwardLink(RegionIndex a, double energy) noexcept {
@@ -603,6 +603,22 @@ EnergyAccount AsyncRegions::Energies() noexcept {
     }
   }
   return account;
+}
+
+AsyncRegions::PublishedBalanceView AsyncRegions::PublishedBalance() const noexcept {
+  PublishedBalanceView view;
+  for (int a = 0; a < num_regions(); ++a) {
+    const Region& region = *regions_[a];
+    view.stored_j += region.energy_published.load(std::memory_order_relaxed);
+    if (a == 0) continue;
+    const Region& inner = *regions_[a - 1];
+    // As in Energies: the observer's base plus the inner side's own sums, both as published.
+    const double pending = region.excess_base_published.load(std::memory_order_relaxed) +
+                           inner.outer_gamma_work_published.load(std::memory_order_relaxed) -
+                           inner.outward_taken_published.load(std::memory_order_relaxed);
+    view.backlog_j += std::max(0.0, pending);
+  }
+  return view;
 }
 
 std::array<double, 3> AsyncRegions::StepPrimary(

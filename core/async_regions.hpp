@@ -217,6 +217,20 @@ class AsyncRegions {
   /** The energy balance since Reset. One thread, while no steps run. */
   EnergyAccount Energies() noexcept;
 
+  /** The balance as the running threads see it (PublishedBalance). */
+  struct PublishedBalanceView {
+    double backlog_j = 0;  ///< what the interface observers hold, their positive parts summed
+    double stored_j = 0;   ///< Σ of the regions' discrete energies at their last steps
+  };
+  /**
+   * What the interface observers hold (EnergyAccount::pending_excess_j, each link's positive
+   * part) and the stored energy, from the values each region published at its last step: any
+   * thread, while the steps run (the daemon watches the coupling's energy balance with it). Each
+   * term is one region's view as of its own last step, so on real threads the sum mixes times up
+   * to the lag between the regions. 0 with the controllers off (kOff), which publish nothing.
+   */
+  PublishedBalanceView PublishedBalance() const noexcept;
+
   /** Positive-definite energy of the coupled state (all regions), J. */
   double Energy() noexcept;
   /** Its kinetic part, ½ Σ m v² over the owned DOFs (no K·u needed), J. */

@@ -52,7 +52,9 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
       contact_(scene.mesh, options.engage_ramp_s),
       guard_(options.port, 1e-3) {
   Install(scene, std::make_unique<AsyncRegions>(scene));
-  guard_ = PortGuard(options.port, primary_period_ns_ * 1e-9);
+  guard_ =
+      PortGuard(options.port, primary_period_ns_ * 1e-9,
+                options.port_guard_off ? PortGuard::Mode::kOffForTests : PortGuard::Mode::kGuarded);
   tip_ =
       InputResampler(primary_period_ns_ * 1e-9, kMaxPredictedPeriods * primary_period_ns_ * 1e-9);
 }
@@ -285,10 +287,12 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
         contact_.RestartFromRest();
         restarted_since_fault_ = guard_.latched();
         guard_.Reengage();
+        balance_peak_stored_j_ = 0;
         break;
       case kRestartKeepingContact:
         contact_.RestartKeepingContact();
         guard_.Reengage();
+        balance_peak_stored_j_ = 0;
         break;
       default:
         break;
@@ -330,6 +334,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
         flags |= force_flags::kBoundaryStale;
       }
+      WatchEnergyBalance();
       if (options_.sleep_at_rest) WatchForRest(contact.engaged);
     }
   }
@@ -413,6 +418,19 @@ void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
     rearms_.fetch_add(1, std::memory_order_relaxed);
   }
   port_dissipated_j_.store(guard_.dissipated_j(), std::memory_order_relaxed);
+}
+
+void HapticLoop::WatchEnergyBalance() noexcept {
+  const AsyncRegions::PublishedBalanceView balance = regions_->PublishedBalance();
+  balance_peak_stored_j_ = std::max(balance_peak_stored_j_, balance.stored_j);
+  interface_backlog_j_.store(balance.backlog_j, std::memory_order_relaxed);
+  if (balance.backlog_j > interface_backlog_max_j_.load(std::memory_order_relaxed)) {
+    interface_backlog_max_j_.store(balance.backlog_j, std::memory_order_relaxed);
+  }
+  const double scale = std::max(balance_peak_stored_j_, regions_->port_floor_j());
+  if (balance.backlog_j > kBacklogTolerance * scale) {
+    balance_violations_.fetch_add(1, std::memory_order_relaxed);
+  }
 }
 
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {

@@ -11,6 +11,7 @@
 
 #include "core/async_regions.hpp"
 #include "core/seqlock_slot.hpp"
+#include "core/stability_stress.hpp"
 #include "daemon/contact_tracker.hpp"
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/input_resampler.hpp"
@@ -29,8 +30,8 @@ struct DeviceSample {
 
 /** One primary period's answer, as the primary thread hands it to the I/O thread. */
 struct ForceRecord {
-  std::int64_t period = -1;         ///< the primary period, counting every one since the start
-  std::int64_t seq = -1;            ///< the newest input it answers
+  std::int64_t period = -1;  ///< the primary period, counting every one since the start
+  std::int64_t seq = -1;     ///< the newest input it answers
   /// The oldest input it answers: every seq from first_seq to seq reached the primary since the
   /// last answer and was used (the tip is resampled from all of them); first_seq = seq when one
   /// did, or none (the same seq answered again).
@@ -106,6 +107,9 @@ class HapticLoop {
     std::vector<int> cpus;       ///< pin the region threads here (empty: no pinning)
     double engage_ramp_s = 0.1;  ///< a contact that engages late ramps its force in over this
     bool sleep_at_rest = true;   ///< regions at rest and untouched stop stepping until a touch
+    /** The port guard off (PortGuard::Mode::kOffForTests): hapticsimd --no-port-guard, soaks and
+     *  tests in a sandbox only. */
+    bool port_guard_off = false;
   };
   using ForceRing = SpscRing<ForceRecord, 4096>;
   using BlackBoxRing = SpscRing<BlackBoxRecord, 4096>;
@@ -192,10 +196,29 @@ class HapticLoop {
     return dissipating_periods_.load(std::memory_order_relaxed);
   }
   const PortGuardSettings& port_settings() const { return options_.port; }
+  bool port_guard_off() const { return options_.port_guard_off; }
   /** Energy the port guard's passivity controller has dissipated, J. */
   double port_energy_dissipated_j() const {
     return port_dissipated_j_.load(std::memory_order_relaxed);
   }
+  /**
+   * The coupling's own energy balance, watched every primary period (AsyncRegions::
+   * PublishedBalance): what the interface observers hold now and the most since the loop was
+   * made, J, and the periods in which that backlog exceeded kBacklogTolerance of the regions'
+   * largest energy since they last started from rest (at least their port floor): energy the
+   * exchanges created faster than the controllers took it out. Any thread.
+   */
+  double interface_backlog_j() const {
+    return interface_backlog_j_.load(std::memory_order_relaxed);
+  }
+  double interface_backlog_max_j() const {
+    return interface_backlog_max_j_.load(std::memory_order_relaxed);
+  }
+  std::int64_t energy_balance_violations() const {
+    return balance_violations_.load(std::memory_order_relaxed);
+  }
+  /** The stress test's tolerance for a controlled exchange (StressOutcome::kGrowingBacklog). */
+  static constexpr double kBacklogTolerance = StressOutcome::kGrowingBacklog;
   /**
    * A secondary region's stalls (woke more than kSkipAfterLatePeriods of its periods late) and the
    * periods it skipped holding its state, since the loop was made. Any thread.
@@ -254,6 +277,8 @@ class HapticLoop {
   void WaitForInput() noexcept;
   // Primary thread: a newly latched fault counted, a latched one re-armed when it may be.
   void UpdateFaultState(const PortGuard::Output& sent) noexcept;
+  // Primary thread, while the regions are its own: the coupling's energy balance watched.
+  void WatchEnergyBalance() noexcept;
   // Primary thread: an input from the I/O thread (the resampler, the answers, the newest).
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
@@ -268,7 +293,7 @@ class HapticLoop {
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
   static constexpr std::size_t kInputRingSize = 256;
   SpscRing<DeviceSample, kInputRingSize> inputs_;  // every input offered, in order
-  SeqlockSlot<DeviceSample> input_;      // the newest, for when the ring was full
+  SeqlockSlot<DeviceSample> input_;                // the newest, for when the ring was full
   ForceRing forces_;
   BlackBoxRing black_box_;
   std::atomic<double> error_percent_{-1};
@@ -278,6 +303,9 @@ class HapticLoop {
   std::atomic<bool> fault_latched_{false};
   std::atomic<int> last_fault_{0};
   std::atomic<double> port_dissipated_j_{0};
+  std::atomic<double> interface_backlog_j_{0}, interface_backlog_max_j_{0};
+  std::atomic<std::int64_t> balance_violations_{0};
+  double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;
@@ -333,7 +361,7 @@ class HapticLoop {
   std::int64_t first_taken_seq_ = -1;
   bool taken_in_sequence_ = true;
   std::size_t inputs_dropped_seen_ = 0;  // inputs_.dropped() when the primary last looked
-  std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
+  std::int64_t periods_run_ = 0;         // primary periods answered since the loop was made
   DeviceSample last_input_;
 };
 

@@ -47,6 +47,7 @@
 #include "daemon/miss_logger.hpp"
 #include "daemon/overload_watch.hpp"
 #include "daemon/regions_mover.hpp"
+#include "daemon/sandbox_check.hpp"
 #include "daemon/shm_server.hpp"
 #include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"
@@ -67,6 +68,7 @@ struct Arguments {
   std::string lcm_url;
   std::string error_map;
   double duration_s = 0;
+  bool no_port_guard = false;  // tests and soaks in a sandbox only (WhyNotASandbox)
 };
 
 std::shared_ptr<spdlog::logger> MakeLogger(const std::string& level) {
@@ -157,6 +159,11 @@ int Serve(const Arguments& args) {
   if (!args.lcm_url.empty()) config.lcm_url = args.lcm_url;
   if (!args.error_map.empty()) config.error_map = args.error_map;
   ValidateDaemonConfig(config);
+  if (args.no_port_guard) {
+    if (const std::string why = WhyNotASandbox(); !why.empty()) {
+      throw Error("--no-port-guard is for tests and soaks only, refused: " + why);
+    }
+  }
   if (args.print_config || args.check_config) {
     if (args.print_config) std::cout << FormatDaemonConfig(config);
     if (args.check_config) {
@@ -205,6 +212,12 @@ int Serve(const Arguments& args) {
   options.fifo_priority = config.fifo_priority;
   options.cpus = config.cpus;
   options.sleep_at_rest = config.sleep_at_rest;
+  options.port_guard_off = args.no_port_guard;
+  if (args.no_port_guard) {
+    spdlog::warn(
+        "the port guard is OFF (--no-port-guard, a test): the simulated force goes to the device "
+        "with no envelope, slew ceiling or passivity controller");
+  }
   HapticLoop loop(SceneWith(config.scene, decision.configuration), options);
   loop.SetErrorState(decision.error_percent, DecisionFlags(decision));
   spdlog::info("contact: the regions are centred on node ({}, {}, {}) and follow the tool",
@@ -858,6 +871,10 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", args.lcm_url, "Override lcm.url");
   app.add_option("--error-map", args.error_map, "Override supervisor.error_map");
   app.add_option("--duration", args.duration_s, "Stop after this many seconds (tests, soak)");
+  app.add_flag("--no-port-guard", args.no_port_guard,
+               "Tests and soaks only (refused outside a private network namespace): send the "
+               "simulated force without the port guard's envelope, slew ceiling and passivity "
+               "controller, to show what the coupling does by itself");
   app.set_version_flag("--version", hapticsim::CodeVersion());
   try {
     app.parse(argc, argv);

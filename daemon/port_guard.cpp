@@ -26,8 +26,8 @@ Vec StepTowards(const Vec& from, const Vec& to, double step, bool* reached) {
 
 }  // namespace
 
-PortGuard::PortGuard(const PortGuardSettings& settings, double period_s) noexcept
-    : settings_(settings), period_ms_(period_s * 1e3) {}
+PortGuard::PortGuard(const PortGuardSettings& settings, double period_s, Mode mode) noexcept
+    : settings_(settings), period_ms_(period_s * 1e3), guarded_(mode == Mode::kGuarded) {}
 
 void PortGuard::Latch(Fault fault, Output* out) noexcept {
   if (latched_) return;
@@ -128,9 +128,9 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
   // Steps and ramps are per millisecond of wall time: missed periods run back to back (within
   // microseconds) move the force by little, not by a period's allowance each.
   const double elapsed_ms =
-      last_now_ns_ == 0 ? period_ms_
-                        : std::clamp(static_cast<double>(in.now_ns - last_now_ns_) * 1e-6, 0.0,
-                                     period_ms_);
+      last_now_ns_ == 0
+          ? period_ms_
+          : std::clamp(static_cast<double>(in.now_ns - last_now_ns_) * 1e-6, 0.0, period_ms_);
   last_now_ns_ = in.now_ns;
   Observe(in);
 
@@ -140,7 +140,7 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
   Vec target{0, 0, 0};
   if (rendering) {
     target = in.simulated_n;
-    out.limited = Envelope(in.inward_normal, &target);
+    out.limited = guarded_ && Envelope(in.inward_normal, &target);
     // Rendering again after a release that ran out: ramp in unless the force is within a step.
     if (!rendering_before_ && Norm(sent_) == 0 && !engaging_) {
       engaging_ = Norm(target) > ramp_step;
@@ -160,15 +160,16 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
     engaging_ = !reached;
     out.limited = out.limited || !reached;
   }
-  if (rendering && settings_.passivity) {
+  if (rendering && settings_.passivity && guarded_) {
     out.dissipating = Dissipate(in.inward_normal, &force);
   } else {
     correction_ = {0, 0, 0};
   }
 
-  bool within = false;
+  bool within = true;
   const Vec slewed =
-      StepTowards(sent_, force, settings_.max_force_rate_n_per_ms * elapsed_ms, &within);
+      guarded_ ? StepTowards(sent_, force, settings_.max_force_rate_n_per_ms * elapsed_ms, &within)
+               : force;
   if (!within) out.limited = true;
   sent_ = Finite(slewed) ? slewed : Vec{0, 0, 0};
   out.force_n = sent_;

@@ -10,13 +10,13 @@ namespace hapticsim {
  * The defaults suit a desktop device rated 3–9 N peak; docs/operations.md lists profiles.
  */
 struct PortGuardSettings {
-  double max_force_n = 8.0;               ///< magnitude ceiling: larger forces are saturated
-  double max_force_rate_n_per_ms = 0.5;   ///< slew ceiling between consecutive periods, N per ms
-  double engage_rate_n_per_ms = 0.05;     ///< engaging and releasing ramp (from and to zero)
-  double fault_force_n = 50.0;            ///< a simulated force above this is a divergence: fault
-  double watchdog_s = 0.2;                ///< a primary gap this long while sending force: fault
-  bool passivity = true;                  ///< time-domain passivity observer and controller
-  double max_damping_n_s_per_m = 10.0;    ///< the most damping the controller may add
+  double max_force_n = 8.0;              ///< magnitude ceiling: larger forces are saturated
+  double max_force_rate_n_per_ms = 0.5;  ///< slew ceiling between consecutive periods, N per ms
+  double engage_rate_n_per_ms = 0.05;    ///< engaging and releasing ramp (from and to zero)
+  double fault_force_n = 50.0;           ///< a simulated force above this is a divergence: fault
+  double watchdog_s = 0.2;               ///< a primary gap this long while sending force: fault
+  bool passivity = true;                 ///< time-domain passivity observer and controller
+  double max_damping_n_s_per_m = 10.0;   ///< the most damping the controller may add
 };
 
 /**
@@ -65,24 +65,33 @@ class PortGuard {
 
   struct Output {
     std::array<double, 3> force_n{};
-    bool limited = false;      ///< envelope, unilateral, ramp or slew changed the force
-    bool dissipating = false;  ///< the passivity controller took energy out this period
-    bool latched = false;      ///< a fault holds the output at (or on its way to) zero
+    bool limited = false;            ///< envelope, unilateral, ramp or slew changed the force
+    bool dissipating = false;        ///< the passivity controller took energy out this period
+    bool latched = false;            ///< a fault holds the output at (or on its way to) zero
     Fault new_fault = Fault::kNone;  ///< the fault latched in this period, if any
   };
 
   /** One period's input. */
   struct Input {
-    std::int64_t now_ns = 0;               ///< when this period runs (CLOCK_MONOTONIC)
-    std::array<double, 3> simulated_n{};   ///< the simulation's force on the user
-    bool render = false;                   ///< the simulated force may be sent
-    bool engaged = false;                  ///< the contact is engaged (rendered or not)
-    std::array<double, 3> position_m{};    ///< the device's newest received position
+    std::int64_t now_ns = 0;              ///< when this period runs (CLOCK_MONOTONIC)
+    std::array<double, 3> simulated_n{};  ///< the simulation's force on the user
+    bool render = false;                  ///< the simulated force may be sent
+    bool engaged = false;                 ///< the contact is engaged (rendered or not)
+    std::array<double, 3> position_m{};   ///< the device's newest received position
     bool have_position = false;
     std::array<double, 3> inward_normal{};  ///< the contact surface's, into the object (0: none)
   };
 
-  PortGuard(const PortGuardSettings& settings, double period_s) noexcept;
+  /**
+   * kOffForTests (hapticsimd --no-port-guard, which only a sandbox may run): the simulated force
+   * goes out as it is, with only 1 (faults) and 4 (the engagement ramps) left: no unilateral
+   * cut, envelope, passivity controller or slew. A soak shows with it that the regions'
+   * coupling holds by itself, not because this class hides what it does.
+   */
+  enum class Mode { kGuarded, kOffForTests };
+
+  PortGuard(const PortGuardSettings& settings, double period_s,
+            Mode mode = Mode::kGuarded) noexcept;
 
   Output Period(const Input& in) noexcept;
 
@@ -97,6 +106,7 @@ class PortGuard {
   void Reengage() noexcept;
 
   bool latched() const noexcept { return latched_; }
+  bool guarded() const noexcept { return guarded_; }
   /** Energy the port has absorbed since the current engagement began, J (the observer's E). */
   double port_energy_j() const noexcept { return energy_j_; }
   /** Energy the passivity controller has dissipated since construction, J. */
@@ -120,13 +130,14 @@ class PortGuard {
 
   PortGuardSettings settings_;
   double period_ms_;
+  bool guarded_ = true;  // Mode::kGuarded
   bool latched_ = false;
-  std::array<double, 3> sent_{};       // the force sent last period
+  std::array<double, 3> sent_{};        // the force sent last period
   std::array<double, 3> correction_{};  // what the controller took off it (its damping)
-  bool engaging_ = false;              // ramping towards the target at the engage rate
-  bool rendering_before_ = false;      // the last period rendered the simulated force
-  bool engaged_before_ = false;        // the contact was engaged last period
-  double energy_j_ = 0;                // the observer's E since the engagement began
+  bool engaging_ = false;               // ramping towards the target at the engage rate
+  bool rendering_before_ = false;       // the last period rendered the simulated force
+  bool engaged_before_ = false;         // the contact was engaged last period
+  double energy_j_ = 0;                 // the observer's E since the engagement began
   double dissipated_j_ = 0;
   std::int64_t last_now_ns_ = 0;
   // The newest kVelocityPeriods + 1 received positions, one per period (a ring).

@@ -33,6 +33,10 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
   s.fault_latched = loop.fault_latched();
   s.latched_faults = loop.force_faults();
   s.fault_rearms = loop.rearms();
+  s.port_guard_off = loop.port_guard_off();
+  s.interface_backlog_j = loop.interface_backlog_j();
+  s.interface_backlog_max_j = loop.interface_backlog_max_j();
+  s.energy_balance_violations = loop.energy_balance_violations();
   s.stale_periods = loop.stale_periods();
   for (int c = 0; c < 3; ++c) s.contact_node[c] = loop.centre_node()[c];
   s.reconfigurations = loop.reconfigurations();

@@ -31,7 +31,7 @@ struct PortRun {
 
 template <typename Environment>
 PortRun Drive(PortGuard& guard, int periods, double amplitude_m, double frequency_hz,
-          Environment environment) {
+              Environment environment) {
   PortRun run;
   Vec previous_sent{}, previous_position{};
   for (int n = 0; n < periods; ++n) {
@@ -154,6 +154,34 @@ TEST(PortGuard, ContactIsUnilateralAndTheMagnitudeIsCeiled) {
   EXPECT_NEAR(Norm(out.force_n), 2.0, 1e-12);
   EXPECT_NEAR(out.force_n[1] / out.force_n[2], -0.75, 1e-12);
   EXPECT_TRUE(out.limited);
+}
+
+// Off for a test (hapticsimd --no-port-guard): no unilateral cut, ceiling or slew — the soak then
+// sees the coupling's own force — but a divergence still latches a fault.
+TEST(PortGuard, OffForATestItSendsTheSimulatedForceAndStillLatchesFaults) {
+  PortGuardSettings settings;
+  settings.max_force_n = 2.0;
+  PortGuard guard(settings, kPeriod_s, PortGuard::Mode::kOffForTests);
+  EXPECT_FALSE(guard.guarded());
+  PortGuard::Input in;
+  in.render = true;
+  in.engaged = true;
+  in.inward_normal = {0, 0, 1};
+  in.simulated_n = {0.02, 0, 0.04};  // within one engage step: no ramp, and a pull is sent
+  PortGuard::Output out = guard.Period(in);
+  EXPECT_EQ(out.force_n, in.simulated_n);
+  EXPECT_FALSE(out.limited);
+  in.now_ns = kPeriodNs;
+  in.simulated_n = {0, 3, -4};  // 5 N in one period: above the ceiling, ten times the slew
+  out = guard.Period(in);
+  EXPECT_EQ(out.force_n, in.simulated_n);
+  EXPECT_FALSE(out.limited);
+  EXPECT_FALSE(out.dissipating);
+  in.now_ns = 2 * kPeriodNs;
+  in.simulated_n = {0, 0, -2 * settings.fault_force_n};
+  out = guard.Period(in);
+  EXPECT_EQ(out.new_fault, PortGuard::Fault::kDivergence);
+  EXPECT_TRUE(out.latched);
 }
 
 TEST(PortGuard, EngagingRampsFromZeroAndReleasingRampsToZero) {

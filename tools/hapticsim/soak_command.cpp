@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/stability_stress.hpp"
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
@@ -43,9 +44,10 @@ struct SoakOptions {
   unsigned seed = 1;
   double max_lcm_loss_percent = 1.0;
   double max_rss_growth_kib = 2048;
-  int cpu_load = 0;              // busy threads beside daemon and device, normal priority
+  int cpu_load = 0;               // busy threads beside daemon and device, normal priority
   double max_force_step_n = 1.0;  // largest force change between answers in contact
   double min_answered_percent = 95;
+  bool no_port_guard = false;  // hapticsimd --no-port-guard: the coupling alone behind the port
   bool json = false;
 };
 
@@ -162,8 +164,8 @@ int RunSoak(const SoakOptions& o) {
   // The service socket in a directory of its own that only this user can write: the driver
   // trusts no socket others could have put in place (ipc/service_socket.hpp).
   char socket_dir[] = "/tmp/hapticsim-soak-XXXXXX";
-  HAPTICSIM_THROW_UNLESS(mkdtemp(socket_dir), std::string("cannot make a directory in /tmp: ") +
-                                                  std::strerror(errno));
+  HAPTICSIM_THROW_UNLESS(mkdtemp(socket_dir),
+                         std::string("cannot make a directory in /tmp: ") + std::strerror(errno));
   const std::string shm_socket = std::string(socket_dir) + "/hapticsimd.sock";
   struct RemoveDir {
     std::string path;
@@ -186,7 +188,11 @@ int RunSoak(const SoakOptions& o) {
   if (pid == 0) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1), dup2(fd, 2);
-    execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), nullptr);
+    if (o.no_port_guard) {
+      execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), "--no-port-guard", nullptr);
+    } else {
+      execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), nullptr);
+    }
     _exit(127);
   }
   auto stop_daemon = [&](int* status) {
@@ -318,6 +324,10 @@ int RunSoak(const SoakOptions& o) {
       {"memory_flat_after_warm_up", rss_growth <= o.max_rss_growth_kib},
       {"answering_after_bad_input", report.answers_after_last_burst > 0},
       {"no_force_out_of_contact", report.force_out_of_contact == 0},
+      {"no_energy_balance_violations",
+       report.status.has_value() && last_status.energy_balance_violations == 0},
+      {"port_guard_as_asked",
+       report.status.has_value() && last_status.port_guard_off == o.no_port_guard},
       {"daemon_stopped_cleanly", clean_exit}};
   bool passed = true;
   for (const auto& [name, ok] : checks.items()) passed = passed && ok.get<bool>();
@@ -361,6 +371,9 @@ int RunSoak(const SoakOptions& o) {
       {"force_limited_periods", last_status.force_limited_periods},
       {"port_dissipating_periods", last_status.port_dissipating_periods},
       {"port_energy_dissipated_j", last_status.port_energy_dissipated_j},
+      {"port_guard_off", last_status.port_guard_off},
+      {"energy_balance_violations", last_status.energy_balance_violations},
+      {"interface_backlog_max_j", last_status.interface_backlog_max_j},
       {"daemon_exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
       {"report",
        {{"json", (dir / "soak.json").string()},
@@ -393,6 +406,12 @@ int RunSoak(const SoakOptions& o) {
         o.max_force_step_n, static_cast<long long>(last_status.latched_faults),
         static_cast<long long>(last_status.force_limited_periods),
         last_status.port_energy_dissipated_j);
+    std::printf(
+        "  coupling                   %lld period(s) with the interface backlog above %.3g %% of "
+        "the regions' energy; largest backlog %.3g J%s\n",
+        static_cast<long long>(last_status.energy_balance_violations),
+        100 * StressOutcome::kGrowingBacklog, last_status.interface_backlog_max_j,
+        last_status.port_guard_off ? " (port guard OFF)" : "");
     std::printf("  shared-memory inputs answered %.2f %% (at least %.3g %%)\n", answered_percent,
                 o.min_answered_percent);
     std::printf("  LCM answers lost           %lld of %lld (%.3f %%, budget %.3g %%)\n",
@@ -457,6 +476,10 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
                   "Shared-memory inputs that must be answered, %")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
+  app->add_flag("--no-port-guard", options->no_port_guard,
+                "Run the daemon with its port guard off (hapticsimd --no-port-guard, allowed in "
+                "the soak's private network namespace): the checks then show what the regions' "
+                "coupling does by itself");
   app->add_flag("--json", options->json, "Print the summary as JSON");
   return {app, [options, argc, argv] {
             if (!std::getenv(kInNetnsVariable)) ReexecInPrivateNetns(argc, argv);

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# hapticsimd --no-port-guard on a host's network namespace (an interface besides loopback): refused
+# with a message that says why and what to run instead, before any LCM or socket is opened
+# (--check-config exits right after the refusal would have been made).
+set -u
+daemon=$1
+others=$(ls /sys/class/net | grep -v '^lo$' || true)
+if [ -z "$others" ]; then
+  echo "only loopback here: nothing to refuse on (skipped)"
+  exit 77
+fi
+out=$("$daemon" --no-port-guard --check-config 2>&1)
+status=$?
+echo "$out"
+if [ "$status" -ne 2 ]; then echo "FAILED: exit status $status, want 2"; exit 1; fi
+for want in "--no-port-guard is for tests and soaks only" "besides loopback" "hapticsim soak --no-port-guard"; do
+  if ! grep -qF -- "$want" <<<"$out"; then echo "FAILED: the message lacks: $want"; exit 1; fi
+done
+# Without the flag the same check passes: the refusal is the flag's.
+"$daemon" --check-config >/dev/null || { echo "FAILED: --check-config alone failed"; exit 1; }
+echo "refused as it should be"
