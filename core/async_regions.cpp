@@ -609,8 +609,12 @@ AsyncRegions::PublishedBalanceView AsyncRegions::PublishedBalance() const noexce
   PublishedBalanceView view;
   for (int a = 0; a < num_regions(); ++a) {
     const Region& region = *regions_[a];
-    view.stored_j += region.energy_published.load(std::memory_order_relaxed);
-    if (a == 0) continue;
+    const double energy = region.energy_published.load(std::memory_order_relaxed);
+    view.stored_j += energy;
+    if (a == 0) {
+      if (num_regions() > 1) view.primary_reserve_j = kPrimaryReserve * energy;
+      continue;
+    }
     const Region& inner = *regions_[a - 1];
     // As in Energies: the observer's base plus the inner side's own sums, both as published.
     const double pending = region.excess_base_published.load(std::memory_order_relaxed) +

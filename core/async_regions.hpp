@@ -221,13 +221,16 @@ class AsyncRegions {
   struct PublishedBalanceView {
     double backlog_j = 0;  ///< what the interface observers hold, their positive parts summed
     double stored_j = 0;   ///< Σ of the regions' discrete energies at their last steps
+    /** What the primary leaves to the shells by design (kPrimaryReserve of its energy): the
+     *  backlog above it is what EnergyAboveBound counts. */
+    double primary_reserve_j = 0;
   };
   /**
    * What the interface observers hold (EnergyAccount::pending_excess_j, each link's positive
    * part) and the stored energy, from the values each region published at its last step: any
    * thread, while the steps run (the daemon watches the coupling's energy balance with it). Each
    * term is one region's view as of its own last step, so on real threads the sum mixes times up
-   * to the lag between the regions. 0 with the controllers off (kOff), which publish nothing.
+   * to the lag between the regions. With the controllers off (kOff) the energies are not published.
    */
   PublishedBalanceView PublishedBalance() const noexcept;
 

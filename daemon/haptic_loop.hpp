@@ -204,9 +204,10 @@ class HapticLoop {
   /**
    * The coupling's own energy balance, watched every primary period (AsyncRegions::
    * PublishedBalance): what the interface observers hold now and the most since the loop was
-   * made, J, and the periods in which that backlog exceeded kBacklogTolerance of the regions'
-   * largest energy since they last started from rest (at least their port floor): energy the
-   * exchanges created faster than the controllers took it out. Any thread.
+   * made, J, and the periods in which that backlog, less the reserve the primary leaves to the
+   * shells by design, exceeded kBacklogTolerance of the regions' largest energy since they last
+   * started from rest (at least their port floor): energy the exchanges created faster than the
+   * controllers took it out. Any thread.
    */
   double interface_backlog_j() const {
     return interface_backlog_j_.load(std::memory_order_relaxed);

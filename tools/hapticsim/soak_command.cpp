@@ -189,6 +189,7 @@ int RunSoak(const SoakOptions& o) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1), dup2(fd, 2);
     if (o.no_port_guard) {
+      setenv("HAPTICSIM_SANDBOX", "1", 1);  // hapticsimd's WhyNotASandbox: the soak started it
       execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), "--no-port-guard", nullptr);
     } else {
       execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), nullptr);
