@@ -872,7 +872,8 @@ int main(int argc, char** argv) {
   app.add_option("--error-map", args.error_map, "Override supervisor.error_map");
   app.add_option("--duration", args.duration_s, "Stop after this many seconds (tests, soak)");
   app.add_flag("--no-port-guard", args.no_port_guard,
-               "Tests and soaks only (refused outside a private network namespace): send the "
+               "Tests and soaks only (refused unless in a network namespace with only loopback "
+               "up and HAPTICSIM_SANDBOX=1, as `hapticsim soak --no-port-guard` runs it): send the "
                "simulated force without the port guard's envelope, slew ceiling and passivity "
                "controller, to show what the coupling does by itself");
   app.set_version_flag("--version", hapticsim::CodeVersion());

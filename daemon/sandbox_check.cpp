@@ -37,7 +37,9 @@ std::string WhyNotASandbox() {
   for (const auto& name : others) names += (names.empty() ? "" : ", ") + name;
   return "this network namespace has interfaces up besides loopback (" + names +
          "): it is a host where a real device may be in use. Run it under `hapticsim soak "
-         "--no-port-guard` or in a private network namespace (tests/support/in_private_netns.sh)";
+         "--no-port-guard`, or in a private network namespace (tests/support/in_private_netns.sh) "
+         "with " +
+         std::string(kSandboxVariable) + "=1";
 }
 
 }  // namespace hapticsim

@@ -21,6 +21,7 @@
 
 #include "core/error.hpp"
 #include "core/stability_stress.hpp"
+#include "daemon/sandbox_check.hpp"
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
@@ -189,7 +190,7 @@ int RunSoak(const SoakOptions& o) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1), dup2(fd, 2);
     if (o.no_port_guard) {
-      setenv("HAPTICSIM_SANDBOX", "1", 1);  // hapticsimd's WhyNotASandbox: the soak started it
+      setenv(kSandboxVariable, "1", 1);  // hapticsimd's WhyNotASandbox: the soak started it
       execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), "--no-port-guard", nullptr);
     } else {
       execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), nullptr);
@@ -408,8 +409,8 @@ int RunSoak(const SoakOptions& o) {
         static_cast<long long>(last_status.force_limited_periods),
         last_status.port_energy_dissipated_j);
     std::printf(
-        "  coupling                   %lld period(s) with the interface backlog above %.3g %% of "
-        "the regions' energy; largest backlog %.3g J%s\n",
+        "  coupling                   %lld period(s) with the interface backlog beyond the "
+        "primary's reserve above %.3g %% of the regions' energy; largest backlog %.3g J%s\n",
         static_cast<long long>(last_status.energy_balance_violations),
         100 * StressOutcome::kGrowingBacklog, last_status.interface_backlog_max_j,
         last_status.port_guard_off ? " (port guard OFF)" : "");
