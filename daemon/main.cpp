@@ -448,6 +448,66 @@ int Serve(const Arguments& args) {
   std::int64_t hover_since_ns = 0;
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
+  // Where the regions were last verified stable (at start, or by a verdict): where they go back
+  // to should a move made unverified turn out unstable even at equal rates.
+  RegionConfiguration verified_active = active;
+  LatticeIndex verified_node = loop.centre_node();
+  double verified_radius = active_radius;
+  // The regions where the mover says: moved now (verified before, or to be verified behind
+  // them), confirmed by their verdict, or demoted to equal rates where it finds them unstable.
+  auto apply_move = [&](const RegionsMover::Outcome& moved, std::int64_t now) {
+    using Kind = RegionsMover::Outcome::Kind;
+    const LatticeIndex& node = moved.request.node;
+    const bool still_there = loop.centre_node() == node && active == moved.request.configuration;
+    if (moved.kind == Kind::kConfirmed || moved.kind == Kind::kDemote) {
+      spdlog::log(moved.kind == Kind::kConfirmed ? spdlog::level::info : spdlog::level::warn,
+                  "coupling of {} around contact node ({}, {}, {}) verified {:.3f} s after the "
+                  "regions moved there: {}{}",
+                  DescribeConfiguration(moved.request.configuration), node[0], node[1], node[2],
+                  moved.elapsed_ms * 1e-3,
+                  moved.kind == Kind::kConfirmed
+                      ? fmt::format("stable, spectral radius {:.5f}", moved.centred.spectral_radius)
+                      : "UNSTABLE; secondaries at the primary rate there",
+                  still_there ? "" : " (the regions have moved on since)");
+      if (!still_there) return;
+      verified_node = node;
+      verified_radius = moved.centred.spectral_radius;
+      verified_active = moved.centred.configuration;
+      if (moved.kind == Kind::kConfirmed) {
+        active_radius = moved.centred.spectral_radius;
+        return;
+      }
+    }
+    loop.Reconfigure(SceneWith(config.scene, moved.centred.configuration, node),
+                     /*keep_contact=*/true);
+    // The pending decision this move was asked for: a newer choice may have replaced or
+    // dropped it while the move was being verified; then it is not applied.
+    if (moved.request.applies_pending && pending &&
+        pending->configuration == moved.request.configuration) {
+      decision = *pending;
+      pending.reset();
+      spdlog::info("reconfigured: {}", decision.reason);
+    }
+    active = moved.centred.configuration;
+    active_radius = moved.centred.spectral_radius;
+    if (moved.kind == Kind::kMoveVerified) {
+      verified_active = active, verified_node = node, verified_radius = active_radius;
+    }
+    if (moved.kind != Kind::kDemote) {
+      spdlog::info("regions centred on contact node ({}, {}, {}) {:.3f} s after it was asked for{}",
+                   node[0], node[1], node[2], moved.elapsed_ms * 1e-3,
+                   moved.kind == Kind::kMoveUnverified
+                       ? "; their coupling is being verified behind them"
+                   : moved.centred.fell_back
+                       ? "; the chosen configuration is unstable around it: secondaries at "
+                         "the primary rate there"
+                       : "");
+    }
+    match_miss_loggers(now);
+    overload.Reset(now);
+    report_error();
+    choose_for_centre_if_missed();
+  };
   const double primary_period_s = loop.monitor(kPrimaryRegion).TakeSnapshot().period_s;
   // Every thread's newest sign of life. New region threads, or ones just woken, get a moment
   // before the check expects them to have run: read here, just before each check, so a command
@@ -509,7 +569,8 @@ int Serve(const Arguments& args) {
     }
     return "refused: unknown";
   };
-  const timespec tick{0, 20'000'000};
+  constexpr long kTick_ns = 20'000'000, kTickBeforeAMove_ns = 2'000'000;
+  timespec tick{0, kTick_ns};
   for (;;) {
     siginfo_t info{};
     const int signal = sigtimedwait(&signals, &info, &tick);
@@ -711,41 +772,40 @@ int Serve(const Arguments& args) {
       }
       if (request && mover.may_ask(*request)) mover.Ask(*request, now);
     }
+    const bool moved_unverified = mover.verifying_behind();
     try {
-      if (const std::optional<RegionsMover::Verified> moved = mover.Poll(now)) {
-        const LatticeIndex& node = moved->request.node;
-        loop.Reconfigure(SceneWith(config.scene, moved->centred.configuration, node),
-                         /*keep_contact=*/true);
-        // The pending decision this move was asked for: a newer choice may have replaced or
-        // dropped it while the move was being verified; then it is not applied.
-        if (moved->request.applies_pending && pending &&
-            pending->configuration == moved->request.configuration) {
-          decision = *pending;
-          pending.reset();
-          spdlog::info("reconfigured: {}", decision.reason);
-        }
-        active = moved->centred.configuration;
-        active_radius = moved->centred.spectral_radius;
-        spdlog::info(
-            "regions centred on contact node ({}, {}, {}) {:.3f} s after it was asked for{}",
-            node[0], node[1], node[2], moved->verify_ms * 1e-3,
-            moved->centred.fell_back
-                ? "; the chosen configuration is unstable around it: secondaries at "
-                  "the primary rate there"
-                : "");
-        match_miss_loggers(now);
-        overload.Reset(now);
-        report_error();
-        choose_for_centre_if_missed();
+      if (const std::optional<RegionsMover::Outcome> moved = mover.Poll(now)) {
+        apply_move(*moved, now);
       }
     } catch (const Error& e) {
-      spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
+      if (moved_unverified && !(active == verified_active && loop.centre_node() == verified_node)) {
+        // The regions moved onto the node unverified, and not even equal rates are stable
+        // there: back to where they were verified; a touch on that node waits, as refused.
+        spdlog::error("{}: the regions go back to contact node ({}, {}, {})", e.what(),
+                      verified_node[0], verified_node[1], verified_node[2]);
+        try {
+          loop.Reconfigure(SceneWith(config.scene, verified_active, verified_node),
+                           /*keep_contact=*/true);
+          active = verified_active;
+          active_radius = verified_radius;
+          match_miss_loggers(now);
+          overload.Reset(now);
+        } catch (const Error& again) {  // a hung primary: the watchdog's pings stop
+          spdlog::error("moving the regions back failed: {}", again.what());
+        }
+      } else {
+        spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
+      }
       if (pending &&
           !mover.may_ask({pending->configuration, wanted.value_or(loop.centre_node()), true})) {
         pending.reset();  // refused around this node: not asked again
       }
       report_error();
     }
+    // A touch waiting for its regions, or a tool about to touch another node, is served within a
+    // few milliseconds (the move is at the next tick); otherwise the tick is slower.
+    const bool move_soon = loop.contact_waiting() || (wanted && *wanted != loop.centre_node());
+    tick.tv_nsec = move_soon ? kTickBeforeAMove_ns : kTick_ns;
     // Deadlines before accuracy: a region that keeps missing them gets a cheaper configuration
     // (the map's measured costs), switched like any other once the tool is away.
     std::vector<double> rates_hz;
