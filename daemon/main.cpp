@@ -384,11 +384,13 @@ int Serve(const Arguments& args) {
     choice_for_overload = false;
     start_choice(pin);
   };
-  // The regions run `active` centred on loop.centre_node(): the decision's configuration, or its
-  // equal-rate fallback where the decision's is unstable around that node.
-  RegionConfiguration active = decision.configuration;
-  double active_radius = decision.spectral_radius;
-  RegionsMover mover(config.scene);
+  // The regions run mover.placement(): the decision's configuration, or its equal-rate fallback
+  // where the decision's is unstable around the node they are centred on.
+  RegionsMover mover(config.scene, {{decision.configuration, decision.spectral_radius, false},
+                                    loop.centre_node()});
+  auto active = [&mover]() -> const RegionConfiguration& {
+    return mover.placement().centred.configuration;
+  };
   // The error the status reports: the decision's, looked up again for the configuration running
   // and the node the regions are centred on — interpolated between mapped contact nodes, the
   // nearest mapped one's beyond them (flagged clamped). Where the map has no finite error the
@@ -400,7 +402,7 @@ int Serve(const Arguments& args) {
     std::int32_t flags = DecisionFlags(decision) | (pending ? force_flags::kReconfiguring : 0);
     double error = decision.error_percent;
     if (decision.have_map && map.map) {
-      const NodeError here = LookupErrorAt(*map.map, config.scene, active, loop.centre_node());
+      const NodeError here = LookupErrorAt(*map.map, config.scene, active(), loop.centre_node());
       error = here.error_percent;
       flags &= ~(force_flags::kLookupClamped | force_flags::kErrorTargetExceeded);
       if (here.clamped) flags |= force_flags::kLookupClamped;
@@ -422,7 +424,7 @@ int Serve(const Arguments& args) {
     spdlog::warn(
         "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the target "
         "{} %: choosing again for this node",
-        node[0], node[1], node[2], DescribeConfiguration(active),
+        node[0], node[1], node[2], DescribeConfiguration(active()),
         reported_error < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error),
         target);
     start_choice(std::nullopt);
@@ -430,7 +432,7 @@ int Serve(const Arguments& args) {
   // Restarts the regions from rest where they are: the tool must lift off before it feels force.
   auto restart_from_rest = [&](const char* why) {
     try {
-      loop.Reconfigure(SceneWith(config.scene, active, loop.centre_node()));
+      loop.Reconfigure(SceneWith(config.scene, active(), loop.centre_node()));
     } catch (const Error& e) {
       // Only a hung primary thread gets here (the scene is the running one): the watchdog's
       // pings stop and systemd restarts the daemon.
@@ -448,37 +450,16 @@ int Serve(const Arguments& args) {
   std::int64_t hover_since_ns = 0;
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
-  // Where the regions were last verified stable (at start, or by a verdict): where they go back
-  // to should a move made unverified turn out unstable even at equal rates.
-  RegionConfiguration verified_active = active;
-  LatticeIndex verified_node = loop.centre_node();
-  double verified_radius = active_radius;
   // The regions where the mover says: moved now (verified before, or to be verified behind
-  // them), confirmed by their verdict, or demoted to equal rates where it finds them unstable.
+  // them), demoted to equal rates or moved back where the verdict finds them unstable.
   auto apply_move = [&](const RegionsMover::Outcome& moved, std::int64_t now) {
     using Kind = RegionsMover::Outcome::Kind;
-    const LatticeIndex& node = moved.request.node;
-    const bool still_there = loop.centre_node() == node && active == moved.request.configuration;
-    if (moved.kind == Kind::kConfirmed || moved.kind == Kind::kDemote) {
-      spdlog::log(moved.kind == Kind::kConfirmed ? spdlog::level::info : spdlog::level::warn,
-                  "coupling of {} around contact node ({}, {}, {}) verified {:.3f} s after the "
-                  "regions moved there: {}{}",
-                  DescribeConfiguration(moved.request.configuration), node[0], node[1], node[2],
-                  moved.elapsed_ms * 1e-3,
-                  moved.kind == Kind::kConfirmed
-                      ? fmt::format("stable, spectral radius {:.5f}", moved.centred.spectral_radius)
-                      : "UNSTABLE; secondaries at the primary rate there",
-                  still_there ? "" : " (the regions have moved on since)");
-      if (!still_there) return;
-      verified_node = node;
-      verified_radius = moved.centred.spectral_radius;
-      verified_active = moved.centred.configuration;
-      if (moved.kind == Kind::kConfirmed) {
-        active_radius = moved.centred.spectral_radius;
-        return;
-      }
-    }
-    loop.Reconfigure(SceneWith(config.scene, moved.centred.configuration, node),
+    spdlog::log(moved.kind == Kind::kMoveBack ? spdlog::level::err
+                : moved.kind == Kind::kDemote ? spdlog::level::warn
+                                              : spdlog::level::info,
+                "{}", moved.Describe());
+    if (!moved.moves()) return;
+    loop.Reconfigure(SceneWith(config.scene, moved.to.centred.configuration, moved.to.node),
                      /*keep_contact=*/true);
     // The pending decision this move was asked for: a newer choice may have replaced or
     // dropped it while the move was being verified; then it is not applied.
@@ -487,21 +468,6 @@ int Serve(const Arguments& args) {
       decision = *pending;
       pending.reset();
       spdlog::info("reconfigured: {}", decision.reason);
-    }
-    active = moved.centred.configuration;
-    active_radius = moved.centred.spectral_radius;
-    if (moved.kind == Kind::kMoveVerified) {
-      verified_active = active, verified_node = node, verified_radius = active_radius;
-    }
-    if (moved.kind != Kind::kDemote) {
-      spdlog::info("regions centred on contact node ({}, {}, {}) {:.3f} s after it was asked for{}",
-                   node[0], node[1], node[2], moved.elapsed_ms * 1e-3,
-                   moved.kind == Kind::kMoveUnverified
-                       ? "; their coupling is being verified behind them"
-                   : moved.centred.fell_back
-                       ? "; the chosen configuration is unstable around it: secondaries at "
-                         "the primary rate there"
-                       : "");
     }
     match_miss_loggers(now);
     overload.Reset(now);
@@ -772,30 +738,12 @@ int Serve(const Arguments& args) {
       }
       if (request && mover.may_ask(*request)) mover.Ask(*request, now);
     }
-    const bool moved_unverified = mover.verifying_behind();
     try {
       if (const std::optional<RegionsMover::Outcome> moved = mover.Poll(now)) {
         apply_move(*moved, now);
       }
     } catch (const Error& e) {
-      if (moved_unverified && !(active == verified_active && loop.centre_node() == verified_node)) {
-        // The regions moved onto the node unverified, and not even equal rates are stable
-        // there: back to where they were verified; a touch on that node waits, as refused.
-        spdlog::error("{}: the regions go back to contact node ({}, {}, {})", e.what(),
-                      verified_node[0], verified_node[1], verified_node[2]);
-        try {
-          loop.Reconfigure(SceneWith(config.scene, verified_active, verified_node),
-                           /*keep_contact=*/true);
-          active = verified_active;
-          active_radius = verified_radius;
-          match_miss_loggers(now);
-          overload.Reset(now);
-        } catch (const Error& again) {  // a hung primary: the watchdog's pings stop
-          spdlog::error("moving the regions back failed: {}", again.what());
-        }
-      } else {
-        spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
-      }
+      spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
       if (pending &&
           !mover.may_ask({pending->configuration, wanted.value_or(loop.centre_node()), true})) {
         pending.reset();  // refused around this node: not asked again
@@ -865,8 +813,8 @@ int Serve(const Arguments& args) {
       }
       if (bridge) {
         SupervisorDecision shown = decision;
-        shown.configuration = active;
-        shown.spectral_radius = active_radius;
+        shown.configuration = active();
+        shown.spectral_radius = mover.placement().centred.spectral_radius;
         shown.error_percent = reported_error;  // for the node the regions are centred on
         shown.target_met = reported_target_met;
         status_t status =

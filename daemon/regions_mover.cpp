@@ -1,10 +1,58 @@
 #include "daemon/regions_mover.hpp"
 
+#include <sstream>
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/region_partition.hpp"
 
 namespace hapticsim {
+namespace {
+
+std::string NodeText(const LatticeIndex& node) {
+  std::ostringstream text;
+  text << "contact node (" << node[0] << ", " << node[1] << ", " << node[2] << ")";
+  return text.str();
+}
+
+}  // namespace
+
+std::string RegionsMover::Outcome::Describe() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << std::fixed;
+  const double elapsed_s = elapsed_ms * 1e-3;
+  switch (kind) {
+    case Kind::kMoveUnverified:
+    case Kind::kMoveVerified:
+      text << "regions centred on " << NodeText(to.node) << " " << elapsed_s
+           << " s after it was asked for";
+      if (kind == Kind::kMoveUnverified) {
+        text << "; their coupling is being verified behind them";
+      } else if (to.centred.fell_back) {
+        text << "; the chosen configuration is unstable around it: secondaries at the primary "
+                "rate there";
+      }
+      break;
+    case Kind::kConfirmed:
+    case Kind::kDemote:
+      text << "coupling of " << DescribeConfiguration(request.configuration) << " around "
+           << NodeText(request.node) << " verified " << elapsed_s
+           << " s after the regions moved there: ";
+      text.precision(5);
+      if (kind == Kind::kConfirmed) {
+        text << "stable, spectral radius " << to.centred.spectral_radius;
+      } else {
+        text << "UNSTABLE; secondaries at the primary rate there";
+      }
+      break;
+    case Kind::kMoveBack:
+      text << why_not << "; the regions go back to " << NodeText(to.node) << " ("
+           << DescribeConfiguration(to.centred.configuration) << ")";
+      break;
+  }
+  return text.str();
+}
 
 void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
   asked_ = request;
@@ -13,25 +61,31 @@ void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
   ready_.reset();
   refusal_.clear();
   if (const auto known = verdicts_.find(KeyOf(request)); known != verdicts_.end()) {
-    ready_ = Outcome{Outcome::Kind::kMoveVerified, request, known->second, 0};
+    ready_ = Outcome{Outcome::Kind::kMoveVerified, request, {known->second, request.node}, 0, ""};
     return;
   }
   if (!request.applies_pending) {
-    // A node the tool cannot touch is refused before anything moves (cheap: no estimate).
+    // A node the tool cannot touch, or regions that cannot be built around it, are refused
+    // before anything moves (cheap: no estimate, no operators).
     try {
-      ValidateScene(SceneWith(scene_, request.configuration, request.node));
+      const Scene centred = SceneWith(scene_, request.configuration, request.node);
+      ValidateScene(centred);
+      (void)RegionPartition(centred);
     } catch (const Error& e) {
       refusal_ = e.what();
       return;
     }
   }
-  verifier_.Submit([scene = scene_, request] {
-    return VerifyCentredOn(scene, request.configuration, request.node);
+  verifier_.Submit([scene = scene_, request, verify = verify_] {
+    return verify(scene, request.configuration, request.node);
   });
   if (request.applies_pending) return;  // out of contact: nobody waits, so verify first
   behind_ = true;
-  ready_ = Outcome{Outcome::Kind::kMoveUnverified, request,
-                   CentredConfiguration{request.configuration, -1, false}, 0};
+  ready_ = Outcome{Outcome::Kind::kMoveUnverified,
+                   request,
+                   {CentredConfiguration{request.configuration, -1, false}, request.node},
+                   0,
+                   ""};
 }
 
 std::optional<RegionsMover::Outcome> RegionsMover::Poll(std::int64_t now_ns) {
@@ -46,7 +100,7 @@ std::optional<RegionsMover::Outcome> RegionsMover::Poll(std::int64_t now_ns) {
     ready_.reset();
     out.elapsed_ms = (now_ns - asked_ns_) * 1e-6;
     if (!behind_) asked_.reset();  // a move made unverified stays asked until its verdict
-    return out;
+    return Place(std::move(out));
   }
   return TakeVerdict(now_ns);
 }
@@ -58,13 +112,23 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
   const bool behind = behind_;
   asked_.reset();
   behind_ = false;
+  const double elapsed_ms = (now_ns - asked_ns_) * 1e-6;
   if (!verdict->result) {
     refused_.insert(KeyOf(request));
-    throw Error(verdict->error);
+    if (!behind) throw Error(verdict->error);
+    return Place({Outcome::Kind::kMoveBack, request, last_verified_, elapsed_ms, verdict->error});
   }
   verdicts_[KeyOf(request)] = *verdict->result;
-  Outcome out{Outcome::Kind::kMoveVerified, request, *verdict->result, (now_ns - asked_ns_) * 1e-6};
-  if (behind) out.kind = out.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
+  Outcome out{
+      Outcome::Kind::kMoveVerified, request, {*verdict->result, request.node}, elapsed_ms, ""};
+  if (behind)
+    out.kind = out.to.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
+  return Place(std::move(out));
+}
+
+RegionsMover::Outcome RegionsMover::Place(Outcome out) {
+  placed_ = out.to;
+  if (out.kind != Outcome::Kind::kMoveUnverified) last_verified_ = out.to;
   return out;
 }
 

@@ -1,11 +1,13 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "daemon/background_worker.hpp"
 #include "daemon/supervisor.hpp"
@@ -14,17 +16,21 @@ namespace hapticsim {
 
 /**
  * The supervisor's side of moving the regions — to another configuration or to another contact
- * node. The move itself is HapticLoop::Reconfigure, done by the caller with what Poll returns.
+ * node — and where they are now. The move itself is HapticLoop::Reconfigure, done by the caller
+ * with what Poll returns.
  *
  * A touch does not wait. The regions move onto a touched node at once, with their interface
  * controllers and port limits on (docs/regions.md), and the coupled stability of the bare
  * exchange around the node is verified behind them (VerifyCentredOn, a fraction of a second on
  * the paper's cube) on a background thread of its own, made once, so the supervisor's tick never
  * waits and no request makes a thread. Should the verdict be that the configuration is unstable
- * around the node, Poll says to demote the regions there to their secondaries at the primary rate;
- * the port guard bounds what reaches the hand until then. A configuration change (asked out of
- * contact, with nobody waiting) is still verified before it moves. Verdicts are kept per
- * configuration and node, so a node touched before moves straight to its verified configuration.
+ * around the node, Poll says to demote the regions there to their secondaries at the primary
+ * rate, or — unstable even so — to move them back to where they were last verified; the port
+ * guard bounds what reaches the hand meanwhile. A configuration change (asked out of contact,
+ * with nobody waiting) is still verified before it moves. Verdicts are kept per configuration and
+ * node, so a node touched before moves straight to its verified configuration. No other move is
+ * asked while a verdict is still to come (busy()), so the regions stay where the unverified move
+ * put them until it comes.
  */
 class RegionsMover {
  public:
@@ -33,29 +39,46 @@ class RegionsMover {
     LatticeIndex node{};
     bool applies_pending = false;  ///< the supervisor's pending configuration change
   };
+  /** Where the regions run: a configuration, centred on a node. */
+  struct Placement {
+    CentredConfiguration centred;  ///< spectral_radius −1 while unverified
+    LatticeIndex node{};
+  };
   struct Outcome {
     enum class Kind {
       kMoveUnverified,  ///< move now; its coupling is being verified behind it
       kMoveVerified,    ///< move now; verified (before, or by an earlier touch on the node)
       kConfirmed,       ///< the regions moved unverified are stable there: nothing to move
-      kDemote,          ///< they are not: move them to `centred` (the secondaries at equal rates)
+      kDemote,          ///< they are not: move them to the secondaries at equal rates there
+      kMoveBack,        ///< not even at equal rates: back to where they were last verified
     };
     Kind kind = Kind::kMoveVerified;
     Request request;
-    CentredConfiguration centred;  ///< spectral_radius −1 while unverified
-    double elapsed_ms = 0;         ///< from the request to this outcome
+    Placement to;           ///< where the regions go (or stay, kConfirmed)
+    double elapsed_ms = 0;  ///< from the request to this outcome
+    std::string why_not;    ///< kMoveBack: why the node was refused
     bool moves() const { return kind != Kind::kConfirmed; }
+    /** The log line that says what happened. */
+    std::string Describe() const;
   };
 
-  explicit RegionsMover(const Scene& scene) : scene_(scene) {}
+  /** How a configuration is verified around a node: VerifyCentredOn, or — in a test of what
+   *  the mover does with a verdict no scene here gives — a stand-in for it. */
+  using Verifier = std::function<CentredConfiguration(const Scene&, const RegionConfiguration&,
+                                                      const LatticeIndex&)>;
+
+  /** `at`: where the regions run at start (verified). */
+  RegionsMover(const Scene& scene, const Placement& at, Verifier verify = VerifyCentredOn)
+      : scene_(scene), placed_(at), last_verified_(at), verify_(std::move(verify)) {}
 
   /** Shutting down: the verifying thread stops after the verification it runs, if any. */
   void RequestStop() { verifier_.RequestStop(); }
 
+  /** Where the regions run, as of the last outcome Poll returned. */
+  const Placement& placement() const { return placed_; }
+
   /** True from Ask until Poll has returned its last outcome (a verdict behind a move included). */
   bool busy() const { return asked_.has_value(); }
-  /** True while regions moved unverified wait for their verdict. */
-  bool verifying_behind() const { return asked_ && behind_; }
   /** When its verification running now started (CLOCK_MONOTONIC ns), 0 when none runs. */
   std::int64_t running_since_ns() const { return verifier_.running_since_ns(); }
   /** False for a configuration and node found unstable (or invalid) before: not asked again. */
@@ -66,10 +89,11 @@ class RegionsMover {
    */
   void Ask(const Request& request, std::int64_t now_ns);
   /**
-   * The next outcome, once there is one.
-   * @throws Error when the node cannot be touched (off the surface, a support: at once) or the
-   *         configuration is unstable around it even at equal rates (remembered as refused). For a
-   *         move made unverified, the regions it moved must then be moved away.
+   * The next outcome, once there is one; placement() follows it.
+   * @throws Error when a move is refused before anything moved: the node cannot be touched (off
+   *         the surface, a support) or the regions cannot be built around it (both at once), or a
+   *         configuration change is unstable around it even at equal rates. Remembered as
+   *         refused; the regions stay where they are.
    */
   std::optional<Outcome> Poll(std::int64_t now_ns);
 
@@ -84,8 +108,11 @@ class RegionsMover {
             r.node[2]};
   }
   std::optional<Outcome> TakeVerdict(std::int64_t now_ns);
+  Outcome Place(Outcome out);  // placement() follows an outcome
 
   Scene scene_;
+  Placement placed_, last_verified_;
+  Verifier verify_;
   std::map<Key, CentredConfiguration> verdicts_;
   std::set<Key> refused_;
   std::optional<Request> asked_;
