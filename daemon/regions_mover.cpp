@@ -38,7 +38,7 @@ std::string RegionsMover::Outcome::Describe() const {
     case Kind::kDemote:
       text << "coupling of " << DescribeConfiguration(request.configuration) << " around "
            << NodeText(request.node) << " verified " << elapsed_s
-           << " s after the regions moved there: ";
+           << " s after the touch asked for the regions there: ";
       text.precision(5);
       if (kind == Kind::kConfirmed) {
         text << "stable, spectral radius " << to.centred.spectral_radius;
@@ -54,6 +54,13 @@ std::string RegionsMover::Outcome::Describe() const {
   return text.str();
 }
 
+RegionsMover::RegionsMover(const Scene& scene, const Placement& at, Verifier verify)
+    : scene_(scene), placed_(at), last_verified_(at), verify_(std::move(verify)) {
+  if (at.centred.spectral_radius >= 0) {  // the start is verified: a touch back there need not be
+    verdicts_[KeyOf({at.centred.configuration, at.node})] = at.centred;
+  }
+}
+
 void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
   asked_ = request;
   asked_ns_ = now_ns;
@@ -64,7 +71,7 @@ void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
     ready_ = Outcome{Outcome::Kind::kMoveVerified, request, {known->second, request.node}, 0, ""};
     return;
   }
-  if (!request.applies_pending) {
+  if (request.touch_waits) {
     // A node the tool cannot touch, or regions that cannot be built around it, are refused
     // before anything moves (cheap: no estimate, no operators).
     try {
@@ -79,7 +86,7 @@ void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
   verifier_.Submit([scene = scene_, request, verify = verify_] {
     return verify(scene, request.configuration, request.node);
   });
-  if (request.applies_pending) return;  // out of contact: nobody waits, so verify first
+  if (!request.touch_waits) return;  // nobody waits, so verify first
   behind_ = true;
   ready_ = Outcome{Outcome::Kind::kMoveUnverified,
                    request,
@@ -100,7 +107,7 @@ std::optional<RegionsMover::Outcome> RegionsMover::Poll(std::int64_t now_ns) {
     ready_.reset();
     out.elapsed_ms = (now_ns - asked_ns_) * 1e-6;
     if (!behind_) asked_.reset();  // a move made unverified stays asked until its verdict
-    return Place(std::move(out));
+    return out;
   }
   return TakeVerdict(now_ns);
 }
@@ -116,20 +123,31 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
   if (!verdict->result) {
     refused_.insert(KeyOf(request));
     if (!behind) throw Error(verdict->error);
-    return Place({Outcome::Kind::kMoveBack, request, last_verified_, elapsed_ms, verdict->error});
+    return Outcome{Outcome::Kind::kMoveBack, request, last_verified_, elapsed_ms, verdict->error};
   }
   verdicts_[KeyOf(request)] = *verdict->result;
   Outcome out{
       Outcome::Kind::kMoveVerified, request, {*verdict->result, request.node}, elapsed_ms, ""};
   if (behind)
     out.kind = out.to.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
-  return Place(std::move(out));
+  return out;
 }
 
-RegionsMover::Outcome RegionsMover::Place(Outcome out) {
-  placed_ = out.to;
-  if (out.kind != Outcome::Kind::kMoveUnverified) last_verified_ = out.to;
-  return out;
+void RegionsMover::Applied(const Outcome& outcome) {
+  placed_ = outcome.to;
+  if (outcome.kind != Outcome::Kind::kMoveUnverified) last_verified_ = outcome.to;
+}
+
+void RegionsMover::NotApplied(const Outcome& outcome) {
+  using Kind = Outcome::Kind;
+  if (outcome.kind == Kind::kDemote || outcome.kind == Kind::kMoveBack) {
+    asked_ = outcome.request;  // the regions still run what was found unstable: again next Poll
+    ready_ = outcome;
+    behind_ = false;
+  } else if (outcome.kind == Kind::kMoveUnverified) {
+    asked_.reset();  // never moved: its verdict (dropped by the next Submit) is not wanted
+    behind_ = false;
+  }
 }
 
 }  // namespace hapticsim

@@ -27,10 +27,10 @@ namespace hapticsim {
  * around the node, Poll says to demote the regions there to their secondaries at the primary
  * rate, or — unstable even so — to move them back to where they were last verified; the port
  * guard bounds what reaches the hand meanwhile. A configuration change (asked out of contact,
- * with nobody waiting) is still verified before it moves. Verdicts are kept per configuration and
- * node, so a node touched before moves straight to its verified configuration. No other move is
- * asked while a verdict is still to come (busy()), so the regions stay where the unverified move
- * put them until it comes.
+ * with nobody waiting) and a hovering tool's move are still verified before they move. Verdicts
+ * are kept per configuration and node, so a node touched before moves straight to its verified
+ * configuration. A touch elsewhere may give up a verification still running (the regions leave
+ * that node anyway).
  */
 class RegionsMover {
  public:
@@ -38,6 +38,7 @@ class RegionsMover {
     RegionConfiguration configuration;
     LatticeIndex node{};
     bool applies_pending = false;  ///< the supervisor's pending configuration change
+    bool touch_waits = false;      ///< a touch waits for it: move at once, verify behind
   };
   /** Where the regions run: a configuration, centred on a node. */
   struct Placement {
@@ -68,24 +69,26 @@ class RegionsMover {
                                                       const LatticeIndex&)>;
 
   /** `at`: where the regions run at start (verified). */
-  RegionsMover(const Scene& scene, const Placement& at, Verifier verify = VerifyCentredOn)
-      : scene_(scene), placed_(at), last_verified_(at), verify_(std::move(verify)) {}
+  RegionsMover(const Scene& scene, const Placement& at, Verifier verify = VerifyCentredOn);
 
   /** Shutting down: the verifying thread stops after the verification it runs, if any. */
   void RequestStop() { verifier_.RequestStop(); }
 
-  /** Where the regions run, as of the last outcome Poll returned. */
+  /** Where the regions run, as of the last outcome the caller applied (Applied). */
   const Placement& placement() const { return placed_; }
 
   /** True from Ask until Poll has returned its last outcome (a verdict behind a move included). */
   bool busy() const { return asked_.has_value(); }
+  /** True while what it is busy with may be given up for a touch: a verification (behind a
+   *  move, or before a configuration change), not an outcome still to be applied. */
+  bool may_interrupt() const { return busy() && !ready_; }
   /** When its verification running now started (CLOCK_MONOTONIC ns), 0 when none runs. */
   std::int64_t running_since_ns() const { return verifier_.running_since_ns(); }
   /** False for a configuration and node found unstable (or invalid) before: not asked again. */
   bool may_ask(const Request& request) const { return !refused_.count(KeyOf(request)); }
   /**
-   * Starts a move: a touch's at once (the next Poll returns it), a configuration change once
-   * verified.
+   * Starts a move: one a touch waits for at once (the next Poll returns it), any other once
+   * verified. Asked while busy, it replaces what the mover was doing (see may_interrupt).
    */
   void Ask(const Request& request, std::int64_t now_ns);
   /**
@@ -96,6 +99,14 @@ class RegionsMover {
    *         refused; the regions stay where they are.
    */
   std::optional<Outcome> Poll(std::int64_t now_ns);
+  /**
+   * The caller moved the regions as `outcome` said (or, kConfirmed, left them): placement()
+   * follows. An outcome that fails to apply (HapticLoop::Reconfigure threw) is given back with
+   * NotApplied: a demotion or a move back is then returned again by the next Poll; a move is
+   * dropped, with the verification behind it.
+   */
+  void Applied(const Outcome& outcome);
+  void NotApplied(const Outcome& outcome);
 
  private:
   using Key = std::tuple<int, int, double, int, int, int>;
@@ -108,7 +119,6 @@ class RegionsMover {
             r.node[2]};
   }
   std::optional<Outcome> TakeVerdict(std::int64_t now_ns);
-  Outcome Place(Outcome out);  // placement() follows an outcome
 
   Scene scene_;
   Placement placed_, last_verified_;
@@ -119,7 +129,7 @@ class RegionsMover {
   std::int64_t asked_ns_ = 0;
   bool behind_ = false;  // asked_ was moved unverified: its verdict is still to come
   BackgroundWorker<CentredConfiguration> verifier_{"hsim-verify"};
-  std::optional<Outcome> ready_;  // an outcome known at Ask, waiting for Poll
+  std::optional<Outcome> ready_;  // an outcome known at Ask (or to retry), waiting for Poll
   std::string refusal_;           // why the node asked for cannot be touched, for Poll
 };
 

@@ -148,6 +148,7 @@ TEST_F(HapticsimdEndToEnd, AnswersDeviceInputWithForceErrorAndItsSeq) {
   EXPECT_DOUBLE_EQ(status->error_target_percent, 7.0);
   EXPECT_TRUE(status->target_met);
   EXPECT_GE(status->inputs_received, 1300);
+  EXPECT_GT(status->spectral_radius, 0.0);  // verified (−1 while a verdict is still to come)
   EXPECT_LT(status->spectral_radius, 1.0);
   EXPECT_FALSE(status->asleep) << "pressing in at the end";
 
@@ -245,6 +246,8 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
   EXPECT_EQ(status->contact_node[1], 3);
   EXPECT_EQ(status->contact_node[2], 0);
   EXPECT_GE(status->reconfigurations, 1);
+  EXPECT_GT(status->spectral_radius, 0.0) << "the verdict behind the move is in the status";
+  EXPECT_LT(status->spectral_radius, 1.0);
   EXPECT_NE(daemon_->Log().find("regions centred on contact node (2, 3, 0)"), std::string::npos)
       << daemon_->Log();
   EXPECT_NE(daemon_->Log().find("around contact node (2, 3, 0) verified"), std::string::npos)

@@ -1,5 +1,6 @@
-// The supervisor's mover: a touch moves the regions at once and its verdict follows; a
-// configuration change is verified first; a node the tool cannot touch is refused at once.
+// The supervisor's mover: a touch moves the regions at once and its verdict follows (confirmed,
+// demoted to equal rates, or sent back where they were last verified); a configuration change
+// and a hovering tool's move are verified first; a node the tool cannot touch is refused at once.
 #include "daemon/regions_mover.hpp"
 
 #include <gtest/gtest.h>
@@ -13,25 +14,19 @@
 namespace hapticsim {
 namespace {
 
+using Kind = RegionsMover::Outcome::Kind;
+const LatticeIndex kOffCentre{2, 3, 0};
+const LatticeIndex kElsewhere{9, 4, 0};
+
 std::int64_t Now() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
-// Polls until the mover has something to say (a verification takes well under a minute here).
-RegionsMover::Outcome NextOutcome(RegionsMover& mover) {
-  const std::int64_t give_up = Now() + 60'000'000'000;
-  while (Now() < give_up) {
-    if (std::optional<RegionsMover::Outcome> out = mover.Poll(Now())) return *out;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  ADD_FAILURE() << "no verdict within 60 s";
-  return {};
+RegionsMover::Request Touch(const RegionConfiguration& configuration, const LatticeIndex& node) {
+  return {configuration, node, /*applies_pending=*/false, /*touch_waits=*/true};
 }
-
-using Kind = RegionsMover::Outcome::Kind;
-const LatticeIndex kOffCentre{2, 3, 0};
 
 // The regions at start: the scene's own configuration on its own node, verified.
 RegionsMover::Placement AtStart(const Scene& scene) {
@@ -42,16 +37,47 @@ RegionsMover::Placement AtStart(const Scene& scene) {
           ContactNode(scene)};
 }
 
+// What the supervisor does with an outcome: moves the regions, then tells the mover.
+std::optional<RegionsMover::Outcome> PollAndApply(RegionsMover& mover) {
+  std::optional<RegionsMover::Outcome> out = mover.Poll(Now());
+  if (out) mover.Applied(*out);
+  return out;
+}
+
+// Polls (and applies) until the mover has something to say (a verification takes well under a
+// minute here).
+RegionsMover::Outcome NextOutcome(RegionsMover& mover) {
+  const std::int64_t give_up = Now() + 60'000'000'000;
+  while (Now() < give_up) {
+    if (std::optional<RegionsMover::Outcome> out = PollAndApply(mover)) return *out;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ADD_FAILURE() << "no verdict within 60 s";
+  return {};
+}
+
+// A verdict no scene here gives — unstable around a node even at equal rates (every equal-rate
+// configuration of the paper's grid is stable, docs/regions.md) — from a stand-in for
+// VerifyCentredOn: `refused` is refused, any other node stable.
+RegionsMover::Verifier RefusingAt(const LatticeIndex& refused) {
+  return [refused](const Scene&, const RegionConfiguration& configuration,
+                   const LatticeIndex& node) -> CentredConfiguration {
+    if (node == refused) throw Error("not stable there, not even at equal rates");
+    return {configuration, 0.98, false};
+  };
+}
+
 TEST(RegionsMover, ATouchMovesAtOnceAndItsVerdictFollowsThenTheNodeIsKnown) {
   const Scene scene;
   RegionsMover mover(scene, AtStart(scene));
   const RegionConfiguration configuration{2, 2, 600};
-  mover.Ask({configuration, kOffCentre, false}, Now());
-  const std::optional<RegionsMover::Outcome> now = mover.Poll(Now());
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  const std::optional<RegionsMover::Outcome> now = PollAndApply(mover);
   ASSERT_TRUE(now) << "a touch must not wait for the estimate";
   EXPECT_EQ(now->kind, Kind::kMoveUnverified);
   EXPECT_EQ(now->to.centred.configuration, configuration);
   EXPECT_EQ(now->to.node, kOffCentre);
+  EXPECT_EQ(mover.placement().node, kOffCentre);
   EXPECT_EQ(mover.placement().centred.spectral_radius, -1) << "unverified";
   EXPECT_TRUE(mover.busy()) << "its verdict is still to come";
 
@@ -65,12 +91,17 @@ TEST(RegionsMover, ATouchMovesAtOnceAndItsVerdictFollowsThenTheNodeIsKnown) {
   EXPECT_FALSE(mover.busy());
 
   // Touched again: straight to the verified configuration, no estimate.
-  mover.Ask({configuration, kOffCentre, false}, Now());
-  const std::optional<RegionsMover::Outcome> again = mover.Poll(Now());
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  const std::optional<RegionsMover::Outcome> again = PollAndApply(mover);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->kind, Kind::kMoveVerified);
   EXPECT_EQ(again->to.centred.spectral_radius, verdict.to.centred.spectral_radius);
   EXPECT_FALSE(mover.busy());
+  // And the node the regions started on is known from the start.
+  mover.Ask(Touch(AtStart(scene).centred.configuration, AtStart(scene).node), Now());
+  const std::optional<RegionsMover::Outcome> home = PollAndApply(mover);
+  ASSERT_TRUE(home);
+  EXPECT_EQ(home->kind, Kind::kMoveVerified);
 }
 
 TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
@@ -78,8 +109,8 @@ TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
   scene.material.poisson_ratio = 0.49;  // k 1 r 2 700 Hz: 1.47 per common period, bare
   RegionsMover mover(scene, AtStart(scene));
   const RegionConfiguration configuration{2, 1, 700};
-  mover.Ask({configuration, kOffCentre, false}, Now());
-  const std::optional<RegionsMover::Outcome> now = mover.Poll(Now());
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  const std::optional<RegionsMover::Outcome> now = PollAndApply(mover);
   ASSERT_TRUE(now);
   EXPECT_EQ(now->kind, Kind::kMoveUnverified);
   const RegionsMover::Outcome verdict = NextOutcome(mover);
@@ -92,8 +123,8 @@ TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
   EXPECT_EQ(mover.placement().centred.configuration, verdict.to.centred.configuration);
   EXPECT_NE(verdict.Describe().find("UNSTABLE"), std::string::npos) << verdict.Describe();
   // Touched again: straight to the equal rates, verified.
-  mover.Ask({configuration, kOffCentre, false}, Now());
-  const std::optional<RegionsMover::Outcome> again = mover.Poll(Now());
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  const std::optional<RegionsMover::Outcome> again = PollAndApply(mover);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->kind, Kind::kMoveVerified);
   EXPECT_TRUE(again->to.centred.fell_back);
@@ -102,7 +133,7 @@ TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
 TEST(RegionsMover, ANodeTheToolCannotTouchIsRefusedAtOnceAndNotAskedAgain) {
   const Scene scene;
   RegionsMover mover(scene, AtStart(scene));
-  const RegionsMover::Request inside{{2, 2, 600}, {6, 6, 6}, false};
+  const RegionsMover::Request inside = Touch({2, 2, 600}, {6, 6, 6});
   mover.Ask(inside, Now());
   try {
     (void)mover.Poll(Now());
@@ -115,11 +146,11 @@ TEST(RegionsMover, ANodeTheToolCannotTouchIsRefusedAtOnceAndNotAskedAgain) {
   EXPECT_FALSE(mover.may_ask(inside));
 }
 
-TEST(RegionsMover, AConfigurationChangeIsVerifiedBeforeItMoves) {
+TEST(RegionsMover, AConfigurationChangeAndAHoverAreVerifiedBeforeTheyMove) {
   const Scene scene;
   RegionsMover mover(scene, AtStart(scene));
   const RegionConfiguration configuration{3, 2, 800};
-  mover.Ask({configuration, kOffCentre, true}, Now());
+  mover.Ask({configuration, kOffCentre, /*applies_pending=*/true, /*touch_waits=*/false}, Now());
   EXPECT_FALSE(mover.Poll(Now())) << "a configuration change moves only once verified";
   const RegionsMover::Outcome verdict = NextOutcome(mover);
   EXPECT_EQ(verdict.kind, Kind::kMoveVerified);
@@ -127,6 +158,13 @@ TEST(RegionsMover, AConfigurationChangeIsVerifiedBeforeItMoves) {
   EXPECT_LT(verdict.to.centred.spectral_radius, 1);
   EXPECT_GT(verdict.elapsed_ms, 0);
   EXPECT_EQ(mover.placement().node, kOffCentre);
+
+  // A tool hovering over another node: nobody waits, so verified first too.
+  mover.Ask({configuration, kElsewhere, false, false}, Now());
+  EXPECT_FALSE(mover.Poll(Now())) << "a hover moves only once verified";
+  const RegionsMover::Outcome hover = NextOutcome(mover);
+  EXPECT_EQ(hover.kind, Kind::kMoveVerified);
+  EXPECT_EQ(mover.placement().node, kElsewhere);
 }
 
 TEST(RegionsMover, RegionsThatCannotBeBuiltAroundTheNodeAreRefusedBeforeTheyMove) {
@@ -135,7 +173,7 @@ TEST(RegionsMover, RegionsThatCannotBeBuiltAroundTheNodeAreRefusedBeforeTheyMove
   scene.adaptivity.shell_cells = 2;
   RegionsMover mover(scene, AtStart(scene));
   const RegionsMover::Placement before = mover.placement();
-  mover.Ask({{2, 2, 600}, kOffCentre, false}, Now());
+  mover.Ask(Touch({2, 2, 600}, kOffCentre), Now());
   try {
     (void)mover.Poll(Now());
     ADD_FAILURE() << "regions with an empty shell were moved";
@@ -147,30 +185,67 @@ TEST(RegionsMover, RegionsThatCannotBeBuiltAroundTheNodeAreRefusedBeforeTheyMove
   EXPECT_FALSE(mover.busy());
 }
 
-// No scene here is unstable around a node even at equal rates (every equal-rate configuration of
-// the paper's grid is stable, docs/regions.md), so the verdict comes from a stand-in.
-TEST(RegionsMover, ANodeUnstableEvenAtEqualRatesSendsTheRegionsBackWhereTheyWereVerified) {
+TEST(RegionsMover, ANodeUnstableEvenAtEqualRatesSendsTheRegionsBackWhereTheyWereLastVerified) {
   const Scene scene;
-  RegionsMover mover(
-      scene, AtStart(scene),
-      [](const Scene&, const RegionConfiguration&, const LatticeIndex&) -> CentredConfiguration {
-        throw Error("not stable, not even at equal rates");
-      });
-  const RegionsMover::Placement start = mover.placement();
-  const RegionsMover::Request touch{{2, 2, 600}, kOffCentre, false};
-  mover.Ask(touch, Now());
-  const std::optional<RegionsMover::Outcome> now = mover.Poll(Now());
-  ASSERT_TRUE(now);
-  EXPECT_EQ(now->kind, Kind::kMoveUnverified);
+  RegionsMover mover(scene, AtStart(scene), RefusingAt(kElsewhere));
+  const RegionConfiguration configuration{2, 2, 600};
+  // A touch at one node, confirmed there: the last verified place is now that node.
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  ASSERT_EQ(PollAndApply(mover)->kind, Kind::kMoveUnverified);
+  ASSERT_EQ(NextOutcome(mover).kind, Kind::kConfirmed);
+  // Then one at a node it refuses: moved at once, then sent back to the confirmed node.
+  const RegionsMover::Request refused = Touch(configuration, kElsewhere);
+  mover.Ask(refused, Now());
+  ASSERT_EQ(PollAndApply(mover)->kind, Kind::kMoveUnverified);
+  EXPECT_EQ(mover.placement().node, kElsewhere);
   const RegionsMover::Outcome verdict = NextOutcome(mover);
   EXPECT_EQ(verdict.kind, Kind::kMoveBack);
-  EXPECT_EQ(verdict.to.node, start.node);
-  EXPECT_EQ(verdict.to.centred.configuration, start.centred.configuration);
-  EXPECT_EQ(mover.placement().node, start.node);
-  EXPECT_NE(verdict.Describe().find("not even at equal rates; the regions go back to"),
+  EXPECT_EQ(verdict.to.node, kOffCentre);
+  EXPECT_EQ(verdict.to.centred.configuration, configuration);
+  EXPECT_EQ(mover.placement().node, kOffCentre);
+  EXPECT_NE(verdict.Describe().find("not even at equal rates; the regions go back to contact node "
+                                    "(2, 3, 0)"),
             std::string::npos)
       << verdict.Describe();
-  EXPECT_FALSE(mover.may_ask(touch));
+  EXPECT_FALSE(mover.may_ask(refused));
+}
+
+TEST(RegionsMover, AMoveBackThatCouldNotBeAppliedIsAskedForAgain) {
+  const Scene scene;
+  RegionsMover mover(scene, AtStart(scene), RefusingAt(kOffCentre));
+  mover.Ask(Touch({2, 2, 600}, kOffCentre), Now());
+  ASSERT_EQ(PollAndApply(mover)->kind, Kind::kMoveUnverified);
+  std::optional<RegionsMover::Outcome> back;
+  for (int i = 0; i < 30000 && !back; ++i) {  // not applied: the loop did not answer
+    back = mover.Poll(Now());
+    if (!back) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(back);
+  ASSERT_EQ(back->kind, Kind::kMoveBack);
+  mover.NotApplied(*back);
+  EXPECT_EQ(mover.placement().node, kOffCentre) << "the regions still run there";
+  EXPECT_FALSE(mover.may_interrupt()) << "a move back is not given up for a touch";
+  const std::optional<RegionsMover::Outcome> again = mover.Poll(Now());
+  ASSERT_TRUE(again) << "asked for again at the next poll";
+  EXPECT_EQ(again->kind, Kind::kMoveBack);
+  mover.Applied(*again);
+  EXPECT_EQ(mover.placement().node, AtStart(scene).node);
+  EXPECT_FALSE(mover.busy());
+}
+
+TEST(RegionsMover, ATouchElsewhereGivesUpTheVerificationBehindTheLastOne) {
+  const Scene scene;
+  RegionsMover mover(scene, AtStart(scene), RefusingAt({0, 0, 0}));
+  mover.Ask(Touch({2, 2, 600}, kOffCentre), Now());
+  ASSERT_EQ(PollAndApply(mover)->kind, Kind::kMoveUnverified);
+  ASSERT_TRUE(mover.may_interrupt());
+  mover.Ask(Touch({2, 2, 600}, kElsewhere), Now());
+  ASSERT_EQ(PollAndApply(mover)->kind, Kind::kMoveUnverified);
+  const RegionsMover::Outcome verdict = NextOutcome(mover);
+  EXPECT_EQ(verdict.kind, Kind::kConfirmed);
+  EXPECT_EQ(verdict.request.node, kElsewhere) << "the verdict is the newest touch's";
+  EXPECT_EQ(mover.placement().node, kElsewhere);
+  EXPECT_FALSE(mover.busy());
 }
 
 }  // namespace
