@@ -172,6 +172,11 @@ class AsyncRegions {
    * contact at the step's start time, N (the force on the user is −R).
    */
   std::array<double, 3> StepPrimary(const std::array<double, 3>& contact_next) noexcept;
+  /**
+   * Where the contact is in the primary's current state (the last step's contact_next; zero
+   * after Reset), m: where a period's substeps start from. Primary thread.
+   */
+  std::array<double, 3> primary_contact_m() const noexcept;
   /** A secondary region's thread: one step of region `region` ≥ 1. */
   void StepRegion(RegionIndex region) noexcept;
   /**

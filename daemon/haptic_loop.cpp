@@ -137,6 +137,23 @@ void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
   pause_requested_.store(false, std::memory_order_release);
 }
 
+std::array<double, 3> HapticLoop::StepPrimaryPeriod(
+    const std::array<double, 3>& contact_m) noexcept {
+  // The device gives one position per period: the substeps go there in equal parts, from where
+  // the last period left the contact (holding it for every substep would move the contact node a
+  // period's way in one substep: a drag of 4m/dt on its mass m).
+  const int substeps = regions_->schedule(kPrimaryRegion).substeps;
+  const std::array<double, 3> from = regions_->primary_contact_m();
+  std::array<double, 3> reaction{};
+  for (int q = 1; q <= substeps; ++q) {
+    std::array<double, 3> to;
+    for (int c = 0; c < 3; ++c) to[c] = from[c] + (contact_m[c] - from[c]) * q / substeps;
+    const std::array<double, 3> r = regions_->StepPrimary(to);
+    if (q == 1) reaction = r;
+  }
+  return reaction;
+}
+
 std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
   const std::int64_t code = wanted_node_code_.load(std::memory_order_relaxed);
   if (code < 0) return std::nullopt;
@@ -326,12 +343,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     // period, with the secondaries restarted on this release.
     if (sleep_state_ == kAsleep && contact.engaged) WakeSecondaries(release_ns);
     if (sleep_state_ != kAsleep) {
-      const int substeps = regions_->schedule(kPrimaryRegion).substeps;
-      for (int q = 1; q <= substeps; ++q) {
-        // The device gives one position per period: every substep holds it.
-        const std::array<double, 3> r = regions_->StepPrimary(contact.displacement_m);
-        if (q == 1) reaction = r;
-      }
+      reaction = StepPrimaryPeriod(contact.displacement_m);
       // Only here: while paused for a reconfiguration the regions are not the primary's to read.
       if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
         flags |= force_flags::kBoundaryStale;

@@ -280,6 +280,9 @@ class HapticLoop {
   void UpdateFaultState(const PortGuard::Output& sent) noexcept;
   // Primary thread, while the regions are its own: the coupling's energy balance watched.
   void WatchEnergyBalance() noexcept;
+  // Primary thread: one period's steps, the contact moved to `contact_m` over its substeps; the
+  // reaction at the period's start, N.
+  std::array<double, 3> StepPrimaryPeriod(const std::array<double, 3>& contact_m) noexcept;
   // Primary thread: an input from the I/O thread (the resampler, the answers, the newest).
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).

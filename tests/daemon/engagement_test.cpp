@@ -33,8 +33,9 @@ struct Played {
 // hapticsimd's threads played on this one: each period the input that arrived at its release
 // (when the device sent one), the secondary regions stepped in virtual time as far as the
 // primary's coming step needs, then the primary period. `before(n)` runs first (a supervisor).
-Played Play(HapticLoop& loop, const Depth& depth, int periods,
-            const std::function<void(int)>& before = [](int) {}, std::int64_t seq_origin = 0) {
+Played Play(
+    HapticLoop& loop, const Depth& depth, int periods,
+    const std::function<void(int)>& before = [](int) {}, std::int64_t seq_origin = 0) {
   auto& regions = const_cast<AsyncRegions&>(loop.regions());
   Played played;
   static std::int64_t release = 1'000'000'000;  // one clock across the plays of a test
@@ -103,7 +104,8 @@ TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
   HapticLoop loop(DefaultScene(), HapticLoop::Options{});
   const double pi = 3.141592653589793;
   const Played played = Play(
-      loop, [&](int n) -> std::optional<double> {
+      loop,
+      [&](int n) -> std::optional<double> {
         return -0.002 + 0.012 * (1 - std::cos(2 * pi * n / 1000.0)) / 2;
       },
       1000);
@@ -159,12 +161,14 @@ INSTANTIATE_TEST_SUITE_P(Gaps, StaleGap, ::testing::Values(100, 1000));
 TEST(Engagement, ANewSessionWithTheToolInsideRampsInFromZero) {
   HapticLoop loop(DefaultScene(), HapticLoop::Options{});
   // A first session touches and leaves.
-  Play(loop, [](int n) -> std::optional<double> { return n < 300 ? PressTo(0.002)(n) : -0.002; },
-       600);
+  Play(
+      loop, [](int n) -> std::optional<double> { return n < 300 ? PressTo(0.002)(n) : -0.002; },
+      600);
   // 0.5 s of silence, then a new driver (its seq from 0 again) with the tool 1 cm in.
-  Play(loop, [](int) -> std::optional<double> { return std::nullopt; }, 500);
-  const Played played =
-      Play(loop, [](int) -> std::optional<double> { return 0.01; }, 2000, [](int) {}, 0);
+  Play(
+      loop, [](int) -> std::optional<double> { return std::nullopt; }, 500);
+  const Played played = Play(
+      loop, [](int) -> std::optional<double> { return 0.01; }, 2000, [](int) {}, 0);
   ExpectSmooth(played, "new session at 1 cm");
   EXPECT_NEAR(played.force_z.back(), SettledForce(0.01), 0.02 * std::abs(SettledForce(0.01)));
 }
@@ -204,6 +208,52 @@ TEST(Engagement, NewRegionsWhileTheToolPressesRampInFromZero) {
   });
   ExpectSmooth(played, "reconfiguration in contact");
   EXPECT_LT(played.force_z.back(), -0.5);  // pressing again
+}
+
+// A primary that takes substeps (a stiff, nearly incompressible material: the secondary at the
+// primary's rate needs 2, so both take 2) moves the contact in equal parts across them, from
+// where the last period left it — as the offline schedule does. Holding the period's position
+// for every substep moved the contact node a whole period's way in the first: a drag of 4m/dt on
+// its mass. The same press played through the daemon's primary period and, beside it, through
+// regions stepped as the offline schedule steps them must give the same force to round-off.
+TEST(Substeps, APrimaryTakingSubstepsMovesTheContactAsTheOfflineScheduleDoes) {
+  Scene scene = DefaultScene();
+  scene.material.poisson_ratio = 0.49;
+  scene.material.youngs_modulus_pa = 20000;
+  scene.material.density_kg_m3 = 800;
+  scene.adaptivity.primary_size = 2;
+  scene.adaptivity.secondary_lod = 1;
+  HapticLoop::Options options;
+  options.sleep_at_rest = false;  // the twin below steps every period, as the loop then does
+  HapticLoop loop(scene, options);
+  ASSERT_EQ(loop.regions().schedule(kPrimaryRegion).substeps, 2) << "the case this test is about";
+  AsyncRegions twin(scene);
+  std::array<double, 3> from{};
+  std::vector<double> twin_z;  // the twin's simulated force of the loop's period n − 1
+  const Played played = Play(loop, PressTo(0.006), 700, [&](int n) {
+    if (n == 0) return;
+    // Where the loop's last period took the contact: the twin steps there as offline runs do.
+    const std::array<double, 3> to = loop.regions().primary_contact_m();
+    twin.AdvanceSecondariesTo(twin.state_ticks(kPrimaryRegion) + twin.period_ticks(kPrimaryRegion));
+    std::array<double, 3> reaction{};
+    for (int q = 1; q <= 2; ++q) {
+      std::array<double, 3> at;
+      for (int c = 0; c < 3; ++c) at[c] = from[c] + (to[c] - from[c]) * q / 2;
+      const std::array<double, 3> r = twin.StepPrimary(at);
+      if (q == 1) reaction = r;
+    }
+    from = to;
+    twin_z.push_back(-reaction[2]);
+  });
+  ASSERT_EQ(played.simulated_z.size(), 700u);
+  double largest_difference = 0, largest_force = 0;
+  for (size_t n = 0; n < twin_z.size(); ++n) {
+    largest_difference = std::max(largest_difference, std::abs(played.simulated_z[n] - twin_z[n]));
+    largest_force = std::max(largest_force, std::abs(twin_z[n]));
+  }
+  EXPECT_GT(largest_force, 0.5) << "a press that shows nothing";
+  EXPECT_LT(largest_difference, 1e-9 * largest_force)
+      << "the daemon's primary steps its substeps otherwise than the offline schedule";
 }
 
 }  // namespace
