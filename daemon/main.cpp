@@ -46,6 +46,7 @@
 #include "daemon/lcm_bridge.hpp"
 #include "daemon/miss_logger.hpp"
 #include "daemon/overload_watch.hpp"
+#include "daemon/overrun_burst.hpp"
 #include "daemon/regions_mover.hpp"
 #include "daemon/sandbox_check.hpp"
 #include "daemon/shm_server.hpp"
@@ -148,6 +149,33 @@ std::optional<SignedCommandGate> LcmCommandGateOf(const DaemonConfig& config) {
                              CommandClockUs());
   } catch (const Error& e) {
     throw Error(std::string("lcm.command_key_file: ") + e.what());
+  }
+}
+
+// SIGHUP: the supervisor's and the log's keys (and the map's path) take effect now; other
+// changed keys are said and wait for a restart. A file the loader refuses changes nothing.
+// Returns whether it was taken.
+bool ReloadConfig(const Arguments& args, DaemonConfig* config, spdlog::logger& logger) {
+  try {
+    DaemonConfig fresh = LoadDaemonConfig(args.config);
+    if (!args.error_map.empty()) fresh.error_map = args.error_map;
+    if (!args.lcm_url.empty()) fresh.lcm_url = args.lcm_url;
+    config->error_target_percent = fresh.error_target_percent;
+    config->error_map = fresh.error_map;
+    config->status_rate_hz = fresh.status_rate_hz;
+    config->max_log_lines_per_s = fresh.max_log_lines_per_s;
+    config->log_level = fresh.log_level;
+    logger.set_level(spdlog::level::from_str(config->log_level));
+    if (FormatDaemonConfig(fresh) != FormatDaemonConfig(*config)) {
+      spdlog::warn(
+          "SIGHUP: {} changed keys outside [supervisor] and [log]; they take effect at the next "
+          "restart",
+          args.config);
+    }
+    return true;
+  } catch (const Error& e) {
+    spdlog::error("SIGHUP: config reload refused: {}; keeping the running configuration", e.what());
+    return false;
   }
 }
 
@@ -350,11 +378,8 @@ int Serve(const Arguments& args) {
   std::int64_t last_command_refusal_ns = 0, lcm_refusals_logged = 0;
   std::int64_t control_refused_seen = 0, control_refused_logged = 0;
   BlackBox black_box(kBlackBoxCycles);
-  std::int64_t last_overrun_dump_ns = 0, last_fault_dump_ns = 0;
-  constexpr int kOverrunBurst = 10;
-  constexpr std::int64_t kOverrunWindow_ns = 20'000'000;
-  int overrun_burst = 0;  // primary periods late since overrun_window_start_ns
-  std::int64_t overrun_window_start_ns = HapticLoop::NowNs();
+  std::int64_t last_fault_dump_ns = 0;
+  OverrunBurst overrun(HapticLoop::NowNs());
   // New choices are made on one background thread (stability estimates take seconds): the tick
   // never waits, and no command makes a thread.
   BackgroundWorker<SupervisorDecision> chooser("hsim-choose");
@@ -556,29 +581,8 @@ int Serve(const Arguments& args) {
       break;
     }
     if (signal == SIGHUP) {
-      // The supervisor's keys and the map take effect now; the others need a restart.
-      if (!default_missing) {
-        try {
-          DaemonConfig fresh = LoadDaemonConfig(args.config);
-          if (!args.error_map.empty()) fresh.error_map = args.error_map;
-          if (!args.lcm_url.empty()) fresh.lcm_url = args.lcm_url;
-          target = fresh.error_target_percent;
-          config.error_target_percent = fresh.error_target_percent;
-          config.error_map = fresh.error_map;
-          config.status_rate_hz = fresh.status_rate_hz;
-          config.max_log_lines_per_s = fresh.max_log_lines_per_s;
-          config.log_level = fresh.log_level;
-          logger->set_level(spdlog::level::from_str(config.log_level));
-          if (FormatDaemonConfig(fresh) != FormatDaemonConfig(config)) {
-            spdlog::warn(
-                "SIGHUP: {} changed keys outside [supervisor] and [log]; they take "
-                "effect at the next restart",
-                args.config);
-          }
-        } catch (const Error& e) {
-          spdlog::error("SIGHUP: config reload refused: {}; keeping the running configuration",
-                        e.what());
-        }
+      if (!default_missing && ReloadConfig(args, &config, *logger)) {
+        target = config.error_target_percent;
       }
       spdlog::info("SIGHUP: reloading the error map {}", config.error_map);
       MapState reloaded = LoadMap(config.error_map, config.scene, true);
@@ -623,18 +627,11 @@ int Serve(const Arguments& args) {
       while (loop.monitor(r).PopEvent(&event)) miss_loggers[r].Add(event), ++misses;
       overload.Count(r, misses);
       miss_loggers[r].Flush(now);
-      // A primary that overruns again and again is a fault worth the black box (once a minute):
-      // kOverrunBurst late periods within kOverrunWindow_ns, however often the tick runs.
+      // A primary that overruns again and again is a fault worth the black box.
       if (r != kPrimaryRegion) continue;
-      overrun_burst += misses;
-      if (now - overrun_window_start_ns < kOverrunWindow_ns) continue;
-      if (overrun_burst >= kOverrunBurst && now - last_overrun_dump_ns > 60'000'000'000) {
-        black_box.Dump(fmt::format("{} primary periods late within {:.0f} ms", overrun_burst,
-                                   (now - overrun_window_start_ns) * 1e-6));
-        last_overrun_dump_ns = now;
+      if (const std::optional<std::string> burst = overrun.Count(misses, now)) {
+        black_box.Dump(*burst);
       }
-      overrun_burst = 0;
-      overrun_window_start_ns = now;
     }
     // Rejections: at most log.max_lines_per_s lines each; the counts are in every status message.
     auto line_due = [&](std::int64_t last_line_ns) {

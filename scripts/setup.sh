@@ -12,6 +12,7 @@ packages=(
   libssl-dev
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libspdlog-dev default-jdk-headless
   iproute2 util-linux systemd strace
+  python3 universal-ctags
   libopenmpi-dev openmpi-bin
   chromium
   xvfb
