@@ -2,8 +2,9 @@
 """The size bound on hapticsim's own code: no function over 80 lines and no file over 500 in
 core/, daemon/, ipc/ and device/ (tests and generated code are exempt).
 
-Functions are measured with universal-ctags (first to last line, comments and blank lines
-included; a lambda counts as part of the function it is written in). What was over the bound
+Functions are measured with Universal Ctags (first to last line, comments and blank lines
+included; a lambda counts as part of the function it is written in), named with their class and
+namespace (anonymous namespaces left out). What was over the bound
 when the bound came is listed in scripts/size-bounds.txt, each at its size then: it may not grow,
 and its entry is lowered as it shrinks and removed once it is within the bound. Anything else
 over the bound fails the check.
@@ -19,24 +20,51 @@ FUNCTION_LINES, FILE_LINES = 80, 500
 FOLDERS = ("core", "daemon", "ipc", "device")
 
 
+def ctags_program():
+    """Universal Ctags under either of its names (Exuberant Ctags lacks --_xformat)."""
+    for name in ("ctags-universal", "universal-ctags", "ctags"):
+        try:
+            version = subprocess.run([name, "--version"], capture_output=True, text=True).stdout
+        except FileNotFoundError:
+            continue
+        if "Universal Ctags" in version:
+            return name
+    sys.exit("check_sizes: Universal Ctags is not installed (scripts/setup.sh installs "
+             "universal-ctags)")
+
+
 def measure(root):
     files = sorted(p for folder in FOLDERS for p in (root / folder).rglob("*")
-                   if p.suffix in (".cpp", ".hpp", ".h", ".cc"))
+                   if p.suffix in (".cpp", ".hpp", ".h", ".cc") and p.is_file()
+                   and not any(part.startswith(".") for part in p.relative_to(root).parts))
     sizes = {}
     for path in files:
         with open(path, encoding="utf-8") as f:
             sizes[("file", path.relative_to(root).as_posix(), "")] = sum(1 for _ in f)
     out = subprocess.run(
-        ["ctags", "--languages=C++", "--kinds-C++=f", "--fields=+ne", "-x",
-         "--_xformat=%{line} %{end} %F %N"] + [str(p.relative_to(root)) for p in files],
+        [ctags_program(), "--languages=C++", "--kinds-C++=f", "--fields=+neZ", "-x",
+         "--_xformat=%{line} %{end} %F %{scope} %N"]
+        + [str(p.relative_to(root)) for p in files],
         cwd=root, check=True, capture_output=True, text=True).stdout
+    definitions = collections.defaultdict(list)
     for line in out.splitlines():
-        first, last, path, name = line.split(" ", 3)
-        if name.startswith("__anon") or last == "-":
+        first, last, path, scope, name = line.split(" ", 4)
+        if name.startswith("__anon"):
             continue  # a lambda: measured with the function around it
-        key = ("function", path, name)
-        sizes[key] = max(sizes.get(key, 0), int(last) - int(first) + 1)
-    return sizes
+        if last == "-":
+            print(f"check_sizes: no end line for {path}: {name}() (not measured)")
+            continue
+        # Anonymous namespaces' names change with the file: left out of the function's name.
+        qualified = "::".join(part for part in scope.split("::")
+                              if part and part != "-" and not part.startswith("__anon"))
+        key = ("function", path, f"{qualified}::{name}" if qualified else name)
+        definitions[key].append(int(last) - int(first) + 1)
+    overloads = []  # functions of one name with more than one definition over the bound
+    for key, lines in definitions.items():
+        sizes[key] = max(lines)
+        if sum(n > FUNCTION_LINES for n in lines) > 1:
+            overloads.append(key)
+    return sizes, overloads
 
 
 def bounds(path):
@@ -51,8 +79,9 @@ def bounds(path):
 
 def main():
     root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
-    sizes, listed = measure(root), bounds(root / "scripts" / "size-bounds.txt")
-    problems = []
+    (sizes, overloads), listed = measure(root), bounds(root / "scripts" / "size-bounds.txt")
+    problems = [f"{where}: {name}() has more than one definition over the bound of "
+                f"{FUNCTION_LINES} lines: split them" for _, where, name in overloads]
     for (kind, where, name), lines in sorted(sizes.items()):
         limit = FUNCTION_LINES if kind == "function" else FILE_LINES
         what = f"{where}: {name}()" if name else where
