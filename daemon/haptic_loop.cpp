@@ -147,7 +147,9 @@ std::array<double, 3> HapticLoop::StepPrimaryPeriod(
   std::array<double, 3> reaction{};
   for (int q = 1; q <= substeps; ++q) {
     std::array<double, 3> to;
-    for (int c = 0; c < 3; ++c) to[c] = from[c] + (contact_m[c] - from[c]) * q / substeps;
+    for (int c = 0; c < 3; ++c) {  // the last substep exactly where the device put the tip
+      to[c] = q == substeps ? contact_m[c] : from[c] + (contact_m[c] - from[c]) * q / substeps;
+    }
     const std::array<double, 3> r = regions_->StepPrimary(to);
     if (q == 1) reaction = r;
   }

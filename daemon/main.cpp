@@ -378,7 +378,7 @@ int Serve(const Arguments& args) {
   std::int64_t last_command_refusal_ns = 0, lcm_refusals_logged = 0;
   std::int64_t control_refused_seen = 0, control_refused_logged = 0;
   BlackBox black_box(kBlackBoxCycles);
-  std::int64_t last_fault_dump_ns = 0;
+  std::int64_t last_fault_dump_ns = -1;  // none yet (CLOCK_MONOTONIC starts at boot)
   OverrunBurst overrun(HapticLoop::NowNs());
   // New choices are made on one background thread (stability estimates take seconds): the tick
   // never waits, and no command makes a thread.
@@ -804,7 +804,7 @@ int Serve(const Arguments& args) {
     }
     if (loop.force_faults() > faults_seen) {
       faults_seen = loop.force_faults();
-      if (now - last_fault_dump_ns > 10'000'000'000) {  // one black box per 10 s of faults
+      if (last_fault_dump_ns < 0 || now - last_fault_dump_ns > 10'000'000'000) {  // 1 per 10 s
         black_box.Drain(loop);
         black_box.Dump("force fault");
         last_fault_dump_ns = now;

@@ -238,7 +238,7 @@ TEST(Substeps, APrimaryTakingSubstepsMovesTheContactAsTheOfflineScheduleDoes) {
     std::array<double, 3> reaction{};
     for (int q = 1; q <= 2; ++q) {
       std::array<double, 3> at;
-      for (int c = 0; c < 3; ++c) at[c] = from[c] + (to[c] - from[c]) * q / 2;
+      for (int c = 0; c < 3; ++c) at[c] = q == 2 ? to[c] : from[c] + (to[c] - from[c]) * q / 2;
       const std::array<double, 3> r = twin.StepPrimary(at);
       if (q == 1) reaction = r;
     }
