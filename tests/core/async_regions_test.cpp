@@ -33,6 +33,18 @@ TEST(AsyncRegions, EqualRatesAtFullResolutionReproduceTheReference) {
   }
 }
 
+// `base` in regions of spacing factor 1 (k 1), every one at 1000 Hz: what must reproduce the
+// full-resolution reference to round-off.
+Scene FullResolutionAtOneRate(const Scene& base, int primary_size, int shells) {
+  Scene scene = base;
+  scene.adaptivity.primary_size = primary_size;
+  scene.adaptivity.secondary_lod = 1;
+  scene.adaptivity.secondary_rate_hz = 1000;
+  scene.adaptivity.secondary_regions = shells;
+  scene.adaptivity.outer_rate_hz = 1000;
+  return scene;
+}
+
 // A stiff, nearly incompressible material where the regions' own limits differ: the secondary
 // needs 2 substeps of the 1 ms period, the primary (one element deeper than its contact) 1. At
 // one rate they must step together, or the pair is a multirate coupling in disguise — it was:
@@ -49,13 +61,7 @@ TEST(AsyncRegions, RegionsAtOneRateStepTogetherWhateverSubstepsEachNeedsAlone) {
   ASSERT_EQ(reference.substeps, 2);
   for (const auto& [r, shells] :
        {std::pair{1, 1}, std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}}) {
-    Scene scene = base;
-    scene.adaptivity.primary_size = r;
-    scene.adaptivity.secondary_lod = 1;
-    scene.adaptivity.secondary_rate_hz = 1000;
-    scene.adaptivity.secondary_regions = shells;
-    scene.adaptivity.outer_rate_hz = 1000;
-    AsyncRegions dut(scene);
+    AsyncRegions dut(FullResolutionAtOneRate(base, r, shells));
     const std::string label =
         "r " + std::to_string(r) + ", " + std::to_string(shells) + " shell(s)";
     for (int a = 1; a < dut.num_regions(); ++a) {
@@ -87,13 +93,8 @@ TEST(AsyncRegions, EqualRatesReproduceTheReferenceUnderFastInputs) {
     for (int shells : {1, 2}) {
       for (int r : {1, 2}) {
         for (bool displacement : {true, false}) {
-          Scene scene = base;
+          Scene scene = FullResolutionAtOneRate(base, r, shells);
           scene.adaptivity.displacement_coupling = displacement;
-          scene.adaptivity.primary_size = r;
-          scene.adaptivity.secondary_lod = 1;
-          scene.adaptivity.secondary_rate_hz = 1000;
-          scene.adaptivity.secondary_regions = shells;
-          scene.adaptivity.outer_rate_hz = 1000;
           AsyncRegions dut(scene);
           const TrialResult result = dut.RunTrial();
           const std::string label = std::to_string(frequency) + " Hz, r " + std::to_string(r) +
