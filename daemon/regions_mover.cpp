@@ -7,16 +7,6 @@
 #include "core/region_partition.hpp"
 
 namespace hapticsim {
-namespace {
-
-std::string NodeText(const LatticeIndex& node) {
-  std::ostringstream text;
-  text << "contact node (" << node[0] << ", " << node[1] << ", " << node[2] << ")";
-  return text.str();
-}
-
-}  // namespace
-
 std::string RegionsMover::Outcome::Describe() const {
   std::ostringstream text;
   text.precision(3);
@@ -25,7 +15,7 @@ std::string RegionsMover::Outcome::Describe() const {
   switch (kind) {
     case Kind::kMoveUnverified:
     case Kind::kMoveVerified:
-      text << "regions centred on " << NodeText(to.node) << " " << elapsed_s
+      text << "regions centred on " << DescribeContactNode(to.node) << " " << elapsed_s
            << " s after it was asked for";
       if (kind == Kind::kMoveUnverified) {
         text << "; their coupling is being verified behind them";
@@ -37,7 +27,7 @@ std::string RegionsMover::Outcome::Describe() const {
     case Kind::kConfirmed:
     case Kind::kDemote:
       text << "coupling of " << DescribeConfiguration(request.configuration) << " around "
-           << NodeText(request.node) << " verified " << elapsed_s
+           << DescribeContactNode(request.node) << " verified " << elapsed_s
            << " s after the touch asked for the regions there: ";
       text.precision(5);
       if (kind == Kind::kConfirmed) {
@@ -47,7 +37,7 @@ std::string RegionsMover::Outcome::Describe() const {
       }
       break;
     case Kind::kMoveBack:
-      text << why_not << "; the regions go back to " << NodeText(to.node) << " ("
+      text << why_not << "; the regions go back to " << DescribeContactNode(to.node) << " ("
            << DescribeConfiguration(to.centred.configuration) << ")";
       break;
   }
@@ -128,8 +118,9 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
   verdicts_[KeyOf(request)] = *verdict->result;
   Outcome out{
       Outcome::Kind::kMoveVerified, request, {*verdict->result, request.node}, elapsed_ms, ""};
-  if (behind)
+  if (behind) {
     out.kind = out.to.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
+  }
   return out;
 }
 

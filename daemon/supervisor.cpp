@@ -56,6 +56,11 @@ std::string DescribeConfiguration(const RegionConfiguration& c) {
   return text.str();
 }
 
+std::string DescribeContactNode(const LatticeIndex& node) {
+  return "contact node (" + std::to_string(node[0]) + ", " + std::to_string(node[1]) + ", " +
+         std::to_string(node[2]) + ")";
+}
+
 NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
                         const RegionConfiguration& configuration, const LatticeIndex& node) {
   NodeError out;
@@ -100,9 +105,8 @@ CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfigurati
   if (const std::optional<double> radius = CoupledRadius(centred, equal)) {
     return {equal, *radius, true};
   }
-  throw Error(DescribeConfiguration(configuration) + " is not stable around contact node (" +
-              std::to_string(node[0]) + ", " + std::to_string(node[1]) + ", " +
-              std::to_string(node[2]) + "), not even at equal rates");
+  throw Error(DescribeConfiguration(configuration) + " is not stable around " +
+              DescribeContactNode(node) + ", not even at equal rates");
 }
 
 std::string MapProblem(const Scene& scene, const ErrorMap& map) {

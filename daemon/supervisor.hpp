@@ -25,6 +25,8 @@ struct RegionConfiguration {
 
 /** "primary_size 3, secondary_lod 2, secondary_rate 1000 Hz": as logs and errors name it. */
 std::string DescribeConfiguration(const RegionConfiguration& configuration);
+/** "contact node (ix, iy, iz)", as the log and the errors name a node. */
+std::string DescribeContactNode(const LatticeIndex& node);
 
 struct SupervisorDecision {
   RegionConfiguration configuration;
