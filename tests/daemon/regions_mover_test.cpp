@@ -67,6 +67,16 @@ RegionsMover::Verifier RefusingAt(const LatticeIndex& refused) {
   };
 }
 
+// The very next Poll refuses the move, with `reason` in its message.
+void ExpectRefusedAtOnce(RegionsMover& mover, const std::string& reason) {
+  try {
+    (void)mover.Poll(Now());
+    ADD_FAILURE() << "moved, where it should be refused: " << reason;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+  }
+}
+
 TEST(RegionsMover, ATouchMovesAtOnceAndItsVerdictFollowsThenTheNodeIsKnown) {
   const Scene scene;
   RegionsMover mover(scene, AtStart(scene));
@@ -135,13 +145,7 @@ TEST(RegionsMover, ANodeTheToolCannotTouchIsRefusedAtOnceAndNotAskedAgain) {
   RegionsMover mover(scene, AtStart(scene));
   const RegionsMover::Request inside = Touch({2, 2, 600}, {6, 6, 6});
   mover.Ask(inside, Now());
-  try {
-    (void)mover.Poll(Now());
-    ADD_FAILURE() << "an interior node was accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("\"6,6,6\" is inside the object"), std::string::npos)
-        << e.what();
-  }
+  ExpectRefusedAtOnce(mover, "\"6,6,6\" is inside the object");
   EXPECT_FALSE(mover.busy());
   EXPECT_FALSE(mover.may_ask(inside));
 }
@@ -174,13 +178,7 @@ TEST(RegionsMover, RegionsThatCannotBeBuiltAroundTheNodeAreRefusedBeforeTheyMove
   RegionsMover mover(scene, AtStart(scene));
   const RegionsMover::Placement before = mover.placement();
   mover.Ask(Touch({2, 2, 600}, kOffCentre), Now());
-  try {
-    (void)mover.Poll(Now());
-    ADD_FAILURE() << "regions with an empty shell were moved";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("leaves secondary region 4"), std::string::npos)
-        << e.what();
-  }
+  ExpectRefusedAtOnce(mover, "leaves secondary region 4");
   EXPECT_EQ(mover.placement().node, before.node);
   EXPECT_FALSE(mover.busy());
 }
