@@ -9,6 +9,7 @@
 
 #include "core/boundary_channel.hpp"
 #include "core/contact_trajectory.hpp"
+#include "core/object_state.hpp"
 #include "core/reference_trial.hpp"
 #include "core/region_integrator.hpp"
 #include "core/region_partition.hpp"
@@ -165,6 +166,25 @@ class AsyncRegions {
   void Reset();
   /** A reproducible random state (free DOFs), consistent on every Γ, at t = 0. */
   void SetRandomState(unsigned seed);
+
+  /**
+   * The object's present motion on the fine lattice (ObjectState): at each lattice point the
+   * value of the region that owns it — an independent node's own, or between a coarse cell's
+   * vertices the cell's trilinear field (which is what a hanging node is held to) — velocities
+   * (u − u⁻)/h with each region's own substep. The regions are taken as they are: on the
+   * real-time schedule the secondaries may be a step or two ahead of the primary.
+   * One thread, while no steps run.
+   */
+  ObjectState CaptureState() const;
+  /**
+   * Starts the regions at t = 0 from `state` instead of rest (a configuration switched while the
+   * object is deformed): every independent node takes its lattice point's displacement, each
+   * region its u⁻ = u − v·h for its own substep h, the contact stays where the state has it
+   * (primary_contact_m), the boundaries are published and the energy balance starts afresh.
+   * One thread, while no steps run.
+   * @throws Error for a state of another lattice.
+   */
+  void RestoreState(const ObjectState& state);
 
   /**
    * Primary thread: one primary step (a period, or one of its substeps). contact_next is the
