@@ -183,4 +183,14 @@ void ContactTracker::RestartKeepingContact() noexcept {
   held_ = false;
 }
 
+void ContactTracker::CatchUpFrom(const std::array<double, 3>& held_m,
+                                 std::int64_t held_at_ns) noexcept {
+  if (state_ != State::kEngaged) return;
+  // The node's own path starts where it was held, so its velocity over the next period is the
+  // one it had (velocity_: the tip's, which it followed until the hold).
+  displacement_ = held_m;
+  last_ns_ = held_at_ns;
+  StartRamp(held_m, velocity_, kCatchUp_ns, held_at_ns);
+}
+
 }  // namespace hapticsim

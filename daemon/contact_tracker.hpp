@@ -60,6 +60,13 @@ class ContactTracker {
   /** The regions restart from rest around a new centre: an engaged or waiting contact engages
    * again with its force ramped in from zero. */
   void RestartKeepingContact() noexcept;
+  /**
+   * New regions took over with the old ones' motion, the contact node where the last regions
+   * held it (`held_m`, at `held_at_ns`) while the tip went on: an engaged contact goes on from
+   * there at the velocity it had and catches up with the tip over kCatchUp_ns (a smoothstep, as
+   * after a jump), so neither the node's position nor its velocity steps.
+   */
+  void CatchUpFrom(const std::array<double, 3>& held_m, std::int64_t held_at_ns) noexcept;
 
   /**
    * The node the regions should be centred on: the touched node while inside, else the surface
@@ -91,9 +98,8 @@ class ContactTracker {
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
-  void StartRamp(const std::array<double, 3>& from_m,
-                 const std::array<double, 3>& velocity_m_per_s, std::int64_t duration_ns,
-                 std::int64_t now_ns) noexcept;
+  void StartRamp(const std::array<double, 3>& from_m, const std::array<double, 3>& velocity_m_per_s,
+                 std::int64_t duration_ns, std::int64_t now_ns) noexcept;
 
   MeshSettings mesh_;
   double h_ = 0;
@@ -108,7 +114,7 @@ class ContactTracker {
   bool ramping_ = false;
   std::array<double, 3> ramp_from_{}, ramp_velocity_{};
   std::int64_t ramp_start_ns_ = 0, ramp_duration_ns_ = 0;
-  bool held_ = false;  // the last period was a Hold while engaged
+  bool held_ = false;                     // the last period was a Hold while engaged
   std::array<double, 3> displacement_{};  // the last engaged displacement
   std::array<double, 3> velocity_{};      // of the displacement over the last period, m/s
   std::int64_t last_ns_ = 0;              // when displacement_ was set

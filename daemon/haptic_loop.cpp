@@ -1,20 +1,16 @@
 #include "daemon/haptic_loop.hpp"
 
-#include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 #include <string>
 
 #include "core/error.hpp"
 #include "core/monotonic_clock.hpp"
+#include "daemon/futex.hpp"
 
 namespace hapticsim {
 namespace {
@@ -22,23 +18,6 @@ namespace {
 // Named threads show up as such in top -H, ps -L, perf and gdb (15 characters at most).
 void NameThisThread(const std::string& name) {
   pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
-}
-
-// The futex behind an atomic word, for every wait of the loop's threads: std::atomic::wait has
-// no timeout (an idle primary must still come round now and then: stop, reconfiguration, the
-// watchdog's sign of life), and a wake is one system call, no lock, in the 1 kHz path too.
-static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) &&
-              std::atomic<std::uint32_t>::is_always_lock_free);
-void FutexWait(std::atomic<std::uint32_t>* word, std::uint32_t expected, double timeout_s) {
-  const auto ns = static_cast<long>(timeout_s * 1e9);
-  const timespec timeout{ns / 1'000'000'000, ns % 1'000'000'000};
-  // Returns at once if *word != expected; spurious returns are harmless to the caller.
-  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAIT_PRIVATE, expected, &timeout,
-          nullptr, 0);
-}
-void FutexWakeAll(std::atomic<std::uint32_t>* word) {
-  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAKE_PRIVATE, INT_MAX, nullptr,
-          nullptr, 0);
 }
 
 }  // namespace
@@ -60,82 +39,6 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
 }
 
 HapticLoop::~HapticLoop() { Stop(); }
-
-void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions) {
-  scene_ = scene;
-  regions_ = std::move(regions);
-  centre_ = ContactNode(scene);
-  const int count = regions_->num_regions();
-  tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
-  auto nominal_ns = [&](int a) {
-    return static_cast<double>(regions_->period_ticks(a) * regions_->schedule(a).substeps) *
-           tick_ns_;
-  };
-  if (monitors_.empty()) {  // the primary's period is fixed for the loop's life
-    primary_period_ns_ = nominal_ns(kPrimaryRegion);
-    monitors_.push_back(std::make_unique<DeadlineMonitor>(primary_period_ns_ * 1e-9));
-  }
-  std::vector<std::unique_ptr<DeadlineMonitor>> replaced(
-      std::make_move_iterator(monitors_.begin() + 1), std::make_move_iterator(monitors_.end()));
-  monitors_.resize(1);
-  lead_ns_.assign(static_cast<size_t>(count), 0);
-  for (int a = 1; a < count; ++a) {
-    monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal_ns(a) * 1e-9));
-    // The a-th secondary thread's statistics run on across reconfigurations.
-    if (a - 1 < static_cast<int>(replaced.size())) monitors_.back()->CarryOver(*replaced[a - 1]);
-    // Each coarser region is released ahead of the finer one by 1.25 of the finer's period, so
-    // its boundary is published before the finer region needs it (as in RealTimeSchedule).
-    lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ns(a - 1));
-  }
-}
-
-std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
-  const double periods = std::ceil((not_before_ns - origin_ns_) / primary_period_ns_);
-  return origin_ns_ + std::llround(periods * primary_period_ns_);
-}
-
-void HapticLoop::Reconfigure(const Scene& scene, bool keep_contact) {
-  auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
-  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || scene.mesh.nodes != nodes_ ||
-      scene.mesh.edge_m != scene_.mesh.edge_m) {
-    throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
-  }
-  ++reconfigurations_;
-  const RestartKind restart = keep_contact ? kRestartKeepingContact : kRestartFromRest;
-  if (!running_.load()) {
-    restart_kind_.store(restart);
-    ForgetSleep();
-    Install(scene, std::move(regions));
-    return;
-  }
-  paused_.store(false);
-  pause_requested_.store(true, std::memory_order_release);
-  // An idle primary waiting for input comes round now (the count moves, so a primary about to
-  // wait does not wait either).
-  input_arrivals_.fetch_add(1);
-  FutexWakeAll(&input_arrivals_);
-  // The primary acknowledges at its next release; after that it does not touch the regions.
-  const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
-  while (!paused_.load(std::memory_order_acquire)) {
-    if (NowNs() > give_up_ns) {
-      // A primary thread that does not come round in a second is hung: joining it would hang the
-      // supervisor too. Leave everything as it is; the watchdog stops getting pings.
-      pause_requested_.store(false, std::memory_order_release);
-      throw Error("the primary thread did not answer within 1 s: regions not replaced");
-    }
-    SleepUntilMonotonicNs(NowNs() + 100'000);
-  }
-  StopSecondaries();
-  ForgetSleep();
-  Install(scene, std::move(regions));
-  // The new regions start from rest on the primary's own release grid, late enough for the
-  // secondaries to be released ahead of it.
-  const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());
-  StartSecondaries(resume_at);
-  restart_kind_.store(restart, std::memory_order_relaxed);  // published by the release below
-  resume_at_ns_.store(resume_at, std::memory_order_release);
-  pause_requested_.store(false, std::memory_order_release);
-}
 
 std::array<double, 3> HapticLoop::StepPrimaryPeriod(
     const std::array<double, 3>& contact_m) noexcept {
@@ -302,22 +205,11 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   } else if (release_ns < resume_at_ns_.load(std::memory_order_acquire)) {
     usable = false;  // the new regions start at resume_at
   }
+  // Paused to carry the motion to new regions: the contact stays engaged on the node it was, and
+  // the force it had is held until they take over.
+  const bool holding = !usable && hold_force_while_paused_.load(std::memory_order_relaxed);
   if (usable) {
-    switch (restart_kind_.exchange(kNoRestart, std::memory_order_acq_rel)) {
-      case kRestartFromRest:
-        contact_.RestartFromRest();
-        restarted_since_fault_ = guard_.latched();
-        guard_.Reengage();
-        balance_peak_stored_j_ = 0;
-        break;
-      case kRestartKeepingContact:
-        contact_.RestartKeepingContact();
-        guard_.Reengage();
-        balance_peak_stored_j_ = 0;
-        break;
-      default:
-        break;
-    }
+    ApplyRestart(release_ns);
   } else {
     paused_periods_.fetch_add(1, std::memory_order_relaxed);
     flags |= force_flags::kReconfiguring;
@@ -326,12 +218,13 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   // Stale input holds the contact where it was; fresh input moves it. Both on the release grid,
   // not on when this thread woke: a period woken late must not hurry the tip or the engage ramp
   // (the driven node's inertia turns an uneven step into a force spike).
+  if (usable) held_centre_ = centre_;
   const std::optional<LatticeIndex> centre =
-      usable ? std::optional<LatticeIndex>(centre_) : std::nullopt;
+      usable || holding ? std::optional<LatticeIndex>(held_centre_) : std::nullopt;
   const ContactTracker::Contact contact =
       have && !stale ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
                      : contact_.Hold(release_ns, centre);
-  const bool in_contact = contact.engaged && usable;
+  const bool in_contact = contact.engaged && (usable || holding);
   if (contact.waiting) flags |= force_flags::kReconfiguring;
   contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
@@ -353,6 +246,9 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       WatchEnergyBalance();
       if (options_.sleep_at_rest) WatchForRest(contact.engaged);
     }
+    held_reaction_ = reaction;
+  } else if (holding) {
+    reaction = held_reaction_;
   }
   idle_.store(usable && sleep_state_ == kAsleep && stale, std::memory_order_relaxed);
   const bool render = in_contact && !(stale && options_.zero_force_when_stale);
@@ -382,6 +278,34 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     flags |= force_flags::kInContact;
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);
   }
+  PublishPeriod(now_ns, sent.force_n, port.simulated_n, flags);
+}
+
+void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
+  switch (restart_kind_.exchange(kNoRestart, std::memory_order_acq_rel)) {
+    case kRestartFromRest:
+      contact_.RestartFromRest();
+      restarted_since_fault_ = guard_.latched();
+      guard_.Reengage();
+      break;
+    case kRestartKeepingContact:
+      contact_.RestartKeepingContact();
+      guard_.Reengage();
+      break;
+    case kRestartCarryingMotion:
+      // The new regions hold the contact where the last period before the pause left it.
+      contact_.CatchUpFrom(regions_->primary_contact_m(),
+                           release_ns - static_cast<std::int64_t>(primary_period_ns_));
+      break;
+    default:
+      return;
+  }
+  balance_peak_stored_j_ = 0;  // the balance starts afresh with the new regions
+}
+
+void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
+                               const std::array<double, 3>& raw_force_n,
+                               std::int32_t flags) noexcept {
   ForceRecord out;
   out.period = periods_run_++;
   out.seq = last_input_.seq;
@@ -390,7 +314,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   taken_in_sequence_ = true;
   out.utime_us = now_ns / 1000;
   out.error_percent = error_percent_.load(std::memory_order_relaxed);
-  out.force_n = sent.force_n;
+  out.force_n = force_n;
   out.flags = flags;
   forces_.Push(out);
   BlackBoxRecord box;
@@ -398,7 +322,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   box.seq = out.seq;
   box.position_m = last_input_.position_m;
   box.force_n = out.force_n;
-  box.raw_force_n = port.simulated_n;
+  box.raw_force_n = raw_force_n;
   box.port_energy_j = guard_.port_energy_j();
   box.error_percent = out.error_percent;
   box.flags = flags;

@@ -80,7 +80,7 @@ inline constexpr std::int32_t kFaultLatched = 1024;
  * Contact (ContactTracker): the tool tip touching the surface picks the nearest surface node.
  * When the regions are centred on it the node follows the tip at once; otherwise the loop renders
  * zero force, flagged "reconfiguring", and publishes the node it wants (wanted_contact_node) for
- * the supervisor, which centres the regions on it (Reconfigure with keep_contact); the contact
+ * the supervisor, which centres the regions on it (Reconfigure, Handover::kRampIn); the contact
  * then engages with its force ramped in from zero. Out of contact the force is zero. After a
  * restart from rest (Start, a reset, a fault) a tip already inside the object renders nothing
  * until it has left the object once.
@@ -122,17 +122,31 @@ class HapticLoop {
   std::string Start();
   /** Stops and joins the region threads. */
   void Stop();
+  /** What a touching tool feels when new regions take over (Reconfigure). */
+  enum class Handover {
+    /** The regions start from rest; a tool inside must lift off before it feels force again
+     *  (a reset, a fault's restart). */
+    kFromRest,
+    /** From rest around a new centre: a tool inside engages again, its force ramped in from
+     *  zero (the regions moved onto the node it touches). */
+    kRampIn,
+    /** Around the same centre, from the old regions' motion (AsyncRegions::CaptureState and
+     *  RestoreState): a tool inside feels the force it felt, held for the periods the regions
+     *  are being installed, and the contact node catches up with the tip from where it was held
+     *  (ContactTracker::CatchUpFrom). A configuration switched in contact. */
+    kCarryMotion,
+  };
   /**
    * Replaces the regions by those of `scene` (another adaptive configuration of the same object,
-   * or the same one centred on another contact node), starting from rest. The regions are built
-   * while the loop runs; the primary thread then pauses them for a few periods (zero force,
-   * flagged, every input answered) and resumes on the new ones. `keep_contact`: a touching tip
-   * engages again with its force ramped in (re-centring on it); otherwise it must lift off first
-   * (a reset). Supervisor thread only.
-   * @throws Error for an invalid scene, another primary rate, or a primary thread that does not
-   *         answer within a second (the running loop is left as it was).
+   * or the same one centred on another contact node). The regions are built while the loop runs;
+   * the primary thread then pauses them for a few periods (every input answered, flagged
+   * "reconfiguring": with zero force, or with kCarryMotion the held force) and resumes on the new
+   * ones, as `handover` says. Supervisor thread only.
+   * @throws Error for an invalid scene, another primary rate, kCarryMotion around another contact
+   *         node, or a primary thread that does not answer within a second (the running loop is
+   *         left as it was).
    */
-  void Reconfigure(const Scene& scene, bool keep_contact = false);
+  void Reconfigure(const Scene& scene, Handover handover = Handover::kFromRest);
   /** The node the tool wants the regions centred on (see ContactTracker::wanted_node). */
   std::optional<LatticeIndex> wanted_contact_node() const;
   /** True while the tip is inside on a node the regions are not centred on (force zero). */
@@ -287,6 +301,11 @@ class HapticLoop {
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
   void ForgetSleep();
+  // Primary thread, the first period on new regions: the contact as Reconfigure's hand-over says.
+  void ApplyRestart(std::int64_t release_ns) noexcept;
+  // Primary thread: the period's answer to the I/O thread and its record to the black box.
+  void PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
+                     const std::array<double, 3>& raw_force_n, std::int32_t flags) noexcept;
 
   Scene scene_;
   Options options_;
@@ -324,8 +343,19 @@ class HapticLoop {
   // The handshake of a reconfiguration (supervisor ↔ primary thread).
   std::atomic<bool> pause_requested_{false}, paused_{false};
   std::atomic<std::int64_t> resume_at_ns_{0};  // new regions run from this release on
-  enum RestartKind : int { kNoRestart = 0, kRestartFromRest = 1, kRestartKeepingContact = 2 };
+  enum RestartKind : int {
+    kNoRestart = 0,
+    kRestartFromRest = 1,
+    kRestartKeepingContact = 2,
+    kRestartCarryingMotion = 3,
+  };
   std::atomic<int> restart_kind_{kNoRestart};  // what the primary does to the contact on resume
+  // Set before a pause that carries the motion: the primary renders the held force meanwhile.
+  std::atomic<bool> hold_force_while_paused_{false};
+  // Primary thread: the last period's reaction and centre, for a pause that holds the force (the
+  // regions and centre_ are the supervisor's while paused).
+  std::array<double, 3> held_reaction_{};
+  LatticeIndex held_centre_{};
 
   // Published by the primary thread for the supervisor.
   std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none

@@ -370,9 +370,9 @@ int Serve(const Arguments& args) {
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
   std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
-  std::int64_t regions_since_ns = start_ns, health_reconfigurations = 0, last_health_line_ns = 0;
+  std::int64_t regions_since_ns = start_ns, health_reconfigurations = 0;
   bool health_asleep = false;
-  std::string reported_stalls;  // the stalled threads' names as last logged and told to systemd
+  StallReport stall_report;  // the stalled threads, as last logged and told to systemd
   std::int64_t wrong_transport_seen = 0;
   CommandRateLimit command_limit, ctl_limit;  // one each: an LCM flood cannot crowd out ctl
   std::int64_t last_command_refusal_ns = 0, lcm_refusals_logged = 0;
@@ -442,7 +442,7 @@ int Serve(const Arguments& args) {
   };
   // Around the node the regions moved to, the configuration may miss the target that it met
   // where it was chosen (a box cut by the object's edge, a coarser neighbourhood): choose again
-  // for that node, once per node. What is chosen switches like any other, once the tool is away.
+  // for that node, once per node. What is chosen switches like any other.
   auto choose_for_centre_if_missed = [&] {
     const LatticeIndex& node = loop.centre_node();
     if (reported_target_met || !decision.have_map || !map.map || pinned || chooser.busy() ||
@@ -488,8 +488,11 @@ int Serve(const Arguments& args) {
                 "{}", moved.Describe());
     if (moved.moves()) {
       try {
+        // Around the same node the object's motion goes on in the new configuration (a switch in
+        // contact); onto another node the regions start from rest there and the touch ramps in.
         loop.Reconfigure(SceneWith(config.scene, moved.to.centred.configuration, moved.to.node),
-                         /*keep_contact=*/true);
+                         moved.to.node == loop.centre_node() ? HapticLoop::Handover::kCarryMotion
+                                                             : HapticLoop::Handover::kRampIn);
       } catch (const Error&) {
         mover.NotApplied(moved);  // a demotion or a move back is tried again at the next tick
         throw;
@@ -719,8 +722,9 @@ int Serve(const Arguments& args) {
           pending.reset();
         } else {
           spdlog::info(
-              "{} configuration: {}; switching when the tool has been out of contact for {} s",
-              pinned ? "pinned" : "better", chosen.reason, kSettleBeforeReconfigure_s);
+              "{} configuration: {}; switching once it is verified around the contact "
+              "node, carrying the object's motion over",
+              pinned ? "pinned" : "better", chosen.reason);
           pending = chosen;
         }
         report_error();
@@ -734,19 +738,22 @@ int Serve(const Arguments& args) {
       choose_for_centre_if_missed();  // the regions may have moved while it was being made
     }
     // Moving the regions — to the pending configuration, or onto the node the tool touches or
-    // hovers over. A new configuration only out of contact, after the object has settled: the
-    // force is zero then and the regions restart from rest, so the user feels no step. A touch on
-    // another node moves them at once (zero force, flagged, for the few periods until they are
-    // there; their coupling verified behind them), then ramps its force in; it may give up a
-    // verification still running (the regions leave that node anyway).
+    // hovers over. A new configuration around the same node switches as soon as it is verified,
+    // in contact too: the object's motion carries over and the force is held meanwhile
+    // (Handover::kCarryMotion). Onto a hovered node only after the object has settled, as the
+    // regions restart from rest there. A touch on another node moves them at once (zero force,
+    // flagged, for the few periods until they are there; their coupling verified behind them),
+    // then ramps its force in; it may give up a verification still running.
     const bool settled = (now - loop.last_contact_ns()) * 1e-9 >= kSettleBeforeReconfigure_s;
     const std::optional<LatticeIndex> wanted = loop.wanted_contact_node();
     if (wanted != hover_node) hover_node = wanted, hover_since_ns = now;
     const bool waiting = loop.contact_waiting();
     if (!mover.busy() || (waiting && mover.may_interrupt())) {
       std::optional<RegionsMover::Request> request;
-      if (pending && settled && !waiting) {
-        request = {pending->configuration, wanted.value_or(loop.centre_node()), true, false};
+      if (pending && !waiting) {
+        const LatticeIndex node =
+            settled ? wanted.value_or(loop.centre_node()) : loop.centre_node();
+        request = {pending->configuration, node, true, false};
       } else if (wanted && *wanted != loop.centre_node() &&
                  (waiting ||
                   (settled && (now - hover_since_ns) * 1e-9 >= kHoverBeforeRecentre_s))) {
@@ -772,7 +779,7 @@ int Serve(const Arguments& args) {
                            mover.may_ask({decision.configuration, *wanted, false, true});
     tick.tv_nsec = move_soon ? kTickBeforeAMove_ns : kTick_ns;
     // Deadlines before accuracy: a region that keeps missing them gets a cheaper configuration
-    // (the map's measured costs), switched like any other once the tool is away.
+    // (the map's measured costs), switched like any other.
     std::vector<double> rates_hz;
     for (int r = 0; r < loop.regions().num_regions(); ++r) {
       rates_hz.push_back(loop.regions().schedule(r).rate_hz);
@@ -846,21 +853,14 @@ int Serve(const Arguments& args) {
     // systemd restarts the daemon; a stalled secondary is rendered around (the primary holds its
     // boundary, every answer flagged boundary stale); a job that never ends is reported.
     const std::vector<Stall> stalls = StalledThreads(health_beats(now), now);
-    // Said when the set of stalled threads changes, and every 10 s while it lasts.
-    std::string stalled_names;
-    for (const Stall& stall : stalls) stalled_names += stall.name + ";";
-    if (stalled_names != reported_stalls ||
-        (!stalled_names.empty() && now - last_health_line_ns > 10'000'000'000)) {
-      const std::string stalled = DescribeStalls(stalls);
-      if (stalled.empty()) {
+    if (const std::optional<std::string> stalled = stall_report.Due(stalls, now)) {
+      if (stalled->empty()) {
         spdlog::info("health: every thread runs again");
       } else {
-        spdlog::error("health: stalled: {}{}", stalled,
+        spdlog::error("health: stalled: {}{}", *stalled,
                       AnyOnForcePath(stalls) ? "; the systemd watchdog is not pinged" : "");
       }
-      last_health_line_ns = now;
-      systemd.Notify(stalled.empty() ? "STATUS=serving" : "STATUS=stalled: " + stalled);
-      reported_stalls = stalled_names;
+      systemd.Notify(stalled->empty() ? "STATUS=serving" : "STATUS=stalled: " + *stalled);
     }
     if (systemd.watchdog_interval_s() > 0 && now >= next_watchdog_ns && !AnyOnForcePath(stalls)) {
       systemd.Notify("WATCHDOG=1");

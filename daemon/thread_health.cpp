@@ -51,4 +51,15 @@ bool AnyOnForcePath(const std::vector<Stall>& stalls) {
   return std::any_of(stalls.begin(), stalls.end(), [](const Stall& s) { return s.force_path; });
 }
 
+std::optional<std::string> StallReport::Due(const std::vector<Stall>& stalls, std::int64_t now_ns) {
+  std::string names;
+  for (const Stall& stall : stalls) names += stall.name + ";";
+  if (names == said_names_ && (names.empty() || now_ns - said_ns_ <= kRepeat_ns)) {
+    return std::nullopt;
+  }
+  said_names_ = names;
+  said_ns_ = now_ns;
+  return DescribeStalls(stalls);
+}
+
 }  // namespace hapticsim

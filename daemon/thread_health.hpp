@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,5 +48,20 @@ std::string DescribeStalls(const std::vector<Stall>& stalls);
 
 /** Whether any stall is on the force path: then the systemd watchdog is not pinged. */
 bool AnyOnForcePath(const std::vector<Stall>& stalls);
+
+/**
+ * When the stalled threads are said (the log and systemd's status line): when the set of stalled
+ * threads changes, and every 10 s while some stay stalled.
+ */
+class StallReport {
+ public:
+  /** What to say at `now_ns`: nullopt nothing, "" every thread runs again, else DescribeStalls. */
+  std::optional<std::string> Due(const std::vector<Stall>& stalls, std::int64_t now_ns);
+  static constexpr std::int64_t kRepeat_ns = 10'000'000'000;
+
+ private:
+  std::string said_names_;  // the stalled threads' names as last said
+  std::int64_t said_ns_ = 0;
+};
 
 }  // namespace hapticsim

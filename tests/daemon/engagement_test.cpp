@@ -12,6 +12,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/error.hpp"
 #include "daemon/haptic_loop.hpp"
 
 namespace hapticsim {
@@ -204,10 +205,60 @@ TEST(Engagement, NewRegionsWhileTheToolPressesRampInFromZero) {
   Scene other = DefaultScene();
   other.adaptivity.primary_size = 2;
   const Played played = Play(loop, PressTo(0.006), 3000, [&](int n) {
-    if (n == 1200) loop.Reconfigure(other, /*keep_contact=*/true);
+    if (n == 1200) loop.Reconfigure(other, HapticLoop::Handover::kRampIn);
   });
   ExpectSmooth(played, "reconfiguration in contact");
   EXPECT_LT(played.force_z.back(), -0.5);  // pressing again
+}
+
+// A configuration switched while the tool presses (hapticsimd does this as soon as a better one is
+// verified) carries the object's motion over: the force goes on as it was — no ramp from zero, no
+// step — and settles where the new configuration's own press settles.
+TEST(Engagement, AConfigurationSwitchedInContactCarriesTheForceOnWithoutAStep) {
+  const Scene first = DefaultScene();  // r 3, k 2, 1000 Hz
+  Scene second = first, third = first;
+  second.adaptivity.primary_size = 2, second.adaptivity.secondary_lod = 3;
+  second.adaptivity.secondary_rate_hz = 600;
+  third.adaptivity.primary_size = 4, third.adaptivity.secondary_rate_hz = 800;
+  HapticLoop loop(first, HapticLoop::Options{});
+  // In to 1 cm at 10 mm/s from period 50 (at 1 cm from period 1050), switched twice: while
+  // pressing in (6 mm) and while held.
+  const Played played = Play(loop, PressTo(0.01), 2500, [&](int n) {
+    if (n == 650) loop.Reconfigure(second, HapticLoop::Handover::kCarryMotion);
+    if (n == 1600) loop.Reconfigure(third, HapticLoop::Handover::kCarryMotion);
+  });
+  ASSERT_EQ(loop.reconfigurations(), 2);
+  ExpectSmooth(played, "switched in contact");
+  // The force never drops towards zero across a switch: it is carried, not ramped in again.
+  for (int n : {650, 1600}) {
+    for (int m = n - 2; m < n + 20; ++m) {
+      EXPECT_LT(played.force_z[m], 0.9 * played.force_z[n - 3])
+          << "period " << m << ": the force fell back after the switch at " << n;
+    }
+  }
+  HapticLoop alone(third, HapticLoop::Options{});
+  const double third_settles = Play(alone, PressTo(0.01), 2500).force_z.back();
+  EXPECT_NEAR(played.force_z.back(), third_settles, 0.01 * std::abs(third_settles));
+  double across = 0;  // the largest change between periods within 30 ms of a switch
+  for (int n : {650, 1600}) {
+    for (int m = n - 1; m < n + 30; ++m) {
+      across = std::max(across, std::abs(played.force_z[m] - played.force_z[m - 1]));
+    }
+  }
+  EXPECT_LE(across, 0.1);
+  std::printf(
+      "switched at 6 mm and at 1 cm: largest force change between periods %.4f N across "
+      "the switches, %.4f N over the whole press; settled at %.4f N (the last "
+      "configuration pressed alone: %.4f N)\n",
+      across, played.largest_step_n, played.force_z.back(), third_settles);
+}
+
+TEST(Engagement, TheMotionIsCarriedOnlyToRegionsAroundTheSameNode) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  Scene elsewhere = DefaultScene();
+  elsewhere.input.contact_node = LatticeIndex{3, 9, 0};
+  EXPECT_THROW(loop.Reconfigure(elsewhere, HapticLoop::Handover::kCarryMotion), Error);
+  EXPECT_EQ(loop.reconfigurations(), 0);
 }
 
 // A primary that takes substeps (a stiff, nearly incompressible material: the secondary at the

@@ -213,15 +213,43 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
             "refused: SET_ERROR_TARGET -3 refused: the target must be in (0, 100] %");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(client.LastStatus()->error_target_percent, 0.001);
-  // While the tool is in contact the configuration is not changed under the user's hand.
-  EXPECT_EQ(Ctl("set-error-target 5").rfind("ok:", 0), 0u);  // size 1 meets it, and is cheaper
-  for (std::int64_t seq = 101; seq <= 1600; ++seq) {
-    client.Send(seq, kEdge / 2, kEdge / 2, 0.001);  // in contact for 1.5 s
+  // In contact, a new target switches the configuration as soon as it is verified: the object's
+  // motion carries over, so the force goes on, neither dropped nor stepped.
+  for (std::int64_t seq = 101; seq <= 900; ++seq) {  // in to 8 mm at 10 mm/s, then held
+    client.Send(seq, kEdge / 2, kEdge / 2, std::min(0.008, 0.001 + 1e-5 * (seq - 100)));
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  EXPECT_EQ(client.LastStatus()->primary_size, 3) << "reconfigured during contact";
-  client.Send(1601, kEdge / 2, kEdge / 2, -0.002);  // lift off
-  ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.primary_size == 1; }, 10))
+  const size_t before = client.Forces().size();
+  ASSERT_GT(before, 0u);
+  EXPECT_EQ(Ctl("set-error-target 5").rfind("ok:", 0), 0u);  // size 1 meets it, and is cheaper
+  for (std::int64_t seq = 901; seq <= 2400; ++seq) {         // held at 8 mm for 1.5 s
+    client.Send(seq, kEdge / 2, kEdge / 2, 0.008);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(client.LastStatus()->primary_size, 1) << "not switched in contact\n" << daemon_->Log();
+  const auto pressed = client.Forces();
+  const double pressing_n = pressed[before - 1].force[2];
+  ASSERT_LT(pressing_n, -0.5) << "8 mm in pushes back with about 0.7 N";
+  // The force nearest to zero and farthest from it, N (z < 0 pushes back).
+  double largest_step = 0, weakest = -1e9, strongest = 0;
+  for (size_t i = before; i < pressed.size(); ++i) {
+    // After the last input the answers go stale and the force is released: not the switch's.
+    if (pressed[i].flags & force_feedback_t::FLAG_INPUT_STALE) break;
+    ASSERT_TRUE(pressed[i].flags & force_feedback_t::FLAG_IN_CONTACT) << "seq " << pressed[i].seq;
+    largest_step = std::max(largest_step, std::abs(pressed[i].force[2] - pressed[i - 1].force[2]));
+    weakest = std::max(weakest, static_cast<double>(pressed[i].force[2]));
+    strongest = std::min(strongest, static_cast<double>(pressed[i].force[2]));
+  }
+  std::printf(
+      "switched in contact at 8 mm: largest force change between periods %.4f N, force "
+      "between %.3f N and %.3f N (it pressed with %.3f N before)\n",
+      largest_step, strongest, weakest, pressing_n);
+  EXPECT_LE(largest_step, 0.1);
+  // It relaxes from the press's overshoot towards the static 0.7–0.75 N; a force dropped and
+  // ramped in again (a switch from rest) would pass near zero.
+  EXPECT_LT(weakest, -0.5) << "the force was dropped across the switch\n" << daemon_->Log();
+  EXPECT_NE(daemon_->Log().find("reconfigured: primary_size 1"), std::string::npos)
       << daemon_->Log();
 }
 

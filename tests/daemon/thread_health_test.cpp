@@ -29,5 +29,21 @@ TEST(ThreadHealth, AThreadSilentLongerThanItMayBeIsStalledUnlessItIsMeantToBeIdl
   EXPECT_EQ(StalledThreads({{"x", now - kSecond / 2 - 1000, 0.5, true, true}}, now).size(), 1u);
 }
 
+// Said when the set of stalled threads changes and every 10 s while it lasts; once when it clears.
+TEST(StallReport, SaysAChangeAtOnceARepeatEveryTenSecondsAndTheRecoveryOnce) {
+  constexpr std::int64_t kSecond = 1'000'000'000;
+  const std::vector<Stall> io{{"I/O (hsim-io)", 0.6, true}};
+  const std::vector<Stall> both{{"I/O (hsim-io)", 1.6, true}, {"secondary", 0.7, false}};
+  StallReport report;
+  EXPECT_EQ(report.Due({}, 1 * kSecond), std::nullopt) << "nothing stalled, nothing to say";
+  EXPECT_EQ(report.Due(io, 2 * kSecond), "I/O (hsim-io) (0.6 s)");
+  EXPECT_EQ(report.Due(io, 3 * kSecond), std::nullopt);
+  EXPECT_EQ(report.Due(both, 4 * kSecond), "I/O (hsim-io) (1.6 s), secondary (0.7 s)");
+  EXPECT_EQ(report.Due(both, 14 * kSecond), std::nullopt) << "10 s is not yet more than 10 s";
+  EXPECT_TRUE(report.Due(both, 14 * kSecond + 1).has_value());
+  EXPECT_EQ(report.Due({}, 15 * kSecond), "") << "every thread runs again: said once";
+  EXPECT_EQ(report.Due({}, 30 * kSecond), std::nullopt);
+}
+
 }  // namespace
 }  // namespace hapticsim

@@ -1,0 +1,101 @@
+// Replacing the regions while hapticsimd's loop runs (HapticLoop::Reconfigure): the hand-over
+// between the supervisor, which builds and installs the new regions, and the primary thread,
+// which answers every period meanwhile.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "core/error.hpp"
+#include "core/monotonic_clock.hpp"
+#include "daemon/futex.hpp"
+#include "daemon/haptic_loop.hpp"
+
+namespace hapticsim {
+
+void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions) {
+  scene_ = scene;
+  regions_ = std::move(regions);
+  centre_ = ContactNode(scene);
+  const int count = regions_->num_regions();
+  tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
+  auto nominal_ns = [&](int a) {
+    return static_cast<double>(regions_->period_ticks(a) * regions_->schedule(a).substeps) *
+           tick_ns_;
+  };
+  if (monitors_.empty()) {  // the primary's period is fixed for the loop's life
+    primary_period_ns_ = nominal_ns(kPrimaryRegion);
+    monitors_.push_back(std::make_unique<DeadlineMonitor>(primary_period_ns_ * 1e-9));
+  }
+  std::vector<std::unique_ptr<DeadlineMonitor>> replaced(
+      std::make_move_iterator(monitors_.begin() + 1), std::make_move_iterator(monitors_.end()));
+  monitors_.resize(1);
+  lead_ns_.assign(static_cast<size_t>(count), 0);
+  for (int a = 1; a < count; ++a) {
+    monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal_ns(a) * 1e-9));
+    // The a-th secondary thread's statistics run on across reconfigurations.
+    if (a - 1 < static_cast<int>(replaced.size())) monitors_.back()->CarryOver(*replaced[a - 1]);
+    // Each coarser region is released ahead of the finer one by 1.25 of the finer's period, so
+    // its boundary is published before the finer region needs it (as in RealTimeSchedule).
+    lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ns(a - 1));
+  }
+}
+
+std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
+  const double periods = std::ceil((not_before_ns - origin_ns_) / primary_period_ns_);
+  return origin_ns_ + std::llround(periods * primary_period_ns_);
+}
+
+void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
+  auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
+  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || scene.mesh.nodes != nodes_ ||
+      scene.mesh.edge_m != scene_.mesh.edge_m) {
+    throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
+  }
+  const bool carry = handover == Handover::kCarryMotion;
+  if (carry && ContactNode(scene) != centre_) {
+    throw Error("the motion can be carried only to regions around the same contact node");
+  }
+  ++reconfigurations_;
+  const RestartKind restart = carry                           ? kRestartCarryingMotion
+                              : handover == Handover::kRampIn ? kRestartKeepingContact
+                                                              : kRestartFromRest;
+  if (!running_.load()) {
+    if (carry) regions->RestoreState(regions_->CaptureState());
+    restart_kind_.store(restart);
+    ForgetSleep();
+    Install(scene, std::move(regions));
+    return;
+  }
+  hold_force_while_paused_.store(carry, std::memory_order_relaxed);  // published by the request
+  paused_.store(false);
+  pause_requested_.store(true, std::memory_order_release);
+  // An idle primary waiting for input comes round now (the count moves, so a primary about to
+  // wait does not wait either).
+  input_arrivals_.fetch_add(1);
+  FutexWakeAll(&input_arrivals_);
+  // The primary acknowledges at its next release; after that it does not touch the regions.
+  const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
+  while (!paused_.load(std::memory_order_acquire)) {
+    if (NowNs() > give_up_ns) {
+      // A primary thread that does not come round in a second is hung: joining it would hang the
+      // supervisor too. Leave everything as it is; the watchdog stops getting pings.
+      pause_requested_.store(false, std::memory_order_release);
+      throw Error("the primary thread did not answer within 1 s: regions not replaced");
+    }
+    SleepUntilMonotonicNs(NowNs() + 100'000);
+  }
+  StopSecondaries();
+  // Nothing steps the old regions now: their motion is the new ones' start.
+  if (carry) regions->RestoreState(regions_->CaptureState());
+  ForgetSleep();
+  Install(scene, std::move(regions));
+  // The new regions start (from rest, or from the carried motion) on the primary's own release
+  // grid, late enough for the secondaries to be released ahead of it.
+  const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());
+  StartSecondaries(resume_at);
+  restart_kind_.store(restart, std::memory_order_relaxed);  // published by the release below
+  resume_at_ns_.store(resume_at, std::memory_order_release);
+  pause_requested_.store(false, std::memory_order_release);
+}
+
+}  // namespace hapticsim
