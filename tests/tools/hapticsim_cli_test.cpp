@@ -21,9 +21,8 @@ std::string Temp(const std::string& name) { return ::testing::TempDir() + name; 
 TEST(HapticsimCli, HelpListsTheSubcommands) {
   const CommandResult result = Hapticsim({"--help"});
   EXPECT_EQ(result.exit_status, 0);
-  for (const char* sub :
-       {"simulate", "static", "stability", "scene", "sweep", "map", "lookup", "analyze", "device",
-        "soak", "log", "stress", "bench"}) {
+  for (const char* sub : {"simulate", "static", "stability", "scene", "sweep", "map", "lookup",
+                          "analyze", "device", "soak", "log", "stress", "bench"}) {
     EXPECT_NE(result.out.find(sub), std::string::npos) << sub;
   }
 }
@@ -125,36 +124,50 @@ TEST(HapticsimCli, AdaptiveSimulateComparesWithTheReference) {
   EXPECT_TRUE(error.contains("max_direction_deg"));
 }
 
-TEST(HapticsimCli, AdaptiveStabilityReportsEachRegionAndTheCoupledVerdict) {
+TEST(HapticsimCli, AdaptiveStabilityReportsEachRegionsOwnLimitAndEstimatesOnlyWhenAsked) {
+  const auto alone = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
+  EXPECT_EQ(alone["regions_stable_alone"], true);
+  EXPECT_EQ(alone["coupled_estimated"], false);
+  EXPECT_FALSE(alone.contains("coupled_spectral_radius"));
+  ASSERT_EQ(alone["regions"].size(), 2u);
+  // Each region's step is within its own limit: what its substeps are for.
+  for (const auto& region : alone["regions"]) {
+    EXPECT_LE(region["step_s"].get<double>(), region["critical_dt_s"].get<double>());
+  }
+  const std::string text = Hapticsim({"stability", "--set", "adaptivity.primary_size=2"}).out;
+  EXPECT_NE(text.find("add --estimate"), std::string::npos) << text;
+}
+
+TEST(HapticsimCli, AdaptiveStabilityEstimateReportsEachRegionAndTheCoupledVerdict) {
   const auto stable =
-      Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
+      Json(Hapticsim({"stability", "--json", "--estimate", "--set", "adaptivity.primary_size=2"}));
   EXPECT_EQ(stable["stable"], true);
+  EXPECT_EQ(stable["coupled_estimated"], true);
   EXPECT_LT(stable["coupled_spectral_radius"].get<double>(), 1.0);
   ASSERT_EQ(stable["regions"].size(), 2u);
   EXPECT_GT(stable["regions"][1]["critical_dt_s"].get<double>(), 0.0);
 
   // ν = 0.49 at 700 Hz: the bare lagged exchange grows (1.47 per 10 ms), as run it decays.
   const auto unstable =
-      Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2", "--set",
-                      "adaptivity.secondary_lod=1", "--set", "adaptivity.secondary_rate=700",
-                      "--set", "material.poisson_ratio=0.49"}));
+      Json(Hapticsim({"stability", "--json", "--estimate", "--set", "adaptivity.primary_size=2",
+                      "--set", "adaptivity.secondary_lod=1", "--set",
+                      "adaptivity.secondary_rate=700", "--set", "material.poisson_ratio=0.49"}));
   EXPECT_EQ(unstable["stable"], false);
   EXPECT_GT(unstable["coupled_spectral_radius"].get<double>(), 1.0);
   EXPECT_LT(unstable["controlled_spectral_radius"].get<double>(), 1.0);
 }
 
 TEST(HapticsimCli, AdaptiveSimulateRunsWhatTheBareExchangeCannotHoldAndReportsTheEnergy) {
-  const auto result = Hapticsim(
-      {"simulate", "--json", "--set", "adaptivity.primary_size=2", "--set",
-       "adaptivity.secondary_lod=1", "--set", "adaptivity.secondary_rate=700", "--set",
-       "material.poisson_ratio=0.49"});
+  const auto result =
+      Hapticsim({"simulate", "--json", "--set", "adaptivity.primary_size=2", "--set",
+                 "adaptivity.secondary_lod=1", "--set", "adaptivity.secondary_rate=700", "--set",
+                 "material.poisson_ratio=0.49"});
   ASSERT_EQ(result.exit_status, 0) << result.out << result.err;
   const auto json = Json(result);
   EXPECT_EQ(json["outcome"], "completed");
   EXPECT_EQ(json["predicted_stable"], false);  // the bare exchange: what hapticsimd verifies
   EXPECT_GT(json["energy_J"]["interface_dissipated"].get<double>(), 0.0);
-  EXPECT_LT(json["energy_J"]["stored"].get<double>(),
-            json["energy_J"]["input_work"].get<double>());
+  EXPECT_LT(json["energy_J"]["stored"].get<double>(), json["energy_J"]["input_work"].get<double>());
   EXPECT_LT(json["peak_force_N"].get<double>(), 3.0);  // the reference's: 2.0 N
 }
 
