@@ -645,10 +645,10 @@ double AsyncRegions::KineticEnergy() const noexcept {
   double kinetic = 0;
   const Eigen::VectorXd& m = partition_.dof_mass();
   for (const auto& region : regions_) {
-    const Eigen::VectorXd& u = region->integrator->u();
-    const Eigen::VectorXd& up = region->integrator->u_previous();
-    const double h = region->integrator->substep();
-    for (int i : region->dofs->owned) kinetic += m[i] * (u[i] - up[i]) * (u[i] - up[i]) / (h * h);
+    const Eigen::VectorXd &u = region->integrator->u(), &up = region->integrator->u_previous();
+    double sum = 0;  // Σ m (u − u⁻)², divided by h² once per region
+    for (int i : region->dofs->owned) sum += m[i] * (u[i] - up[i]) * (u[i] - up[i]);
+    kinetic += sum / std::pow(region->integrator->substep(), 2);
   }
   return 0.5 * kinetic;
 }

@@ -22,6 +22,17 @@ ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material&
       if (touched[r]) touched_dofs_.push_back(mesh.Dof(r, c));
     }
   }
+  direct_nodes_.reserve(element_ids_.size());
+  for (int id : element_ids_) {
+    std::array<int, 8> direct{};
+    for (int local = 0; local < 8 && direct[0] >= 0; ++local) {
+      const auto [begin, end] = mesh.Gather(mesh.elements()[id].nodes[local]);
+      const bool plain = end - begin == 1 && begin->weight == 1.0;
+      direct[local] = begin->independent;
+      if (!plain) direct[0] = -1;
+    }
+    direct_nodes_.push_back(direct);
+  }
 }
 
 void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
@@ -30,22 +41,35 @@ void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
   const int nr = mesh_.num_independent();
   const double h = mesh_.options().spacing_m;
   Eigen::Matrix<double, 24, 1> ue, fe;
-  for (int id : element_ids_) {
-    const HybridElement& e = mesh_.elements()[id];
-    for (int local = 0; local < 8; ++local) {
-      const auto [begin, end] = mesh_.Gather(e.nodes[local]);
-      double x = 0, y = 0, z = 0;
-      for (auto* g = begin; g != end; ++g) {
-        x += g->weight * u[g->independent];
-        y += g->weight * u[nr + g->independent];
-        z += g->weight * u[2 * nr + g->independent];
+  for (size_t k = 0; k < element_ids_.size(); ++k) {
+    const HybridElement& e = mesh_.elements()[element_ids_[k]];
+    const std::array<int, 8>& direct = direct_nodes_[k];
+    if (direct[0] >= 0) {  // no hanging node: each node is one independent node
+      for (int local = 0; local < 8; ++local) {
+        for (int c = 0; c < 3; ++c) ue[3 * local + c] = u[c * nr + direct[local]];
       }
-      ue[3 * local] = x;
-      ue[3 * local + 1] = y;
-      ue[3 * local + 2] = z;
+    } else {
+      for (int local = 0; local < 8; ++local) {
+        const auto [begin, end] = mesh_.Gather(e.nodes[local]);
+        double x = 0, y = 0, z = 0;
+        for (auto* g = begin; g != end; ++g) {
+          x += g->weight * u[g->independent];
+          y += g->weight * u[nr + g->independent];
+          z += g->weight * u[2 * nr + g->independent];
+        }
+        ue[3 * local] = x;
+        ue[3 * local + 1] = y;
+        ue[3 * local + 2] = z;
+      }
     }
-    fe.noalias() = unit_stiffness_ * ue;
+    fe.noalias() = unit_stiffness_.lazyProduct(ue);  // fixed 24 × 24: no general gemv call
     fe *= e.size_factor * h;
+    if (direct[0] >= 0) {
+      for (int local = 0; local < 8; ++local) {
+        for (int c = 0; c < 3; ++c) ku[c * nr + direct[local]] += fe[3 * local + c];
+      }
+      continue;
+    }
     for (int local = 0; local < 8; ++local) {
       const auto [begin, end] = mesh_.Gather(e.nodes[local]);
       for (auto* g = begin; g != end; ++g) {

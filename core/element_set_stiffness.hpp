@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "core/hex8_element.hpp"
@@ -33,6 +34,10 @@ class ElementSetStiffness final : public StiffnessOperator {
   std::vector<int> element_ids_;
   Hex8Element::Matrix24 unit_stiffness_;  // λA + μB (stiffness per metre of edge)
   std::vector<int> touched_dofs_;
+  // Per element (in element_ids_ order), its 8 nodes' independent indices when none of them is
+  // hanging (every gather one term of weight 1: most coarse cells), else −1 in the first: then
+  // Apply goes through the mesh's gathers.
+  std::vector<std::array<int, 8>> direct_nodes_;
 };
 
 }  // namespace hapticsim
