@@ -190,7 +190,11 @@ void ContactTracker::CatchUpFrom(const std::array<double, 3>& held_m,
   // one it had (velocity_: the tip's, which it followed until the hold).
   displacement_ = held_m;
   last_ns_ = held_at_ns;
-  StartRamp(held_m, velocity_, kCatchUp_ns, held_at_ns);
+  // A ramp under way (an engagement, input back after a gap) keeps what is left of it: cut to
+  // kCatchUp_ns it would bring the force in several times faster than it was meant to.
+  std::int64_t duration = kCatchUp_ns;
+  if (ramping_) duration = std::max(duration, ramp_start_ns_ + ramp_duration_ns_ - held_at_ns);
+  StartRamp(held_m, velocity_, duration, held_at_ns);
 }
 
 }  // namespace hapticsim

@@ -63,8 +63,9 @@ class ContactTracker {
   /**
    * New regions took over with the old ones' motion, the contact node where the last regions
    * held it (`held_m`, at `held_at_ns`) while the tip went on: an engaged contact goes on from
-   * there at the velocity it had and catches up with the tip over kCatchUp_ns (a smoothstep, as
-   * after a jump), so neither the node's position nor its velocity steps.
+   * there at the velocity it had and catches up with the tip over kCatchUp_ns, or what is left
+   * of a ramp under way if longer (a smoothstep, as after a jump), so neither the node's position
+   * nor its velocity steps.
    */
   void CatchUpFrom(const std::array<double, 3>& held_m, std::int64_t held_at_ns) noexcept;
 

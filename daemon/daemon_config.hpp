@@ -38,10 +38,10 @@ struct DaemonConfig {
   std::string control_socket = "/run/hapticsim/control.sock";
   std::string control_group;  ///< who may send commands besides root and the daemon's user
   // [shm]
-  bool shm_enabled = false;             ///< the shared-memory interface for a local driver
+  bool shm_enabled = false;  ///< the shared-memory interface for a local driver
   /// The service socket a driver connects to for its segment (ipc/service_socket.hpp)
   std::string shm_socket = "/run/hapticsim/hapticsimd.sock";
-  std::string shm_group;                ///< group the driver runs in (empty: the daemon's own)
+  std::string shm_group;  ///< group the driver runs in (empty: the daemon's own)
   // [supervisor]
   std::string error_map;              ///< map file (empty: none; the error is reported as -1)
   double error_target_percent = 7.0;  ///< the force-magnitude JND

@@ -88,84 +88,6 @@ std::int64_t HapticLoop::primary_alive_ns() const {
                   alive_ns_.load(std::memory_order_relaxed));
 }
 
-void HapticLoop::ForgetSleep() {
-  park_secondaries_.store(false);
-  watch_.store(0);
-  for (auto& parked : parked_) parked.store(false);
-  wake_origin_ns_.store(-1);
-  sleep_state_ = kAwake;
-  asleep_.store(false);
-  idle_.store(false);
-}
-
-bool HapticLoop::SecondaryMayStep(RegionIndex region) noexcept {
-  if (park_secondaries_.load(std::memory_order_acquire)) {
-    parked_[region].store(true, std::memory_order_release);  // publishes its last step's writes
-    return false;
-  }
-  const std::uint32_t watch = watch_.load(std::memory_order_acquire);
-  if (watch != 0 && regions_->RegionAtRest(region, kRestTolerance_m)) {
-    at_rest_in_watch_[region].store(watch, std::memory_order_release);
-  }
-  return true;
-}
-
-void HapticLoop::WatchForRest(bool touched) noexcept {
-  const int secondaries = regions_->num_regions() - 1;
-  if (sleep_state_ == kAwake) {
-    if (touched) {
-      watch_.store(0, std::memory_order_relaxed);
-      return;
-    }
-    const std::uint32_t watch = watch_.load(std::memory_order_relaxed);
-    if (watch == 0) {
-      watches_ = watches_ == UINT32_MAX ? 1 : watches_ + 1;
-      watch_.store(watches_, std::memory_order_release);
-      return;
-    }
-    if (!regions_->RegionAtRest(kPrimaryRegion, kRestTolerance_m)) return;
-    for (int a = 1; a <= secondaries; ++a) {
-      if (at_rest_in_watch_[a].load(std::memory_order_acquire) != watch) return;
-    }
-    park_secondaries_.store(true, std::memory_order_release);
-    sleep_state_ = kParking;
-  }
-  if (sleep_state_ == kParking) {
-    for (int a = 1; a <= secondaries; ++a) {
-      if (!parked_[a].load(std::memory_order_acquire)) return;
-    }
-    watch_.store(0, std::memory_order_relaxed);
-    // Every region is parked, so their states can be read here: the tool may have touched and
-    // left while they were parking (the primary stepped on meanwhile), and that deformation must
-    // not be thrown away.
-    bool at_rest = !touched;
-    for (int a = 0; a <= secondaries && at_rest; ++a) {
-      at_rest = regions_->RegionAtRest(a, kRestTolerance_m);
-    }
-    if (!at_rest) {
-      WakeSecondaries(-1);  // they carry on where they were
-      return;
-    }
-    // Nothing steps any region now: rest exactly, at time 0 of a schedule that starts on waking.
-    regions_->Reset();
-    balance_peak_stored_j_ = 0;  // they start again from rest
-    interface_backlog_j_.store(0, std::memory_order_relaxed);
-    sleep_state_ = kAsleep;
-    asleep_.store(true, std::memory_order_relaxed);
-    sleeps_.fetch_add(1, std::memory_order_relaxed);
-  }
-}
-
-void HapticLoop::WakeSecondaries(std::int64_t origin_ns) noexcept {
-  wake_origin_ns_.store(origin_ns, std::memory_order_relaxed);
-  for (auto& parked : parked_) parked.store(false, std::memory_order_relaxed);
-  park_secondaries_.store(false, std::memory_order_relaxed);
-  wake_generation_.fetch_add(1, std::memory_order_release);  // publishes the stores above
-  FutexWakeAll(&wake_generation_);
-  sleep_state_ = kAwake;
-  asleep_.store(false, std::memory_order_relaxed);
-}
-
 void HapticLoop::WaitForInput() noexcept {
   primary_waiting_.store(true);
   // An input offered since the period read the slot, a reconfiguration or a stop: no wait.
@@ -197,18 +119,11 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   }
   if (last_input_.latest_rejected) flags |= force_flags::kInputRejected;
 
-  // The regions are ours this period unless a reconfiguration has paused them.
-  bool usable = true;
-  if (pause_requested_.load(std::memory_order_acquire)) {
-    paused_.store(true, std::memory_order_release);
-    usable = false;
-  } else if (release_ns < resume_at_ns_.load(std::memory_order_acquire)) {
-    usable = false;  // the new regions start at resume_at
-  }
-  // Paused to carry the motion to new regions: the contact stays engaged on the node it was, and
-  // the force it had is held until they take over.
-  const bool holding = !usable && hold_force_while_paused_.load(std::memory_order_relaxed);
+  const bool usable = RegionsAreOurs(release_ns);
+  const bool holding =
+      !usable && holding_ && held_periods_++ * primary_period_ns_ < kMaxHold_s * 1e9;
   if (usable) {
+    holding_ = false;
     ApplyRestart(release_ns);
   } else {
     paused_periods_.fetch_add(1, std::memory_order_relaxed);
@@ -225,6 +140,8 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
       have && !stale ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
                      : contact_.Hold(release_ns, centre);
   const bool in_contact = contact.engaged && (usable || holding);
+  if (usable) engaged_ = in_contact;
+  if (!contact.engaged) holding_ = false;  // lifted off while held: a new touch is not held
   if (contact.waiting) flags |= force_flags::kReconfiguring;
   contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
@@ -279,6 +196,20 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     last_contact_ns_.store(now_ns, std::memory_order_relaxed);
   }
   PublishPeriod(now_ns, sent.force_n, port.simulated_n, flags);
+}
+
+bool HapticLoop::RegionsAreOurs(std::int64_t release_ns) noexcept {
+  if (pause_requested_.load(std::memory_order_acquire)) {
+    // Paused to carry the motion to new regions, a contact engaged until now keeps its node and
+    // the force it had, until they take over (at most kMaxHold_s); any other contact gets none.
+    if (!paused_.load(std::memory_order_relaxed)) {
+      holding_ = hold_force_while_paused_.load(std::memory_order_relaxed) && engaged_;
+      held_periods_ = 0;
+    }
+    paused_.store(true, std::memory_order_release);
+    return false;
+  }
+  return release_ns >= resume_at_ns_.load(std::memory_order_acquire);  // new regions start there
 }
 
 void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {

@@ -93,9 +93,10 @@ inline constexpr std::int32_t kFaultLatched = 1024;
  * arrives (OfferInput wakes it) and rejoins its release grid. See docs/operations.md.
  *
  * Reconfiguration is gapless: the primary thread never stops. It pauses the regions (answers
- * every period with zero force, flagged "reconfiguring") while the supervisor joins the old
- * secondary threads, installs the new regions and starts their threads, and resumes them on its
- * own release grid, so every input still gets its answer.
+ * every period, flagged "reconfiguring": with zero force, or — carrying the motion to a new
+ * configuration on the same node — with the force a contact engaged until then had) while the
+ * supervisor joins the old secondary threads, installs the new regions and starts their threads,
+ * and resumes them on its own release grid, so every input still gets its answer.
  */
 class HapticLoop {
  public:
@@ -259,6 +260,12 @@ class HapticLoop {
    * any device's resolution.
    */
   static constexpr double kRestTolerance_m = 1e-7;
+  /**
+   * The longest a force is held while new regions are installed (Handover::kCarryMotion); a
+   * supervisor held up longer (a secondary thread slow to join) gets the force released at the
+   * engage rate meanwhile: a force without stiffness behind it is not held for long.
+   */
+  static constexpr double kMaxHold_s = 0.05;
   /** An idle primary thread comes round at least this often (stop, reconfiguration, watchdog). */
   static constexpr double kIdleWait_s = 0.02;
 
@@ -301,6 +308,9 @@ class HapticLoop {
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
   void ForgetSleep();
+  // Primary thread: whether the regions are this period's (not paused by a reconfiguration, not
+  // before new ones start); a pause's first period decides whether it holds the force.
+  bool RegionsAreOurs(std::int64_t release_ns) noexcept;
   // Primary thread, the first period on new regions: the contact as Reconfigure's hand-over says.
   void ApplyRestart(std::int64_t release_ns) noexcept;
   // Primary thread: the period's answer to the I/O thread and its record to the black box.
@@ -353,9 +363,13 @@ class HapticLoop {
   // Set before a pause that carries the motion: the primary renders the held force meanwhile.
   std::atomic<bool> hold_force_while_paused_{false};
   // Primary thread: the last period's reaction and centre, for a pause that holds the force (the
-  // regions and centre_ are the supervisor's while paused).
+  // regions and centre_ are the supervisor's while paused); whether this pause holds it (latched
+  // at its first period), for how many periods so far, and whether the last period on the
+  // regions was in contact.
   std::array<double, 3> held_reaction_{};
   LatticeIndex held_centre_{};
+  bool holding_ = false, engaged_ = false;
+  std::int64_t held_periods_ = 0;
 
   // Published by the primary thread for the supervisor.
   std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none

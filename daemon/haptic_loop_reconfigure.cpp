@@ -56,17 +56,26 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     throw Error("the motion can be carried only to regions around the same contact node");
   }
   ++reconfigurations_;
-  const RestartKind restart = carry                           ? kRestartCarryingMotion
-                              : handover == Handover::kRampIn ? kRestartKeepingContact
-                                                              : kRestartFromRest;
+  RestartKind restart = carry                           ? kRestartCarryingMotion
+                        : handover == Handover::kRampIn ? kRestartKeepingContact
+                                                        : kRestartFromRest;
+  // The last reconfiguration's restart, if the primary has not applied it yet (its regions not yet
+  // resumed), is not undone by a milder one: a reset stays a reset (a fault re-arms only after
+  // it), a ramp-in stays a ramp-in. (Applied meanwhile, this only makes the restart stricter.)
+  const int unapplied = restart_kind_.load(std::memory_order_acquire);
+  if (unapplied == kRestartFromRest ||
+      (unapplied == kRestartKeepingContact && restart == kRestartCarryingMotion)) {
+    restart = static_cast<RestartKind>(unapplied);
+  }
+  const bool carrying = restart == kRestartCarryingMotion;
   if (!running_.load()) {
-    if (carry) regions->RestoreState(regions_->CaptureState());
+    if (carrying) regions->RestoreState(regions_->CaptureState());
     restart_kind_.store(restart);
     ForgetSleep();
     Install(scene, std::move(regions));
     return;
   }
-  hold_force_while_paused_.store(carry, std::memory_order_relaxed);  // published by the request
+  hold_force_while_paused_.store(carrying, std::memory_order_relaxed);  // published by the request
   paused_.store(false);
   pause_requested_.store(true, std::memory_order_release);
   // An idle primary waiting for input comes round now (the count moves, so a primary about to
@@ -86,7 +95,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   }
   StopSecondaries();
   // Nothing steps the old regions now: their motion is the new ones' start.
-  if (carry) regions->RestoreState(regions_->CaptureState());
+  if (carrying) regions->RestoreState(regions_->CaptureState());
   ForgetSleep();
   Install(scene, std::move(regions));
   // The new regions start (from rest, or from the carried motion) on the primary's own release

@@ -488,11 +488,10 @@ int Serve(const Arguments& args) {
                 "{}", moved.Describe());
     if (moved.moves()) {
       try {
-        // Around the same node the object's motion goes on in the new configuration (a switch in
-        // contact); onto another node the regions start from rest there and the touch ramps in.
         loop.Reconfigure(SceneWith(config.scene, moved.to.centred.configuration, moved.to.node),
-                         moved.to.node == loop.centre_node() ? HapticLoop::Handover::kCarryMotion
-                                                             : HapticLoop::Handover::kRampIn);
+                         moved.CarriesMotionFrom(loop.centre_node())
+                             ? HapticLoop::Handover::kCarryMotion
+                             : HapticLoop::Handover::kRampIn);
       } catch (const Error&) {
         mover.NotApplied(moved);  // a demotion or a move back is tried again at the next tick
         throw;
@@ -748,12 +747,13 @@ int Serve(const Arguments& args) {
     const std::optional<LatticeIndex> wanted = loop.wanted_contact_node();
     if (wanted != hover_node) hover_node = wanted, hover_since_ns = now;
     const bool waiting = loop.contact_waiting();
+    // Where a pending configuration goes: a hovered node once the object has settled, else here.
+    const LatticeIndex pending_node =
+        settled ? wanted.value_or(loop.centre_node()) : loop.centre_node();
     if (!mover.busy() || (waiting && mover.may_interrupt())) {
       std::optional<RegionsMover::Request> request;
       if (pending && !waiting) {
-        const LatticeIndex node =
-            settled ? wanted.value_or(loop.centre_node()) : loop.centre_node();
-        request = {pending->configuration, node, true, false};
+        request = {pending->configuration, pending_node, true, false};
       } else if (wanted && *wanted != loop.centre_node() &&
                  (waiting ||
                   (settled && (now - hover_since_ns) * 1e-9 >= kHoverBeforeRecentre_s))) {
@@ -767,8 +767,7 @@ int Serve(const Arguments& args) {
       }
     } catch (const Error& e) {
       spdlog::error("moving the regions failed: {}; they stay where they are", e.what());
-      if (pending &&
-          !mover.may_ask({pending->configuration, wanted.value_or(loop.centre_node()), true})) {
+      if (pending && !mover.may_ask({pending->configuration, pending_node, true})) {
         pending.reset();  // refused around this node: not asked again
       }
       report_error();

@@ -59,6 +59,15 @@ class RegionsMover {
     double elapsed_ms = 0;  ///< from the request to this outcome
     std::string why_not;    ///< kMoveBack: why the node was refused
     bool moves() const { return kind != Kind::kConfirmed; }
+    /**
+     * Whether the new regions start from the object's motion (HapticLoop::Handover::
+     * kCarryMotion, a switch in contact): a verified configuration on the node they are centred
+     * on now. Onto another node, or demoted or moved back from a configuration found unstable
+     * (whose motion is not to be kept), they start from rest, a touch ramped in.
+     */
+    bool CarriesMotionFrom(const LatticeIndex& centre) const {
+      return kind == Kind::kMoveVerified && to.node == centre;
+    }
     /** The log line that says what happened. */
     std::string Describe() const;
   };

@@ -18,9 +18,9 @@ constexpr int kAcceptsPerPoll = 4;
 }  // namespace
 
 ShmServer::ShmServer(const std::string& socket_path, const std::string& group,
-                     const MeshSettings& mesh, double workspace_margin_m,
-                     double max_speed_m_per_s, double max_log_lines_per_s, HapticLoop& loop,
-                     InputCounters& counters, bool owns_input)
+                     const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s,
+                     double max_log_lines_per_s, HapticLoop& loop, InputCounters& counters,
+                     bool owns_input)
     : listener_(socket_path, group),
       intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input),
       counters_(counters),

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -136,6 +137,88 @@ TEST(StateTransfer, KeepsWhatTheFineLatticeHoldsAndInterpolatesTheCoarseCells) {
   EXPECT_LT(largest_velocity, 1e-13);
 }
 
+// The value at lattice point p of the field the coarse elements interpolate from `at_nodes` (one
+// value per independent node): found independently of the transfer's own cell arithmetic, by
+// looking for a coarse element whose box holds p and evaluating its trilinear shape functions.
+double ElementField(const HybridMesh& mesh, const std::vector<double>& at_nodes,
+                    const std::array<int, 3>& p) {
+  for (const HybridElement& e : mesh.elements()) {
+    if (e.size_factor == 1) continue;
+    std::array<int, 3> lo{1 << 30, 1 << 30, 1 << 30};
+    std::array<int, 8> corner{};
+    for (int local = 0; local < 8; ++local) {
+      const auto [begin, end] = mesh.Gather(e.nodes[local]);
+      corner[local] = begin->independent;  // a coarse element's vertices are independent
+      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], mesh.LatticeOf(begin->independent)[d]);
+    }
+    bool inside = true;
+    for (int d = 0; d < 3; ++d) inside = inside && p[d] >= lo[d] && p[d] <= lo[d] + e.size_factor;
+    if (!inside) continue;
+    double value = 0;
+    for (int local = 0; local < 8; ++local) {
+      const std::array<int, 3>& q = mesh.LatticeOf(corner[local]);
+      double weight = 1;
+      for (int d = 0; d < 3; ++d) {
+        const double t = static_cast<double>(p[d] - lo[d]) / e.size_factor;
+        weight *= q[d] == lo[d] ? 1 - t : t;
+      }
+      value += weight * at_nodes[corner[local]];
+    }
+    return value;
+  }
+  ADD_FAILURE() << "no coarse element holds lattice point " << p[0] << ", " << p[1] << ", " << p[2];
+  return 0;
+}
+
+TEST(StateTransfer, ALatticePointBetweenCoarseNodesTakesItsElementsField) {
+  // A random state restored into a coarse configuration (each of its nodes takes its lattice
+  // point's value) and captured again: every lattice point that is a node keeps its value, every
+  // other one (inside a coarse cell, or a hanging node on its face) gets what the element around
+  // it interpolates — including the cells at the object's far faces.
+  const Scene coarse = testing::AdaptiveScene(2, 3, 600);
+  AsyncRegions regions(coarse);
+  const HybridMesh& mesh = regions.partition().mesh();
+  const int n = coarse.mesh.nodes;
+  ObjectState random;
+  random.nodes_per_axis = n;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
+  random.displacement_m.resize(static_cast<size_t>(3 * n * n * n));
+  for (double& x : random.displacement_m) x = uniform(rng);
+  random.velocity_m_per_s = random.displacement_m;
+  // The supports stay fixed whatever the state says: zero there, as the regions keep them.
+  for (const LatticeIndex& support : CubeSupportNodes(coarse.mesh)) {
+    const size_t i = random.Index(support[0], support[1], support[2]);
+    for (int c = 0; c < 3; ++c) random.displacement_m[i + c] = random.velocity_m_per_s[i + c] = 0;
+  }
+  regions.RestoreState(random);
+  const ObjectState back = regions.CaptureState();
+  std::vector<double> at_nodes(static_cast<size_t>(mesh.num_independent()));
+  int interpolated = 0;
+  double largest = 0;
+  for (int c = 0; c < 3; ++c) {
+    for (int node = 0; node < mesh.num_independent(); ++node) {
+      const std::array<int, 3>& q = mesh.LatticeOf(node);
+      at_nodes[node] = random.displacement_m[random.Index(q[0], q[1], q[2]) + c];
+    }
+    for (int ix = 0; ix < n; ++ix) {
+      for (int iy = 0; iy < n; ++iy) {
+        for (int iz = 0; iz < n; ++iz) {
+          const size_t i = back.Index(ix, iy, iz) + c;
+          double expected = random.displacement_m[i];
+          if (mesh.IndependentAt(ix, iy, iz) < 0) {
+            expected = ElementField(mesh, at_nodes, {ix, iy, iz});
+            ++interpolated;
+          }
+          largest = std::max(largest, std::abs(back.displacement_m[i] - expected));
+        }
+      }
+    }
+  }
+  EXPECT_GT(interpolated, 3 * 1000) << "the case is about points between coarse nodes";
+  EXPECT_LT(largest, 1e-15);
+}
+
 TEST(StateTransfer, RefusesAStateOfAnotherLattice) {
   AsyncRegions regions(testing::AdaptiveScene(2, 2, 600));
   ObjectState other;
@@ -173,7 +256,8 @@ TEST(StateTransfer, ASwitchBetweenMultirateConfigurationsInThePressDoesNotStepTh
           from.adaptivity.primary_size, from.adaptivity.secondary_lod,
           from.adaptivity.secondary_rate_hz, to.adaptivity.primary_size,
           to.adaptivity.secondary_lod, to.adaptivity.secondary_rate_hz, switch_at, step, natural);
-      EXPECT_LE(step, 0.1) << "switched at " << switch_at << " ms";
+      // Measured 0.008–0.017 N; the velocity carried at half its value gave 0.076 N, none 0.15 N.
+      EXPECT_LE(step, 0.03) << "switched at " << switch_at << " ms";
     }
   }
 }

@@ -253,6 +253,44 @@ TEST(Engagement, AConfigurationSwitchedInContactCarriesTheForceOnWithoutAStep) {
       across, played.largest_step_n, played.force_z.back(), third_settles);
 }
 
+// A switch while a ramp is still under way (here the engagement of a touch-down found 1 cm deep)
+// keeps what is left of that ramp: cut short to the catch-up's 20 ms it stepped the force by
+// 0.19–0.20 N.
+TEST(Engagement, ASwitchDuringAnEngagementRampKeepsTheRamp) {
+  const Scene first = DefaultScene();
+  Scene second = first;
+  second.adaptivity.primary_size = 2;
+  for (int after : {5, 10, 40}) {
+    HapticLoop loop(first, HapticLoop::Options{});
+    const Played played = Play(
+        loop, [](int n) -> std::optional<double> { return n < 50 ? -0.002 : 0.01; }, 600,
+        [&](int n) {
+          if (n == 50 + after) loop.Reconfigure(second, HapticLoop::Handover::kCarryMotion);
+        });
+    ExpectSmooth(played, "switched " + std::to_string(after) + " periods into the ramp");
+    std::printf("switched %d ms into the engagement ramp: largest force change %.4f N\n", after,
+                played.largest_step_n);
+    EXPECT_LT(played.force_z.back(), -0.5) << "1 cm in pushes back";
+  }
+}
+
+// A reset the primary has not applied yet is not undone by a switch that comes before it is: the
+// tool must still lift off before it feels force (a fault re-arms only after such a reset).
+TEST(Engagement, ASwitchRightAfterAResetLeavesItAReset) {
+  HapticLoop loop(DefaultScene(), HapticLoop::Options{});
+  Scene second = DefaultScene();
+  second.adaptivity.primary_size = 2;
+  const Played played = Play(loop, PressTo(0.006), 1200, [&](int n) {
+    if (n == 900) {
+      loop.Reconfigure(DefaultScene());  // from rest
+      loop.Reconfigure(second, HapticLoop::Handover::kCarryMotion);
+    }
+  });
+  // (A reset in contact releases the force at the slew ceiling: the tool is to lift off.)
+  EXPECT_EQ(played.force_z.back(), 0.0) << "the reset was undone: force without a lift-off";
+  EXPECT_LT(played.force_z[899], -0.5) << "it pressed before the reset";
+}
+
 TEST(Engagement, TheMotionIsCarriedOnlyToRegionsAroundTheSameNode) {
   HapticLoop loop(DefaultScene(), HapticLoop::Options{});
   Scene elsewhere = DefaultScene();

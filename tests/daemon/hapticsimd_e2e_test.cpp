@@ -390,7 +390,7 @@ TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
 
 // A map over two contact nodes where the cheapest configuration meets the target at the middle of
 // the front face but not two nodes from its edge: there the supervisor chooses again, for that
-// node, and switches once the tool is away. Errors of this grid (the real sweep, spacing factor
+// node, and switches once that choice is verified. Errors of this grid (the real sweep, spacing factor
 // 3, 1000 Hz): primary size 1 about 1.8 % at (6, 6, 0) and 6.9 % at (2, 6, 0); size 4 below 1 %
 // at both, and several times dearer (its box is 13 × 13 × 7 nodes at the middle).
 TEST(HapticsimdContactNodes, WhereTheConfigurationMissesTheTargetTheSupervisorChoosesForThatNode) {
@@ -432,7 +432,7 @@ TEST(HapticsimdContactNodes, WhereTheConfigurationMissesTheTargetTheSupervisorCh
   play(50, -0.002);   // hover over (2, 6, 0)
   play(1200, 0.004);  // 4 mm in: the regions move there, size 1 still running
   const size_t in_contact = client.Forces().size();
-  play(3000, -0.002);  // lift off and hover: the new choice switches once the object has settled
+  play(3000, -0.002);  // lift off and hover: the new choice has switched by now
   ASSERT_TRUE(client.WaitForStatus(
       [](const status_t& s) {
         return s.contact_node[0] == 2 && s.contact_node[1] == 6 && s.contact_node[2] == 0 &&

@@ -107,6 +107,10 @@ TEST(RegionsMover, ATouchMovesAtOnceAndItsVerdictFollowsThenTheNodeIsKnown) {
   EXPECT_EQ(again->kind, Kind::kMoveVerified);
   EXPECT_EQ(again->to.centred.spectral_radius, verdict.to.centred.spectral_radius);
   EXPECT_FALSE(mover.busy());
+  // A verified move carries the object's motion only where the regions already are centred.
+  EXPECT_TRUE(again->CarriesMotionFrom(kOffCentre));
+  EXPECT_FALSE(again->CarriesMotionFrom(AtStart(scene).node));
+  EXPECT_FALSE(now->CarriesMotionFrom(kOffCentre)) << "a move verified behind it starts from rest";
   // And the node the regions started on is known from the start.
   mover.Ask(Touch(AtStart(scene).centred.configuration, AtStart(scene).node), Now());
   const std::optional<RegionsMover::Outcome> home = PollAndApply(mover);
@@ -132,6 +136,8 @@ TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
   EXPECT_LT(verdict.to.centred.spectral_radius, 1);
   EXPECT_EQ(mover.placement().centred.configuration, verdict.to.centred.configuration);
   EXPECT_NE(verdict.Describe().find("UNSTABLE"), std::string::npos) << verdict.Describe();
+  // The demotion starts from rest: the motion of a configuration found unstable is not kept.
+  EXPECT_FALSE(verdict.CarriesMotionFrom(kOffCentre));
   // Touched again: straight to the equal rates, verified.
   mover.Ask(Touch(configuration, kOffCentre), Now());
   const std::optional<RegionsMover::Outcome> again = PollAndApply(mover);

@@ -125,15 +125,18 @@ TEST(HapticsimCli, AdaptiveSimulateComparesWithTheReference) {
 }
 
 TEST(HapticsimCli, AdaptiveStabilityReportsEachRegionsOwnLimitAndEstimatesOnlyWhenAsked) {
-  const auto alone = Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2"}));
-  EXPECT_EQ(alone["regions_stable_alone"], true);
+  // Not estimated, nothing is said of the coupled verdict: neither a radius nor "stable" (a
+  // configuration the daemon would refuse must not read as stable).
+  const auto alone =
+      Json(Hapticsim({"stability", "--json", "--set", "adaptivity.primary_size=2", "--set",
+                      "adaptivity.secondary_lod=1", "--set", "adaptivity.secondary_rate=700",
+                      "--set", "material.poisson_ratio=0.49"}));
   EXPECT_EQ(alone["coupled_estimated"], false);
   EXPECT_FALSE(alone.contains("coupled_spectral_radius"));
+  EXPECT_FALSE(alone.contains("stable"));
   ASSERT_EQ(alone["regions"].size(), 2u);
-  // Each region's step is within its own limit: what its substeps are for.
-  for (const auto& region : alone["regions"]) {
-    EXPECT_LE(region["step_s"].get<double>(), region["critical_dt_s"].get<double>());
-  }
+  // ν 0.49 at spacing 1: the secondary region needs 2 substeps at 700 Hz for its own limit.
+  EXPECT_EQ(alone["regions"][1]["substeps"], 2);
   const std::string text = Hapticsim({"stability", "--set", "adaptivity.primary_size=2"}).out;
   EXPECT_NE(text.find("add --estimate"), std::string::npos) << text;
 }
