@@ -27,6 +27,9 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
   u_next_ = &buffers_[2];
   ku_ = Eigen::VectorXd::Zero(n);
   external_ = Eigen::VectorXd::Zero(n);
+  // h²/m per owned DOF, computed once: the same quotient Step used to divide out every step.
+  step_over_mass_.reserve(owned_.size());
+  for (int i : owned_) step_over_mass_.push_back(h_ * h_ / mass_[i]);
 }
 
 void RegionIntegrator::Reset() {
@@ -61,8 +64,9 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
   const double* up = u_previous_->data();
   double* next = u_next_->data();
   double swept = 0;  // Σ m (u⁺ − u⁻)² over the owned DOFs
-  for (int i : owned_) {
-    next[i] = (h2 / mass_[i] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
+  for (size_t k = 0; k < owned_.size(); ++k) {
+    const int i = owned_[k];
+    next[i] = (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
     swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
   }
   load_scale_ = 1;

@@ -138,6 +138,7 @@ class RegionIntegrator {
   double damping_;
   std::vector<int> owned_, prescribed_, loaded_;
   double h_ = 0;
+  std::vector<double> step_over_mass_;  // h²/m per owned DOF, in owned_ order
   Eigen::VectorXd buffers_[3];
   Eigen::VectorXd* u_previous_;
   Eigen::VectorXd* u_;
