@@ -25,6 +25,7 @@
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
+#include "ipc/control_client.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/device_report.hpp"
 #include "tools/hapticsim/line_chart.hpp"
@@ -49,7 +50,41 @@ struct SoakOptions {
   double max_force_step_n = 1.0;  // largest force change between answers in contact
   double min_answered_percent = 95;
   bool no_port_guard = false;  // hapticsimd --no-port-guard: the coupling alone behind the port
+  double switch_every_s = 0;   // pin another configuration this often (0: never)
   bool json = false;
+};
+
+// The configurations a soak with --switch-every pins in turn: they differ in every parameter, so
+// each switch replaces every region.
+constexpr const char* kSoakPins[] = {"pin 2 3 600", "pin 3 2 1000"};
+
+// Pins kSoakPins in turn on the daemon's control socket every `every_s` seconds until `running`
+// goes false (hapticsim ctl's requests, as a user would send them): the answers that began "ok:"
+// and those that did not.
+struct Switcher {
+  std::atomic<int> ok{0}, refused{0};
+  std::thread thread;
+  void Start(const std::string& socket, double every_s, const std::atomic<bool>& running) {
+    thread = std::thread([this, socket, every_s, &running] {
+      auto next = std::chrono::steady_clock::now();
+      for (int k = 0; running; ++k) {
+        next += std::chrono::milliseconds(static_cast<long>(every_s * 1000));
+        while (running && std::chrono::steady_clock::now() < next) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+        if (!running) return;
+        try {
+          const std::string answer = shm::SendControlRequest(socket, kSoakPins[k % 2], 5000);
+          (answer.rfind("ok:", 0) == 0 ? ok : refused).fetch_add(1);
+        } catch (const Error&) {
+          refused.fetch_add(1);
+        }
+      }
+    });
+  }
+  void Join() {
+    if (thread.joinable()) thread.join();
+  }
 };
 
 struct ResourceSample {
@@ -168,6 +203,7 @@ int RunSoak(const SoakOptions& o) {
   HAPTICSIM_THROW_UNLESS(mkdtemp(socket_dir),
                          std::string("cannot make a directory in /tmp: ") + std::strerror(errno));
   const std::string shm_socket = std::string(socket_dir) + "/hapticsimd.sock";
+  const std::string control_socket = std::string(socket_dir) + "/control.sock";
   struct RemoveDir {
     std::string path;
     ~RemoveDir() {
@@ -178,7 +214,8 @@ int RunSoak(const SoakOptions& o) {
   const fs::path config = dir / "hapticsimd.toml", log = dir / "hapticsimd.log";
   {
     std::ofstream c(config);
-    c << "# written by hapticsim soak\n[shm]\nenabled = true\nsocket = \"" << shm_socket << "\"\n";
+    c << "# written by hapticsim soak\n[shm]\nenabled = true\nsocket = \"" << shm_socket << "\"\n"
+      << "[control]\nsocket = \"" << control_socket << "\"\n";
     if (!o.error_map.empty()) {
       c << "[supervisor]\nerror_map = \"" << fs::absolute(o.error_map).string() << "\"\n";
     }
@@ -235,6 +272,8 @@ int RunSoak(const SoakOptions& o) {
   std::vector<ResourceSample> resources;
   std::mutex resources_mutex;
   std::atomic<bool> sampling{true};
+  Switcher switcher;
+  if (o.switch_every_s > 0) switcher.Start(control_socket, o.switch_every_s, sampling);
   const auto start = std::chrono::steady_clock::now();
   std::thread sampler([&] {
     const double ticks_per_s = static_cast<double>(sysconf(_SC_CLK_TCK));
@@ -280,6 +319,7 @@ int RunSoak(const SoakOptions& o) {
   if (terminal) std::fprintf(stderr, "\n");
   sampling = false;
   sampler.join();
+  switcher.Join();
   const double load_cpu_s = load->Stop();
   int status = 0;
   const bool stopped_in_time = stop_daemon(&status);
@@ -330,6 +370,10 @@ int RunSoak(const SoakOptions& o) {
        report.status.has_value() && last_status.energy_balance_violations == 0},
       {"port_guard_as_asked",
        report.status.has_value() && last_status.port_guard_off == o.no_port_guard},
+      // Every pin but the last switched (a pin is verified before it is applied).
+      {"configurations_switched",
+       o.switch_every_s <= 0 || (switcher.refused == 0 && switcher.ok >= 2 &&
+                                 last_status.reconfigurations >= switcher.ok - 1)},
       {"daemon_stopped_cleanly", clean_exit}};
   bool passed = true;
   for (const auto& [name, ok] : checks.items()) passed = passed && ok.get<bool>();
@@ -376,6 +420,10 @@ int RunSoak(const SoakOptions& o) {
       {"port_guard_off", last_status.port_guard_off},
       {"energy_balance_violations", last_status.energy_balance_violations},
       {"interface_backlog_max_j", last_status.interface_backlog_max_j},
+      {"switch_every_s", o.switch_every_s},
+      {"configuration_pins_ok", switcher.ok.load()},
+      {"configuration_pins_refused", switcher.refused.load()},
+      {"reconfigurations", last_status.reconfigurations},
       {"daemon_exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
       {"report",
        {{"json", (dir / "soak.json").string()},
@@ -414,6 +462,13 @@ int RunSoak(const SoakOptions& o) {
         static_cast<long long>(last_status.energy_balance_violations),
         100 * StressOutcome::kGrowingBacklog, last_status.interface_backlog_max_j,
         last_status.port_guard_off ? " (port guard OFF)" : "");
+    if (o.switch_every_s > 0) {
+      std::printf(
+          "  configurations             pinned every %.3g s: %d answered ok, %d refused; "
+          "%lld reconfiguration(s)\n",
+          o.switch_every_s, switcher.ok.load(), switcher.refused.load(),
+          static_cast<long long>(last_status.reconfigurations));
+    }
     std::printf("  shared-memory inputs answered %.2f %% (at least %.3g %%)\n", answered_percent,
                 o.min_answered_percent);
     std::printf("  LCM answers lost           %lld of %lld (%.3f %%, budget %.3g %%)\n",
@@ -482,6 +537,12 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
                 "Run the daemon with its port guard off (hapticsimd --no-port-guard, allowed in "
                 "the soak's private network namespace): the checks then show what the regions' "
                 "coupling does by itself");
+  app->add_option("--switch-every", options->switch_every_s,
+                  "Pin another configuration every this many seconds over the control socket, "
+                  "in turn primary 2, spacing 3, 600 Hz and primary 3, spacing 2, 1000 Hz (as "
+                  "`hapticsim ctl pin` does): the daemon switches them in contact too, carrying "
+                  "the object's motion; checks every pin but the last switched. 0: never")
+      ->check(CLI::NonNegativeNumber);
   app->add_flag("--json", options->json, "Print the summary as JSON");
   return {app, [options, argc, argv] {
             if (!std::getenv(kInNetnsVariable)) ReexecInPrivateNetns(argc, argv);
