@@ -260,21 +260,13 @@ bool AsyncRegions::RegionAtRest(RegionIndex region, double tolerance_m) const no
 }
 
 void AsyncRegions::SetRandomState(unsigned seed) {
-  Reset();
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uniform(-1e-4, 1e-4);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(partition_.mesh().num_dofs());
   for (int a = 0; a < num_regions(); ++a) {
     for (int dof : partition_.dofs(a).owned) u[dof] = uniform(rng);
   }
-  // Every copy holds the same values (each Γ included); each region reads only its own DOFs.
-  for (auto& region : regions_) {
-    region->integrator->SetState(u, u);
-    if (region->inward) region->inward->Clear();
-    if (region->outward) region->outward->Clear();
-  }
-  ResetEnergyAccount();
-  PublishInitialSnapshots();
+  StartFrom(u, Eigen::VectorXd::Zero(u.size()));
 }
 
 void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* contact_next,

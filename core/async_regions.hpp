@@ -303,6 +303,9 @@ class AsyncRegions {
  private:
   struct Region;
   void PublishInitialSnapshots();
+  /** Reset, then every region's copy of the state set to displacements `u` and velocities `v`
+   *  (u⁻ = u − v·h with its own substep h), the boundaries published from it. */
+  void StartFrom(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
   TrialResult RunTrialFromCurrentState(const InputSettings& input);
   void PublishInward(RegionIndex region) noexcept;
   void PublishOutward(RegionIndex region) noexcept;

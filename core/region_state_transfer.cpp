@@ -1,6 +1,7 @@
 // Carrying the object's motion from one configuration of the regions to another
 // (AsyncRegions::CaptureState, AsyncRegions::RestoreState): prolongation onto the fine lattice,
-// then injection into the new configuration's nodes. See docs/regions.md, "Switching in contact".
+// then injection into the new configuration's nodes; AsyncRegions::StartFrom, which SetRandomState
+// shares, starts the regions from such a state. See docs/regions.md, "Switching in contact".
 #include <Eigen/Core>
 #include <algorithm>
 #include <string>
@@ -99,10 +100,13 @@ void AsyncRegions::RestoreState(const ObjectState& state) {
     throw Error("a state of " + std::to_string(state.nodes_per_axis) +
                 " nodes per axis cannot start regions of " + std::to_string(n));
   }
+  StartFrom(Inject(mesh, state, state.displacement_m), Inject(mesh, state, state.velocity_m_per_s));
+}
+
+void AsyncRegions::StartFrom(const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
   Reset();
-  const Eigen::VectorXd u = Inject(mesh, state, state.displacement_m);
-  const Eigen::VectorXd v = Inject(mesh, state, state.velocity_m_per_s);
-  // Every copy holds the same displacements (each Γ included), each its own u⁻ for its substep.
+  // Every copy holds the same displacements (each Γ included), each its own u⁻ for its substep;
+  // each region reads only its own DOFs.
   for (auto& region : regions_) {
     region->integrator->SetState(u, u - region->integrator->substep() * v);
     if (region->inward) region->inward->Clear();

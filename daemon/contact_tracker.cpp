@@ -86,14 +86,11 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   } else if (state_ == State::kEngaged && TipJumped(tip_m)) {
     // Input that came late by more than the resampler continues over (a driver that stalled for
     // a few milliseconds) moves the tip several periods' worth in one. The node catches up from
-    // its own path instead, over what is left of a ramp under way or kCatchUp_ns.
-    std::int64_t duration = kCatchUp_ns;
-    if (ramping_) duration = std::max(duration, ramp_start_ns_ + ramp_duration_ns_ - now_ns);
-    // Where the node's own path is now: on from the last period at its velocity.
+    // its own path instead, from where that path is now: on from the last period at its velocity.
     const double dt = last_ns_ > 0 ? static_cast<double>(now_ns - last_ns_) * 1e-9 : 0.0;
     std::array<double, 3> here = displacement_;
     for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
-    StartRamp(here, velocity_, duration, now_ns);
+    CatchUp(here, now_ns);
   }
   tip_step_ = fresh_tips_ > 0 ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
   last_tip_ = tip_m;
@@ -190,11 +187,15 @@ void ContactTracker::CatchUpFrom(const std::array<double, 3>& held_m,
   // one it had (velocity_: the tip's, which it followed until the hold).
   displacement_ = held_m;
   last_ns_ = held_at_ns;
+  CatchUp(held_m, held_at_ns);
+}
+
+void ContactTracker::CatchUp(const std::array<double, 3>& from_m, std::int64_t from_ns) noexcept {
   // A ramp under way (an engagement, input back after a gap) keeps what is left of it: cut to
   // kCatchUp_ns it would bring the force in several times faster than it was meant to.
   std::int64_t duration = kCatchUp_ns;
-  if (ramping_) duration = std::max(duration, ramp_start_ns_ + ramp_duration_ns_ - held_at_ns);
-  StartRamp(held_m, velocity_, duration, held_at_ns);
+  if (ramping_) duration = std::max(duration, ramp_start_ns_ + ramp_duration_ns_ - from_ns);
+  StartRamp(from_m, velocity_, duration, from_ns);
 }
 
 }  // namespace hapticsim

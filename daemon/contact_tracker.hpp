@@ -99,6 +99,9 @@ class ContactTracker {
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
+  // The node catches up with the tip from `from_m` at `from_ns`, going on at its velocity, over
+  // kCatchUp_ns or what is left of a ramp under way if longer.
+  void CatchUp(const std::array<double, 3>& from_m, std::int64_t from_ns) noexcept;
   void StartRamp(const std::array<double, 3>& from_m, const std::array<double, 3>& velocity_m_per_s,
                  std::int64_t duration_ns, std::int64_t now_ns) noexcept;
 
