@@ -235,7 +235,11 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
       ASSERT_TRUE(std::isfinite(f.force_n[2]));
       if ((f.flags & force_flags::kReconfiguring) && (f.flags & force_flags::kInContact)) {
         ++held;
-        EXPECT_LT(f.force_n[2], -0.05) << "the force was dropped while the regions were replaced";
+        // (Under a sanitizer an install outlasts the 50 ms hold and the force is released: the
+        // hand-over is checked there, the forces are not, as above.)
+        if (!kSanitized) {
+          EXPECT_LT(f.force_n[2], -0.05) << "the force was dropped while the regions were replaced";
+        }
       }
     }
     EXPECT_GT(held, 3) << "no period was answered while the regions were replaced";
