@@ -863,7 +863,15 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
   // busy (its socket buffer overflowed during a 17.7 ms gap): at most 2 % may be missing.
   EXPECT_LE(recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>(), 2000) << summary.out;
   EXPECT_GE(recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>(), 1960) << summary.out;
-  EXPECT_NEAR(recorded["channels"]["HAPTIC_DEVICE"]["rate_hz"].get<double>(), 1000, 20);
+  // The rate is what the logger received over its own span, so the messages it lost and a late
+  // first delivery both lower it: 979 Hz was measured once on a busy CI host with 1960+ messages.
+  // What is checked is that it is a rate per second, and that with the count it gives back the
+  // 2 s the device sent for.
+  const double device_rate_hz = recorded["channels"]["HAPTIC_DEVICE"]["rate_hz"].get<double>();
+  EXPECT_NEAR(device_rate_hz, 1000, 50) << summary.out;
+  EXPECT_NEAR((recorded["channels"]["HAPTIC_DEVICE"]["messages"].get<int>() - 1) / device_rate_hz,
+              2.0, 0.1)
+      << summary.out;
   EXPECT_GT(recorded["channels"]["HAPTIC_FORCE"]["messages"].get<int>(), 1900);
   EXPECT_GT(recorded["forces"]["in_contact"].get<int>(), 500);
   EXPECT_GT(recorded["forces"]["magnitude_N"]["max"].get<double>(), 1.0);  // a 1 cm press
