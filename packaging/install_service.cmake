@@ -1,0 +1,22 @@
+# Run by `cmake --install` (packaging/CMakeLists.txt), when the prefix installed to is known
+# (`cmake --install --prefix P` may differ from the configured one): the systemd unit, its
+# ExecStart and --config naming this prefix's daemon and config, and the default config, in
+# /etc for the /usr prefix (a distribution's) and in P/etc for any other.
+# In: HAPTICSIM_UNIT (the shipped unit), HAPTICSIM_BINDIR (relative), HAPTICSIM_DEFAULT_CONFIG,
+# HAPTICSIM_SYSUSERS.
+if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  set(sysconfdir "/etc")
+else()
+  set(sysconfdir "${CMAKE_INSTALL_PREFIX}/etc")
+endif()
+set(daemon "${CMAKE_INSTALL_PREFIX}/${HAPTICSIM_BINDIR}/hapticsimd")
+file(READ "${HAPTICSIM_UNIT}" unit)
+string(REPLACE "/usr/local/bin/hapticsimd" "${daemon}" unit "${unit}")
+string(REPLACE "/etc/hapticsim/" "${sysconfdir}/hapticsim/" unit "${unit}")
+get_filename_component(staging "${HAPTICSIM_DEFAULT_CONFIG}" DIRECTORY)
+file(WRITE "${staging}/staged/hapticsimd.service" "${unit}")
+file(INSTALL "${staging}/staged/hapticsimd.service"
+     DESTINATION "${CMAKE_INSTALL_PREFIX}/lib/systemd/system")
+file(INSTALL "${HAPTICSIM_SYSUSERS}" DESTINATION "${CMAKE_INSTALL_PREFIX}/lib/sysusers.d"
+     RENAME hapticsim.conf)
+file(INSTALL "${HAPTICSIM_DEFAULT_CONFIG}" DESTINATION "${sysconfdir}/hapticsim")

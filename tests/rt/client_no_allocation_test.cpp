@@ -1,0 +1,69 @@
+// The C API's real-time calls (hapticsim_send_pose, _read_force, _is_live, _read_status) never
+// touch the heap, measured on a session with a real daemon (LCM off: no network) while it
+// answers a press.
+#include <gtest/gtest.h>
+#include <time.h>
+
+#include <chrono>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "hapticsim_client.h"
+#include "tests/support/allocation_counter.hpp"
+#include "tests/support/daemon_harness.hpp"
+#include "tests/support/private_socket.hpp"
+#include "tests/support/run_command.hpp"
+
+namespace {
+
+std::int64_t NowNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+TEST(ClientCApi, TheRealTimeCallsNeverAllocateInASessionWithADaemon) {
+  const std::string socket = hapticsim::testing::PrivateSocketPath();
+  const std::string config = ::testing::TempDir() + "client_c_api.toml";
+  std::ofstream(config) << "[lcm]\nenabled = false\n[control]\nenabled = false\n"
+                        << "[shm]\nenabled = true\nsocket = \"" << socket << "\"\n";
+  hapticsim::testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config},
+                                               ::testing::TempDir() + "client_c_api.log");
+  ASSERT_NO_FATAL_FAILURE(hapticsim::testing::WaitUntilServing(daemon));
+  char why[512];
+  hapticsim_client* client = hapticsim_connect(socket.c_str(), why, sizeof why);
+  ASSERT_NE(client, nullptr) << why;
+
+  std::size_t allocations = 0;
+  int forces = 0, live = 0, in_contact = 0;
+  for (int seq = 1; seq <= 600; ++seq) {
+    const double position[3] = {0.125, 0.125, seq < 100 ? -0.002 : 0.004};
+    hapticsim_force force;
+    hapticsim_status status;
+    {
+      hapticsim::testing::ScopedAllocationCount count;
+      hapticsim_send_pose(client, seq, NowNs() / 1000, position);
+      forces += hapticsim_read_force(client, &force) == 1;
+      live += hapticsim_is_live(client, NowNs());
+      hapticsim_read_status(client, &status);
+      allocations += count.count();
+    }
+    if (forces > 0 && (force.flags & HAPTICSIM_FLAG_IN_CONTACT)) ++in_contact;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(allocations, 0u);
+  // The calls did their work: the daemon answered, live, and felt the press.
+  EXPECT_GT(forces, 500);
+  EXPECT_GT(live, 500);
+  EXPECT_GT(in_contact, 100) << daemon.Log();
+  hapticsim_status status;
+  ASSERT_EQ(hapticsim_read_status(client, &status), 0);
+  EXPECT_EQ(status.daemon_pid, daemon.pid());
+  EXPECT_EQ(status.poses_sent, 600);
+  hapticsim_disconnect(client);
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+}
+
+}  // namespace
