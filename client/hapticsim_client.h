@@ -71,8 +71,9 @@ typedef struct hapticsim_force {
 
 /** What the session knows about the daemon. */
 typedef struct hapticsim_status {
-  int64_t daemon_pid;     /* the daemon's process id (0 once it has stopped) */
-  int32_t daemon_running; /* 1 while the daemon that made the segment runs */
+  int64_t daemon_pid;     /* the daemon's process id; 0 once it stopped cleanly (a killed daemon
+                             leaves it: hapticsim_is_live is what says a force is computed) */
+  int32_t daemon_running; /* daemon_pid != 0: not stopped cleanly (see daemon_pid) */
   int64_t heartbeat_ns;   /* CLOCK_MONOTONIC of its newest answer (0: none yet) */
   int64_t newest_period;  /* the newest period answered (-1: none yet) */
   int64_t poses_sent;     /* hapticsim_send_pose calls in this session */
@@ -80,7 +81,7 @@ typedef struct hapticsim_status {
 
 /**
  * Connects to hapticsimd's service socket (NULL: HAPTICSIM_DEFAULT_SOCKET) and maps the shared
- * memory it hands over; waits up to 2 s for the daemon. Returns NULL when it cannot, with the
+ * memory it hands over; waits up to 2 s to connect and 2 s for the daemon's answer. Returns NULL when it cannot, with the
  * reason in `error` (what to fix: no daemon there, not in its group, another driver holds the
  * session, a socket another user could have put there), truncated to `error_size` bytes.
  */
@@ -118,7 +119,7 @@ HAPTICSIM_API int hapticsim_read_status(const hapticsim_client* client, hapticsi
 
 /**
  * After a daemon restart: a new session at the same socket. Returns 1 when it connected, 0 when
- * not (the old session stays). Not wait-free (up to 200 ms): call it off the real-time thread
+ * not (the old session stays). Not wait-free (up to 400 ms): call it off the real-time thread
  * while hapticsim_is_live says 0; the real-time thread may go on meanwhile.
  */
 HAPTICSIM_API int hapticsim_reconnect(hapticsim_client* client);

@@ -405,7 +405,12 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "max_speed_m_per_s = " << real(c.max_speed_m_per_s) << "\n"
       << "workspace_margin_m = " << real(c.workspace_margin_m) << "\n\n"
       << "[device]  # the driver's transport and the force envelope (docs/operations.md)\n"
-      << "input = " << quote(DeviceInputOf(c)) << "  # \"lcm\" or \"shm\": the other is refused\n"
+      // Unset, the input follows [shm] enabled: written as a comment, so that a config made from
+      // this output (the installed default) still does.
+      << (c.device_input.empty()
+              ? "# input: unset, so shared memory's when [shm] enabled = true, else LCM's (now \"" +
+                    DeviceInputOf(c) + "\")\n"
+              : "input = " + quote(c.device_input) + "  # \"lcm\" or \"shm\": the other is refused\n")
       << "max_force_n = " << real(c.port.max_force_n) << "\n"
       << "max_force_rate_n_per_ms = " << real(c.port.max_force_rate_n_per_ms) << "\n"
       << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"

@@ -1,7 +1,8 @@
 # Run by `cmake --install` (packaging/CMakeLists.txt), when the prefix installed to is known
 # (`cmake --install --prefix P` may differ from the configured one): the systemd unit, its
 # ExecStart and --config naming this prefix's daemon and config, and the default config, in
-# /etc for the /usr prefix (a distribution's) and in P/etc for any other.
+# /etc for the /usr prefix (a distribution's) and in P/etc for any other; an existing config is
+# kept.
 # In: HAPTICSIM_UNIT (the shipped unit), HAPTICSIM_BINDIR (relative), HAPTICSIM_DEFAULT_CONFIG,
 # HAPTICSIM_SYSUSERS.
 if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
@@ -19,4 +20,13 @@ file(INSTALL "${staging}/staged/hapticsimd.service"
      DESTINATION "${CMAKE_INSTALL_PREFIX}/lib/systemd/system")
 file(INSTALL "${HAPTICSIM_SYSUSERS}" DESTINATION "${CMAKE_INSTALL_PREFIX}/lib/sysusers.d"
      RENAME hapticsim.conf)
-file(INSTALL "${HAPTICSIM_DEFAULT_CONFIG}" DESTINATION "${sysconfdir}/hapticsim")
+# The config is the administrator's once it is there: never overwritten (the defaults go beside
+# it, as hapticsimd.toml.default, for comparing).
+if(EXISTS "$ENV{DESTDIR}${sysconfdir}/hapticsim/hapticsimd.toml")
+  message(STATUS "Kept: $ENV{DESTDIR}${sysconfdir}/hapticsim/hapticsimd.toml (an install never "
+                 "overwrites it; the defaults are in hapticsimd.toml.default beside it)")
+  file(INSTALL "${HAPTICSIM_DEFAULT_CONFIG}" DESTINATION "${sysconfdir}/hapticsim"
+       RENAME hapticsimd.toml.default)
+else()
+  file(INSTALL "${HAPTICSIM_DEFAULT_CONFIG}" DESTINATION "${sysconfdir}/hapticsim")
+endif()

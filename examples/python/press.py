@@ -7,7 +7,8 @@ device), and prints what the daemon answered.
 
     python3 press.py [--socket PATH] [--library PATH/TO/libhapticsim_client.so]
 
-Exit status: 0 when the press was felt, 1 when not, 2 when it could not connect.
+Exit status: 0 when at least 90 % of the poses were answered and the press was felt (over
+0.5 N), 1 when not, 2 when it could not connect.
 """
 import argparse
 import ctypes
@@ -87,7 +88,7 @@ def main():
     print(f"press.py: hapticsim_client {lib.hapticsim_client_version().decode()}, daemon pid "
           f"{status.daemon_pid}; {periods} poses sent ({status.poses_sent} counted): {answered} "
           f"answered, {in_contact} in contact; peak force {peak_n:.3f} N")
-    return 0 if in_contact > 0 and peak_n > 0.5 else 1
+    return 0 if answered >= periods * 0.9 and in_contact > 0 and peak_n > 0.5 else 1
 
 
 if __name__ == "__main__":

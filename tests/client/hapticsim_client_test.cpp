@@ -20,7 +20,6 @@ TEST(ClientCApi, NoDaemonAtTheSocketIsAClearReasonAndNoClient) {
   EXPECT_EQ(hapticsim_connect(socket.c_str(), why, sizeof why), nullptr);
   const std::string reason = why;
   EXPECT_NE(reason.find(socket), std::string::npos) << reason;  // says where it looked
-  EXPECT_LT(reason.size(), sizeof why);
 
   // A short buffer gets the reason's beginning, terminated; none at all is allowed.
   char short_why[8];

@@ -107,6 +107,15 @@ TEST(DaemonConfig, DefaultsAreValidHostLocalAndRoundTrip) {
   std::ofstream(path) << FormatDaemonConfig(defaults);
   const DaemonConfig back = LoadDaemonConfig(path);
   EXPECT_EQ(FormatDaemonConfig(back), FormatDaemonConfig(defaults));
+  // The device input is left unset, so a config made from the defaults (the installed one) gives
+  // the input to shared memory once [shm] is enabled in it, as the defaults themselves do.
+  EXPECT_EQ(back.device_input, "");
+  std::string text = FormatDaemonConfig(defaults);
+  const std::string shm_off = "[shm]\nenabled = false";
+  ASSERT_NE(text.find(shm_off), std::string::npos) << text;
+  text.replace(text.find(shm_off), shm_off.size(), "[shm]\nenabled = true");
+  std::ofstream(path) << text;
+  EXPECT_EQ(DeviceInputOf(LoadDaemonConfig(path)), "shm");
 }
 
 TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {

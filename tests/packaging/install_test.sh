@@ -21,12 +21,24 @@ for f in bin/hapticsimd bin/hapticsim bin/hapticsim-shm-client \
          include/hapticsim/ipc/shm_device_client.hpp include/hapticsim/core/scene.hpp \
          include/hapticsim/force_feedback_t.hpp \
          lib/cmake/hapticsim/hapticsimConfig.cmake lib/cmake/hapticsim/hapticsimConfigVersion.cmake \
-         lib/pkgconfig/hapticsim-client.pc share/java/hapticsim-lcmtypes.jar \
+         lib/pkgconfig/hapticsim-client.pc lib/cmake/hapticsim/hapticsimCoreTargets.cmake \
          lib/systemd/system/hapticsimd.service lib/sysusers.d/hapticsim.conf \
          etc/hapticsim/hapticsimd.toml share/doc/hapticsim/README.md \
          share/doc/hapticsim/docs/operations.md; do
   [ -e "$prefix/$f" ] || fail "$f is not installed"
 done
+if [ -e "$build/lcmtypes/hapticsim-lcmtypes.jar" ]; then  # built when a JDK was found
+  [ -e "$prefix/share/java/hapticsim-lcmtypes.jar" ] || fail "the lcm-spy jar is not installed"
+fi
+for f in include/hapticsim/ipc/control_client.hpp include/hapticsim/core/error_sweep.hpp; do
+  [ ! -e "$prefix/$f" ] || fail "$f is installed, but its library is not"
+done
+# An install never overwrites the administrator's config: the defaults go beside it.
+echo "# edited" >> "$prefix/etc/hapticsim/hapticsimd.toml"
+cmake --install "$build" --prefix "$prefix" > "$work/install-again.log"
+grep -q "^# edited" "$prefix/etc/hapticsim/hapticsimd.toml" || fail "a second install overwrote the edited config"
+cmp -s "$prefix/etc/hapticsim/hapticsimd.toml.default" "$build/packaging/hapticsimd.toml" \
+  || fail "the defaults were not put beside the kept config"
 # Only the C API leaves the shared library (hapticsim::ipc is inside it, hidden).
 exported=$(nm -D --defined-only "$prefix/lib/libhapticsim_client.so" | awk '{ print $3 }' | sort)
 others=$(echo "$exported" | grep -v '^hapticsim_' || true)
@@ -58,12 +70,12 @@ cc -std=c11 -Wall -Werror "$source/examples/client/press.c" -o "$work/press_c_pk
 echo "== a daemon from the prefix"
 mkdir -m 0700 "$work/run"
 socket=$work/run/hapticsimd.sock
-# The installed defaults with the driver's input on shared memory, and both sockets here.
+# The installed defaults with shared memory enabled (the device input follows it) and both
+# sockets here.
 sed -e "/^\[shm\]/,/^\[/ { s|^enabled = .*|enabled = true|; s|^socket = .*|socket = \"$socket\"| }" \
-    -e "/^\[device\]/,/^\[/ s|^input = .*|input = \"shm\"|" \
     -e "/^\[control\]/,/^\[/ s|^socket = .*|socket = \"$work/run/control.sock\"|" \
     "$prefix/etc/hapticsim/hapticsimd.toml" > "$work/hapticsimd.toml"
-for line in "socket = \"$socket\"" 'input = "shm"' "socket = \"$work/run/control.sock\""; do
+for line in "socket = \"$socket\"" "socket = \"$work/run/control.sock\""; do
   grep -qF "$line" "$work/hapticsimd.toml" || fail "could not set '$line' in the installed config"
 done
 "$prefix/bin/hapticsimd" --config "$work/hapticsimd.toml" > "$work/daemon.log" 2>&1 &

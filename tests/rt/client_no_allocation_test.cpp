@@ -1,6 +1,6 @@
 // The C API's real-time calls (hapticsim_send_pose, _read_force, _is_live, _read_status) never
 // touch the heap, measured on a session with a real daemon (LCM off: no network) while it
-// answers a press.
+// answers a press; and the session follows a restarted daemon (hapticsim_reconnect).
 #include <gtest/gtest.h>
 #include <time.h>
 
@@ -23,7 +23,7 @@ std::int64_t NowNs() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-TEST(ClientCApi, TheRealTimeCallsNeverAllocateInASessionWithADaemon) {
+TEST(ClientCApi, TheRealTimeCallsNeverAllocateAndASessionFollowsARestartedDaemon) {
   const std::string socket = hapticsim::testing::PrivateSocketPath();
   const std::string config = ::testing::TempDir() + "client_c_api.toml";
   std::ofstream(config) << "[lcm]\nenabled = false\n[control]\nenabled = false\n"
@@ -39,17 +39,19 @@ TEST(ClientCApi, TheRealTimeCallsNeverAllocateInASessionWithADaemon) {
   int forces = 0, live = 0, in_contact = 0;
   for (int seq = 1; seq <= 600; ++seq) {
     const double position[3] = {0.125, 0.125, seq < 100 ? -0.002 : 0.004};
-    hapticsim_force force;
-    hapticsim_status status;
+    hapticsim_force force{};
+    hapticsim_status status{};
+    bool read = false;
     {
       hapticsim::testing::ScopedAllocationCount count;
       hapticsim_send_pose(client, seq, NowNs() / 1000, position);
-      forces += hapticsim_read_force(client, &force) == 1;
+      read = hapticsim_read_force(client, &force) == 1;
       live += hapticsim_is_live(client, NowNs());
       hapticsim_read_status(client, &status);
       allocations += count.count();
     }
-    if (forces > 0 && (force.flags & HAPTICSIM_FLAG_IN_CONTACT)) ++in_contact;
+    forces += read;
+    if (read && (force.flags & HAPTICSIM_FLAG_IN_CONTACT)) ++in_contact;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_EQ(allocations, 0u);
@@ -61,9 +63,33 @@ TEST(ClientCApi, TheRealTimeCallsNeverAllocateInASessionWithADaemon) {
   ASSERT_EQ(hapticsim_read_status(client, &status), 0);
   EXPECT_EQ(status.daemon_pid, daemon.pid());
   EXPECT_EQ(status.poses_sent, 600);
-  hapticsim_disconnect(client);
+
+  // The daemon stops: not live within 20 ms, its pid cleared; a new one at the same socket is
+  // reached by hapticsim_reconnect, and answers.
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(hapticsim_is_live(client, NowNs()), 0);
+  ASSERT_EQ(hapticsim_read_status(client, &status), 0);
+  EXPECT_EQ(status.daemon_running, 0);
+  EXPECT_EQ(hapticsim_reconnect(client), 0);  // nobody there yet: the old session stays
+  hapticsim::testing::BackgroundProcess restarted({HAPTICSIMD_PATH, "--config", config},
+                                                  ::testing::TempDir() + "client_c_api_2.log");
+  ASSERT_NO_FATAL_FAILURE(hapticsim::testing::WaitUntilServing(restarted));
+  EXPECT_EQ(hapticsim_reconnect(client), 1) << restarted.Log();
+  int live_again = 0;
+  for (int seq = 601; seq <= 700; ++seq) {
+    const double position[3] = {0.125, 0.125, -0.002};
+    hapticsim_send_pose(client, seq, NowNs() / 1000, position);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    live_again += hapticsim_is_live(client, NowNs());
+  }
+  EXPECT_GT(live_again, 50);
+  ASSERT_EQ(hapticsim_read_status(client, &status), 0);
+  EXPECT_EQ(status.daemon_pid, restarted.pid());
+  hapticsim_disconnect(client);
+  restarted.Signal(SIGTERM);
+  EXPECT_EQ(restarted.Wait(5), 0) << restarted.Log();
 }
 
 }  // namespace
