@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <climits>
 
+#include "core/cpu_dispatch.hpp"
+
 namespace hapticsim {
 namespace {
 
@@ -132,6 +134,11 @@ BoxStiffness::BoxStiffness(const HybridMesh& mesh, const Material& material,
 
 void BoxStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
                          Eigen::Ref<Eigen::VectorXd> ku) const {
+  ApplyOnBox(u.data(), ku.data());
+}
+
+HAPTICSIM_KERNEL_CLONES
+void BoxStiffness::ApplyOnBox(const double* u, double* ku) const {
   const int nr = mesh_.num_independent();
   const int nb = static_cast<int>(gather_start_.size()) - 1;
   for (const DirectNode& d : direct_nodes_) {

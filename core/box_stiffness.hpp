@@ -56,6 +56,10 @@ class BoxStiffness final : public StiffnessOperator {
     int stencil = 0;  // into stencils_
   };
 
+  // Apply's gather, stencil runs and scatter: the hot kernel, compiled per instruction set
+  // (core/cpu_dispatch.hpp).
+  void ApplyOnBox(const double* u, double* ku) const;
+
   BoxStiffness(const HybridMesh& mesh, const Material& material, std::vector<int> element_ids,
                const std::array<int, 3>& box_nodes, std::vector<int> box_mesh_nodes,
                const std::vector<unsigned>& cell_masks);

@@ -1,6 +1,10 @@
 #include "core/element_set_stiffness.hpp"
 
 #include <algorithm>
+#include <cstring>
+
+#include "core/cpu_dispatch.hpp"
+#include "core/stencil_kernels.hpp"
 
 namespace hapticsim {
 
@@ -37,10 +41,34 @@ ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material&
 
 void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
                                 Eigen::Ref<Eigen::VectorXd> ku) const {
+  ApplyElements(u.data(), ku.data());
+}
+
+namespace {
+
+// fe = k · ue for one element, k the 24 × 24 unit stiffness (column-major): its columns scaled by
+// ue and summed, in six 4-wide vectors. Written out rather than left to Eigen, whose vector width
+// is fixed when a file is compiled (the baseline's, in the portable build), while this is
+// compiled with the kernel that calls it, for each instruction set.
+HAPTICSIM_KERNEL_INLINE void MultiplyElement(const double* k, const double* ue, double* fe) {
+  using stencil_detail::Load4;
+  using stencil_detail::Vec4;
+  Vec4 sum[6] = {};
+  for (int j = 0; j < 24; ++j) {
+    for (int v = 0; v < 6; ++v) sum[v] += ue[j] * Load4(k + 24 * j + 4 * v);
+  }
+  std::memcpy(fe, sum, sizeof sum);
+}
+
+}  // namespace
+
+HAPTICSIM_KERNEL_CLONES
+void ElementSetStiffness::ApplyElements(const double* u, double* ku) const {
+  static_assert(!Hex8Element::Matrix24::IsRowMajor, "MultiplyElement reads columns");
   for (int dof : touched_dofs_) ku[dof] = 0.0;
   const int nr = mesh_.num_independent();
   const double h = mesh_.options().spacing_m;
-  Eigen::Matrix<double, 24, 1> ue, fe;
+  double ue[24], fe[24];
   for (size_t k = 0; k < element_ids_.size(); ++k) {
     const HybridElement& e = mesh_.elements()[element_ids_[k]];
     const std::array<int, 8>& direct = direct_nodes_[k];
@@ -62,8 +90,9 @@ void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
         ue[3 * local + 2] = z;
       }
     }
-    fe.noalias() = unit_stiffness_.lazyProduct(ue);  // fixed 24 × 24: no general gemv call
-    fe *= e.size_factor * h;
+    MultiplyElement(unit_stiffness_.data(), ue, fe);
+    const double scale = e.size_factor * h;
+    for (double& f : fe) f *= scale;
     if (direct[0] >= 0) {
       for (int local = 0; local < 8; ++local) {
         for (int c = 0; c < 3; ++c) ku[c * nr + direct[local]] += fe[3 * local + c];

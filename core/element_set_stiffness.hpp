@@ -30,6 +30,9 @@ class ElementSetStiffness final : public StiffnessOperator {
   const std::vector<int>& touched_dofs() const { return touched_dofs_; }
 
  private:
+  // Apply's element loop: the hot kernel, compiled per instruction set (core/cpu_dispatch.hpp).
+  void ApplyElements(const double* u, double* ku) const;
+
   const HybridMesh& mesh_;
   std::vector<int> element_ids_;
   Hex8Element::Matrix24 unit_stiffness_;  // λA + μB (stiffness per metre of edge)

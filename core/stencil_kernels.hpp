@@ -31,13 +31,18 @@ using NodeStencil = std::array<std::vector<StencilTerm>, 3>;
 NodeStencil MakeNodeStencil(const Hex8Element::Matrix24& ke, unsigned cell_mask, std::ptrdiff_t n,
                             std::ptrdiff_t sy, std::ptrdiff_t sz);
 
+// Every kernel here is always inlined: the K·u kernels that call them are compiled once per
+// instruction set (core/cpu_dispatch.hpp), and a call out of a kernel would run the baseline's
+// code.
+#define HAPTICSIM_KERNEL_INLINE inline __attribute__((always_inline))
+
 namespace stencil_detail {
 
 // Four doubles in one SIMD register (GCC/Clang vector extension: AVX with -march=native, two
 // SSE2 halves otherwise). Loads go through memcpy because neighbour rows are not aligned.
 using Vec4 = double __attribute__((vector_size(32)));
 
-inline Vec4 Load4(const double* p) {
+HAPTICSIM_KERNEL_INLINE Vec4 Load4(const double* p) {
   Vec4 v;
   std::memcpy(&v, p, sizeof v);
   return v;
@@ -47,7 +52,8 @@ inline Vec4 Load4(const double* p) {
 // two interleaved partial accumulators (even and odd terms): an FMA takes several cycles, so
 // one dependency chain per vector would leave the FMA units idle.
 template <int W>
-inline void AccumulateChunk(const std::vector<StencilTerm>& terms, const double* u, double* out) {
+HAPTICSIM_KERNEL_INLINE void AccumulateChunk(const std::vector<StencilTerm>& terms, const double* u,
+                                             double* out) {
   constexpr int kVectors = W / 4;
   Vec4 even[kVectors] = {}, odd[kVectors] = {};
   const size_t count = terms.size();
@@ -71,14 +77,21 @@ inline void AccumulateChunk(const std::vector<StencilTerm>& terms, const double*
   }
 }
 
+// ku at W consecutive nodes from node i, all three components.
+template <int W>
+HAPTICSIM_KERNEL_INLINE void AccumulateNodes(const NodeStencil& stencil, const double* u,
+                                             double* ku, std::ptrdiff_t i, std::ptrdiff_t n) {
+  for (int a = 0; a < 3; ++a) AccumulateChunk<W>(stencil[a], u + i, ku + a * n + i);
+}
+
 }  // namespace stencil_detail
 
 /**
  * ku at node i (all three components) by its stencil; n nodes per component block. Four partial
  * sums, for the same reason as in AccumulateChunk.
  */
-inline void ApplyStencilAt(const NodeStencil& stencil, const double* u, double* ku,
-                           std::ptrdiff_t i, std::ptrdiff_t n) {
+HAPTICSIM_KERNEL_INLINE void ApplyStencilAt(const NodeStencil& stencil, const double* u, double* ku,
+                                            std::ptrdiff_t i, std::ptrdiff_t n) {
   for (int a = 0; a < 3; ++a) {
     const auto& terms = stencil[a];
     double acc[4] = {};
@@ -96,27 +109,25 @@ inline void ApplyStencilAt(const NodeStencil& stencil, const double* u, double* 
  * vectors of 16, 8 and 4 nodes, a tail of fewer than 4 as the run's last 4 again (the overlap
  * writes the same values, cheaper than scalar nodes), single nodes only in runs shorter than 4.
  */
-inline void ApplyStencilRun(const NodeStencil& stencil, const double* u, double* ku,
-                            std::ptrdiff_t first, int length, std::ptrdiff_t n) {
-  using stencil_detail::AccumulateChunk;
+HAPTICSIM_KERNEL_INLINE void ApplyStencilRun(const NodeStencil& stencil, const double* u,
+                                             double* ku, std::ptrdiff_t first, int length,
+                                             std::ptrdiff_t n) {
+  using stencil_detail::AccumulateNodes;
   if (length < 4) {
     for (int k = 0; k < length; ++k) ApplyStencilAt(stencil, u, ku, first + k, n);
     return;
   }
-  auto chunk = [&]<int W>(std::ptrdiff_t i) {
-    for (int a = 0; a < 3; ++a) AccumulateChunk<W>(stencil[a], u + i, ku + a * n + i);
-  };
   int k = 0;
-  for (; k + 16 <= length; k += 16) chunk.template operator()<16>(first + k);
+  for (; k + 16 <= length; k += 16) AccumulateNodes<16>(stencil, u, ku, first + k, n);
   if (k + 8 <= length) {
-    chunk.template operator()<8>(first + k);
+    AccumulateNodes<8>(stencil, u, ku, first + k, n);
     k += 8;
   }
   if (k + 4 <= length) {
-    chunk.template operator()<4>(first + k);
+    AccumulateNodes<4>(stencil, u, ku, first + k, n);
     k += 4;
   }
-  if (k < length) chunk.template operator()<4>(first + length - 4);
+  if (k < length) AccumulateNodes<4>(stencil, u, ku, first + length - 4, n);
 }
 
 }  // namespace hapticsim

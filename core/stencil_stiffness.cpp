@@ -2,6 +2,7 @@
 
 #include <cassert>
 
+#include "core/cpu_dispatch.hpp"
 #include "core/hex8_element.hpp"
 
 namespace hapticsim {
@@ -32,23 +33,26 @@ StencilStiffness::StencilStiffness(const HexGrid& grid, const Material& material
   }
 }
 
-void StencilStiffness::ApplyRow(const double* u, double* ku, int iy, int iz) const {
+HAPTICSIM_KERNEL_CLONES
+void StencilStiffness::ApplyRows(const double* u, double* ku) const {
   const int nx = grid_.nx();
   const std::ptrdiff_t n = grid_.num_nodes();
-  const int row_class = 3 * AxisClass(iy, grid_.ny()) + 9 * AxisClass(iz, grid_.nz());
-  const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(grid_.Node(0, iy, iz));
-  // The two x faces one node each, the interior between them as one run.
-  ApplyStencilAt(stencils_[row_class + 0], u, ku, row, n);
-  ApplyStencilRun(stencils_[row_class + 1], u, ku, row + 1, nx - 2, n);
-  ApplyStencilAt(stencils_[row_class + 2], u, ku, row + nx - 1, n);
+  for (int iz = 0; iz < grid_.nz(); ++iz) {
+    for (int iy = 0; iy < grid_.ny(); ++iy) {
+      const int row_class = 3 * AxisClass(iy, grid_.ny()) + 9 * AxisClass(iz, grid_.nz());
+      const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(grid_.Node(0, iy, iz));
+      // The two x faces one node each, the interior between them as one run.
+      ApplyStencilAt(stencils_[row_class + 0], u, ku, row, n);
+      ApplyStencilRun(stencils_[row_class + 1], u, ku, row + 1, nx - 2, n);
+      ApplyStencilAt(stencils_[row_class + 2], u, ku, row + nx - 1, n);
+    }
+  }
 }
 
 void StencilStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
                              Eigen::Ref<Eigen::VectorXd> ku) const {
   assert(u.size() == num_dofs() && ku.size() == num_dofs());
-  for (int iz = 0; iz < grid_.nz(); ++iz) {
-    for (int iy = 0; iy < grid_.ny(); ++iy) ApplyRow(u.data(), ku.data(), iy, iz);
-  }
+  ApplyRows(u.data(), ku.data());
 }
 
 Eigen::VectorXd StencilStiffness::Diagonal() const {

@@ -36,7 +36,9 @@ class StencilStiffness final : public StiffnessOperator {
   static int AxisClass(int index, int count) {
     return index == 0 ? 0 : (index == count - 1 ? 2 : 1);
   }
-  void ApplyRow(const double* u, double* ku, int iy, int iz) const;
+  // Apply's loop over every row of the grid: the hot kernel, compiled per instruction set
+  // (core/cpu_dispatch.hpp).
+  void ApplyRows(const double* u, double* ku) const;
 
   HexGrid grid_;
   std::array<NodeStencil, 27> stencils_;  // per node class

@@ -31,6 +31,7 @@
 #include <set>
 #include <thread>
 
+#include "core/cpu_dispatch.hpp"
 #include "core/error.hpp"
 #include "core/error_lookup.hpp"
 #include "core/error_map_file.hpp"
@@ -41,6 +42,7 @@
 #include "daemon/control_line.hpp"
 #include "daemon/control_server.hpp"
 #include "daemon/daemon_config.hpp"
+#include "daemon/error_map_loading.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
 #include "daemon/lcm_bridge.hpp"
@@ -82,37 +84,6 @@ std::shared_ptr<spdlog::logger> MakeLogger(const std::string& level) {
   logger->set_level(spdlog::level::from_str(level));
   spdlog::set_default_logger(logger);
   return logger;
-}
-
-struct MapState {
-  std::string path;
-  std::shared_ptr<const ErrorMap> map;  // shared with a choice being computed
-};
-
-// The map at `path`, checked as the supervisor will use it with `scene` (MapProblem).
-// @throws Error naming the file and what is wrong with it.
-std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Scene& scene) {
-  auto map = std::make_shared<const ErrorMap>(LoadErrorMap(path));
-  if (const std::string problem = MapProblem(scene, *map); !problem.empty()) {
-    throw Error("error map " + path + " refused: " + problem);
-  }
-  return map;
-}
-
-MapState LoadMap(const std::string& path, const Scene& scene, bool reload = false) {
-  MapState state{path, nullptr};
-  if (path.empty()) return state;
-  try {
-    state.map = LoadUsableMap(path, scene);
-    spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
-                 state.map->provenance.grid, state.map->provenance.code_version);
-  } catch (const Error& e) {
-    spdlog::error("{}; {}", e.what(),
-                  reload ? "keeping the map loaded before"
-                         : "running without an error map (forces carry error -1 and the no-map "
-                           "flag)");
-  }
-  return state;
 }
 
 std::string FaultName(PortGuard::Fault fault, const PortGuardSettings& port) {
@@ -179,6 +150,28 @@ bool ReloadConfig(const Arguments& args, DaemonConfig* config, spdlog::logger& l
   }
 }
 
+// --print-config and --check-config: say the configuration, or check it (its map and command key
+// too), and exit. @throws Error naming what is wrong.
+int PrintOrCheckConfig(const Arguments& args, const DaemonConfig& config, bool default_missing) {
+  if (args.print_config) std::cout << FormatDaemonConfig(config);
+  if (args.check_config) {
+    // The map too: a config whose map is missing or unusable would start without one.
+    if (!config.error_map.empty()) {
+      try {
+        (void)LoadUsableMap(config.error_map, config.scene);
+      } catch (const Error& e) {
+        throw Error(std::string("supervisor.error_map: ") + e.what());
+      }
+    }
+    (void)LcmCommandGateOf(config);  // and the key of signed LCM commands
+    std::cout << "hapticsimd: configuration "
+              << (default_missing ? "(built-in defaults; " + args.config + " does not exist)"
+                                  : args.config)
+              << " is valid\n";
+  }
+  return 0;
+}
+
 int Serve(const Arguments& args) {
   DaemonConfig config;
   const bool default_missing =
@@ -192,25 +185,8 @@ int Serve(const Arguments& args) {
       throw Error("--no-port-guard is for tests and soaks only, refused: " + why);
     }
   }
-  if (args.print_config || args.check_config) {
-    if (args.print_config) std::cout << FormatDaemonConfig(config);
-    if (args.check_config) {
-      // The map too: a config whose map is missing or unusable would start without one.
-      if (!config.error_map.empty()) {
-        try {
-          (void)LoadUsableMap(config.error_map, config.scene);
-        } catch (const Error& e) {
-          throw Error(std::string("supervisor.error_map: ") + e.what());
-        }
-      }
-      (void)LcmCommandGateOf(config);  // and the key of signed LCM commands
-      std::cout << "hapticsimd: configuration "
-                << (default_missing ? "(built-in defaults; " + args.config + " does not exist)"
-                                    : args.config)
-                << " is valid\n";
-    }
-    return 0;
-  }
+  if (args.print_config || args.check_config)
+    return PrintOrCheckConfig(args, config, default_missing);
 
   // Signals go to the supervisor loop below only: blocked before any thread (the logger's
   // included) starts, so every thread inherits the mask and none takes the default action.
@@ -219,8 +195,9 @@ int Serve(const Arguments& args) {
   for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   auto logger = MakeLogger(config.log_level);
-  spdlog::info("hapticsimd {} starting; config {}", CodeVersion(),
-               default_missing ? "built-in defaults (no " + args.config + ")" : args.config);
+  spdlog::info("hapticsimd {} starting; config {}; K·u kernels {}", CodeVersion(),
+               default_missing ? "built-in defaults (no " + args.config + ")" : args.config,
+               KernelInstructionSet());
   if (config.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
     spdlog::warn(
         "mlockall refused ({}; needs CAP_IPC_LOCK or LimitMEMLOCK=infinity): memory "

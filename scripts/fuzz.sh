@@ -19,7 +19,7 @@ done
 [ ${#targets[@]} -gt 0 ] || targets=(scene_toml daemon_config error_map lcm_messages shm_segment service_handshake control_line)
 
 "$root/scripts/setup.sh"
-CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -G Ninja -DHAPTICSIM_FUZZ=ON \
+CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -G Ninja -DHAPTICSIM_FUZZ=ON -DHAPTICSIM_NATIVE=ON \
   -DHAPTICSIM_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$root/build-fuzz" --target hapticsim_fuzzers
 

@@ -14,6 +14,7 @@
 
 #include "core/assembled_stiffness.hpp"
 #include "core/async_regions.hpp"
+#include "core/cpu_dispatch.hpp"
 #include "core/cube_scene.hpp"
 #include "core/error.hpp"
 #include "core/error_sweep.hpp"
@@ -146,11 +147,14 @@ int RunKernels(const BenchOptions& o) {
                          {"matrix_free_gflops", t.matrix_free_gflops},
                          {"rounds", t.rounds}});
     }
-    std::cout << Json{{"kernels", kernels}}.dump(2) << "\n";
+    std::cout
+        << Json{{"kernels", kernels}, {"kernel_instruction_set", KernelInstructionSet()}}.dump(2)
+        << "\n";
     return kExitOk;
   }
   std::cout << "K·u, matrix-free (27-point stencil) against assembled (Eigen CSR), side by side;\n"
-               "medians of alternating rounds\n\n"
+               "medians of alternating rounds; the kernels run with "
+            << KernelInstructionSet() << "\n\n"
             << "  nodes   matrix-free    assembled   speed-up   matrix-free GFLOP/s   rounds\n";
   for (const KernelTiming& t : timings) {
     char line[160];

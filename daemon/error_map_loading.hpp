@@ -1,0 +1,30 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/error_map.hpp"
+#include "core/scene.hpp"
+
+namespace hapticsim {
+
+/** The error map the daemon's supervisor looks up: where it came from, and the map (or none). */
+struct MapState {
+  std::string path;
+  std::shared_ptr<const ErrorMap> map;  ///< shared with a choice being computed; null: no map
+};
+
+/**
+ * The map at `path`, checked as the supervisor will use it with `scene` (MapProblem).
+ * @throws Error naming the file and what is wrong with it.
+ */
+std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Scene& scene);
+
+/**
+ * The map at `path` (none for an empty path), said in the log; a map it cannot use is said too,
+ * and leaves no map — at start the daemon runs without one, on a reload (`reload`) the caller
+ * keeps the one it had.
+ */
+MapState LoadMap(const std::string& path, const Scene& scene, bool reload = false);
+
+}  // namespace hapticsim
