@@ -27,6 +27,16 @@ for f in bin/hapticsimd bin/hapticsim bin/hapticsim-shm-client \
          share/doc/hapticsim/docs/operations.md; do
   [ -e "$prefix/$f" ] || fail "$f is not installed"
 done
+# The LCM types in C (headers and library) and Python (where Debian's python3 looks).
+for f in include/hapticsim_status_t.h include/hapticsim_force_feedback_t.h lib/libhapticsim_lcmtypes_c.a; do
+  [ -e "$prefix/$f" ] || fail "$f is not installed"
+done
+python_dir=$(ls -d "$prefix"/lib/python3*/dist-packages 2>/dev/null | head -1)
+[ -n "$python_dir" ] && [ -e "$python_dir/hapticsim/force_feedback_t.py" ] || fail "the Python LCM types are not installed"
+PYTHONPATH=$python_dir python3 -c "
+import hapticsim
+f = hapticsim.force_feedback_t(); f.seq = 7
+assert hapticsim.force_feedback_t.decode(f.encode()).seq == 7" || fail "the installed Python LCM types do not import and round-trip"
 if [ -e "$build/lcmtypes/hapticsim-lcmtypes.jar" ]; then  # built when a JDK was found
   [ -e "$prefix/share/java/hapticsim-lcmtypes.jar" ] || fail "the lcm-spy jar is not installed"
 fi
