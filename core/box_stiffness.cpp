@@ -132,11 +132,6 @@ BoxStiffness::BoxStiffness(const HybridMesh& mesh, const Material& material,
   }
 }
 
-void BoxStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
-                         Eigen::Ref<Eigen::VectorXd> ku) const {
-  ApplyOnBox(u.data(), ku.data());
-}
-
 HAPTICSIM_KERNEL_CLONES
 void BoxStiffness::ApplyOnBox(const double* u, double* ku) const {
   const int nr = mesh_.num_independent();
@@ -176,6 +171,11 @@ void BoxStiffness::ApplyOnBox(const double* u, double* ku) const {
       ku[2 * nr + g.independent] += g.weight * ku_box_[2 * nb + b];
     }
   }
+}
+
+void BoxStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+                         Eigen::Ref<Eigen::VectorXd> ku) const {
+  ApplyOnBox(u.data(), ku.data());
 }
 
 }  // namespace hapticsim

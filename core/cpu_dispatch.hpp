@@ -8,8 +8,9 @@
 // native build (-DHAPTICSIM_NATIVE=ON) has one instruction set, the build machine's, and
 // sanitized builds keep to one (their runtimes and ifunc resolvers do not mix).
 //
-// Put HAPTICSIM_KERNEL_CLONES on a kernel's definition; it must not be virtual (GCC cannot clone
-// those), and what it calls should be inline, so it is compiled for each set with it.
+// Put HAPTICSIM_KERNEL_CLONES on a kernel's definition, above its first use in the file (clang
+// refuses it after); it must not be virtual (GCC cannot clone those); what it calls must be
+// inlined (HAPTICSIM_KERNEL_INLINE), so it is compiled for each set with it.
 
 #include <string>
 

@@ -39,11 +39,6 @@ ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material&
   }
 }
 
-void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
-                                Eigen::Ref<Eigen::VectorXd> ku) const {
-  ApplyElements(u.data(), ku.data());
-}
-
 namespace {
 
 // fe = k · ue for one element, k the 24 × 24 unit stiffness (column-major): its columns scaled by
@@ -51,11 +46,11 @@ namespace {
 // is fixed when a file is compiled (the baseline's, in the portable build), while this is
 // compiled with the kernel that calls it, for each instruction set.
 HAPTICSIM_KERNEL_INLINE void MultiplyElement(const double* k, const double* ue, double* fe) {
-  using stencil_detail::Load4;
+  using stencil_detail::AddScaled4;
   using stencil_detail::Vec4;
   Vec4 sum[6] = {};
   for (int j = 0; j < 24; ++j) {
-    for (int v = 0; v < 6; ++v) sum[v] += ue[j] * Load4(k + 24 * j + 4 * v);
+    for (int v = 0; v < 6; ++v) AddScaled4(sum[v], ue[j], k + 24 * j + 4 * v);
   }
   std::memcpy(fe, sum, sizeof sum);
 }
@@ -108,6 +103,11 @@ void ElementSetStiffness::ApplyElements(const double* u, double* ku) const {
       }
     }
   }
+}
+
+void ElementSetStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+                                Eigen::Ref<Eigen::VectorXd> ku) const {
+  ApplyElements(u.data(), ku.data());
 }
 
 Eigen::VectorXd ElementSetStiffness::Diagonal() const {

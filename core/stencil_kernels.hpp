@@ -38,14 +38,17 @@ NodeStencil MakeNodeStencil(const Hex8Element::Matrix24& ke, unsigned cell_mask,
 
 namespace stencil_detail {
 
-// Four doubles in one SIMD register (GCC/Clang vector extension: AVX with -march=native, two
-// SSE2 halves otherwise). Loads go through memcpy because neighbour rows are not aligned.
+// Four doubles in one SIMD register (GCC/Clang vector extension: one AVX register in a kernel
+// compiled for AVX2 or AVX-512, two SSE halves in the baseline's). Loads go through memcpy because
+// neighbour rows are not aligned. A Vec4 is never passed or returned by value: without AVX that
+// is an ABI change GCC warns of and clang refuses.
 using Vec4 = double __attribute__((vector_size(32)));
 
-HAPTICSIM_KERNEL_INLINE Vec4 Load4(const double* p) {
+// sum += c · p[0 … 4)
+HAPTICSIM_KERNEL_INLINE void AddScaled4(Vec4& sum, double c, const double* p) {
   Vec4 v;
   std::memcpy(&v, p, sizeof v);
-  return v;
+  sum += c * v;
 }
 
 // ku_a[i … i+W) for one output component over all its couplings. W/4 vectors, each summed in
@@ -63,13 +66,13 @@ HAPTICSIM_KERNEL_INLINE void AccumulateChunk(const std::vector<StencilTerm>& ter
     const double* src_odd = u + terms[t + 1].offset;
     const double c_even = terms[t].coefficient, c_odd = terms[t + 1].coefficient;
     for (int v = 0; v < kVectors; ++v) {
-      even[v] += c_even * Load4(src_even + 4 * v);
-      odd[v] += c_odd * Load4(src_odd + 4 * v);
+      AddScaled4(even[v], c_even, src_even + 4 * v);
+      AddScaled4(odd[v], c_odd, src_odd + 4 * v);
     }
   }
   if (t < count) {
     const double* src = u + terms[t].offset;
-    for (int v = 0; v < kVectors; ++v) even[v] += terms[t].coefficient * Load4(src + 4 * v);
+    for (int v = 0; v < kVectors; ++v) AddScaled4(even[v], terms[t].coefficient, src + 4 * v);
   }
   for (int v = 0; v < kVectors; ++v) {
     const Vec4 sum = even[v] + odd[v];
