@@ -3,8 +3,11 @@
 # ExecStart and --config naming this prefix's daemon and config, and the default config, in
 # /etc for the /usr prefix (a distribution's) and in P/etc for any other; an existing config is
 # kept.
+# The Python package of the LCM types goes where Debian's python3 looks: lib/python3/dist-packages
+# for /usr, lib/python3.X/dist-packages for any other prefix (/usr/local's is on its path).
 # In: HAPTICSIM_UNIT (the shipped unit), HAPTICSIM_BINDIR (relative), HAPTICSIM_DEFAULT_CONFIG,
-# HAPTICSIM_SYSUSERS.
+# HAPTICSIM_SYSUSERS, HAPTICSIM_PYTHON_PACKAGE (the built package's directory),
+# HAPTICSIM_PYTHON_VERSION ("3.11").
 if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
   set(sysconfdir "/etc")
 else()
@@ -30,3 +33,11 @@ if(EXISTS "$ENV{DESTDIR}${sysconfdir}/hapticsim/hapticsimd.toml")
 else()
   file(INSTALL "${HAPTICSIM_DEFAULT_CONFIG}" DESTINATION "${sysconfdir}/hapticsim")
 endif()
+
+if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  set(python_dir "${CMAKE_INSTALL_PREFIX}/lib/python3/dist-packages")
+else()
+  set(python_dir "${CMAKE_INSTALL_PREFIX}/lib/python${HAPTICSIM_PYTHON_VERSION}/dist-packages")
+endif()
+file(INSTALL "${HAPTICSIM_PYTHON_PACKAGE}" DESTINATION "${python_dir}"
+     PATTERN "__pycache__" EXCLUDE)
