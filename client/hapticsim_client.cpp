@@ -8,8 +8,6 @@
 #include <cstring>
 #include <exception>
 #include <hapticsim/force_feedback_t.hpp>
-#include <memory>
-#include <new>
 #include <string>
 #include <string_view>
 

@@ -21,6 +21,10 @@
 #define HAPTICSIM_KERNEL_CLONES
 #endif
 
+// What a kernel calls: always inlined, so it is compiled for the kernel's instruction set (a call
+// out of a kernel would run the baseline's code).
+#define HAPTICSIM_KERNEL_INLINE inline __attribute__((always_inline))
+
 namespace hapticsim {
 
 /**

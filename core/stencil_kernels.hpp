@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/cpu_dispatch.hpp"
 #include "core/hex8_element.hpp"
 
 namespace hapticsim {
@@ -30,11 +31,6 @@ using NodeStencil = std::array<std::vector<StencilTerm>, 3>;
  */
 NodeStencil MakeNodeStencil(const Hex8Element::Matrix24& ke, unsigned cell_mask, std::ptrdiff_t n,
                             std::ptrdiff_t sy, std::ptrdiff_t sz);
-
-// Every kernel here is always inlined: the K·u kernels that call them are compiled once per
-// instruction set (core/cpu_dispatch.hpp), and a call out of a kernel would run the baseline's
-// code.
-#define HAPTICSIM_KERNEL_INLINE inline __attribute__((always_inline))
 
 namespace stencil_detail {
 
