@@ -13,16 +13,10 @@
 #include "core/reference_trial.hpp"
 #include "core/region_integrator.hpp"
 #include "core/region_partition.hpp"
+#include "core/region_schedule.hpp"
 #include "core/stability_estimate.hpp"
 
 namespace hapticsim {
-
-/** One region's schedule: its rate and how many substeps its stability limit requires. */
-struct RegionSchedule {
-  double rate_hz = 0;
-  int substeps = 1;
-  StabilityEstimate alone;  ///< the region's own limit with its boundary held
-};
 
 /** The spectral radius of the map that advances the coupled state by one common period. */
 struct CoupledStability {
@@ -187,6 +181,30 @@ class AsyncRegions {
   void RestoreState(const ObjectState& state);
 
   /**
+   * The object's surface, for drawing it (hapticsimd's deformation_t, `hapticsim simulate
+   * --vtk`): the lattice points on the cube's faces as ids (ix · n + iy) · n + iz, ascending, in
+   * the order ReadSurface gives their displacements.
+   */
+  const std::vector<std::int32_t>& surface_ids() const { return surface_.ids; }
+  /**
+   * Any thread, while the steps run: asks every region to publish its part of the surface after
+   * its next step, and returns the request's number for SurfaceServed. The steps stay real-time:
+   * each loads one atomic, and copies its part of the surface (no allocation) when asked.
+   */
+  std::uint64_t RequestSurface() noexcept;
+  /** Any thread: whether every region has published its part since request `request` was made
+   *  (a region that does not step — parked, or skipping a stall — publishes nothing). */
+  bool SurfaceServed(std::uint64_t request) const noexcept;
+  /**
+   * Any thread: the surface's displacements as the regions last published them, 3 per surface
+   * point in surface_ids' order, m. Each point has the value of the region that owns it, as
+   * CaptureState takes it (a hanging point its coarse cell's field); on real threads each region's
+   * part is as of its own last publication. Reset and RestoreState publish every part. False when
+   * a region's publication raced every attempt to read it. Allocates: not for a real-time thread.
+   */
+  bool ReadSurface(std::vector<double>* displacement_m) const;
+
+  /**
    * Primary thread: one primary step (a period, or one of its substeps). contact_next is the
    * contact displacement at the end of the step (m, object frame). Returns the reaction R at the
    * contact at the step's start time, N (the force on the user is −R).
@@ -309,6 +327,10 @@ class AsyncRegions {
   TrialResult RunTrialFromCurrentState(const InputSettings& input);
   void PublishInward(RegionIndex region) noexcept;
   void PublishOutward(RegionIndex region) noexcept;
+  /** After a step: the boundaries for the neighbours, and the surface if a reader asked. */
+  void PublishStep(RegionIndex region) noexcept;
+  void PublishSurface(Region& region) noexcept;
+  void BuildSurface();
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
@@ -346,6 +368,20 @@ class AsyncRegions {
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};
   double port_floor_j_ = 0;
+
+  // The surface (core/region_surface.cpp): each of its values (3 per point) is a sum of terms
+  // [term_start[v], term_start[v + 1]), each a weight times a region's published surface value.
+  struct SurfaceTerm {
+    RegionIndex region;
+    int slot;  // into that region's surface_dofs
+    double weight;
+  };
+  struct SurfaceMap {
+    std::vector<std::int32_t> ids;
+    std::vector<int> term_start;
+    std::vector<SurfaceTerm> terms;
+  } surface_;
+  std::atomic<std::uint64_t> surface_request_{0};
 };
 
 /**

@@ -14,6 +14,7 @@
 #include "core/element_set_stiffness.hpp"
 #include "core/region_integrator.hpp"
 #include "core/region_partition.hpp"
+#include "core/seqlock_array.hpp"
 
 namespace hapticsim {
 
@@ -73,6 +74,13 @@ struct AsyncRegions::Region {
   // The observer less the inner side's sums it has counted: the inner side adds its own sums
   // (known exactly) to this one number to see the observer as it would be (InwardPortLimit).
   std::atomic<double> excess_base_published{0};
+
+  // Its part of the object's surface (core/region_surface.cpp): the owned DOFs the surface needs,
+  // published after a step when a reader has asked since the last publication.
+  std::vector<int> surface_dofs;
+  std::unique_ptr<SeqlockArray> surface;
+  std::uint64_t surface_request_served = 0;  // this region's thread
+  std::atomic<std::uint64_t> surface_served{0};
 };
 
 }  // namespace hapticsim

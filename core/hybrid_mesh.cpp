@@ -190,6 +190,36 @@ int HybridMesh::IndependentAt(int ix, int iy, int iz) const {
   return node < 0 ? -1 : independent_of_node_[node];
 }
 
+int HybridMesh::FieldAt(const std::array<int, 3>& p, std::array<GatherTerm, 8>* terms) const {
+  if (const int node = IndependentAt(p[0], p[1], p[2]); node >= 0) {
+    (*terms)[0] = {node, 1.0};
+    return 1;
+  }
+  const int k = options_.coarse_factor;
+  const int last_cell = (options_.nodes_per_axis - 1) / k - 1;
+  std::array<int, 3> cell;
+  std::array<double, 3> t;
+  for (int d = 0; d < 3; ++d) {
+    cell[d] = std::min(p[d] / k, last_cell);
+    t[d] = static_cast<double>(p[d] - cell[d] * k) / k;
+  }
+  int count = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1;
+    std::array<int, 3> vertex;
+    for (int d = 0; d < 3; ++d) {
+      const int up = (corner >> d) & 1;
+      vertex[d] = (cell[d] + up) * k;
+      weight *= up ? t[d] : 1 - t[d];
+    }
+    if (weight == 0) continue;
+    const int node = IndependentAt(vertex[0], vertex[1], vertex[2]);
+    HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a coarse vertex is not a mesh node");
+    (*terms)[count++] = {node, weight};
+  }
+  return count;
+}
+
 Eigen::VectorXd HybridMesh::DofMass(double density_kg_m3) const {
   const int nr = num_independent();
   Eigen::VectorXd node_mass = Eigen::VectorXd::Zero(nr);

@@ -71,6 +71,15 @@ class HybridMesh {
 
   /** Independent index of the node at a lattice point, or −1 (no node there, or hanging). */
   int IndependentAt(int ix, int iy, int iz) const;
+  /**
+   * The mesh's displacement at any lattice point as a sum of independent nodes' values: an
+   * independent node's own (one term of weight 1); elsewhere — a point inside or on an unrefined
+   * coarse cell, a hanging node among them — the cell's trilinear field of its 8 vertices, which
+   * are always independent (terms of weight 0 left out). A point on a face shared with a refined
+   * cell gets the same field from either: it depends on the face's vertices alone. Returns the
+   * number of terms written.
+   */
+  int FieldAt(const std::array<int, 3>& point, std::array<GatherTerm, 8>* terms) const;
   /** Lattice indices of an independent node. */
   const std::array<int, 3>& LatticeOf(int independent) const {
     return independent_lattice_[independent];

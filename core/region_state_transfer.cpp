@@ -3,7 +3,7 @@
 // then injection into the new configuration's nodes; AsyncRegions::StartFrom, which SetRandomState
 // shares, starts the regions from such a state. See docs/regions.md, "Switching in contact".
 #include <Eigen/Core>
-#include <algorithm>
+#include <array>
 #include <string>
 
 #include "core/async_regions.hpp"
@@ -13,44 +13,20 @@
 namespace hapticsim {
 namespace {
 
-// Fills the lattice from the mesh's independent values: a lattice point with an independent node
-// takes its value; any other lies in a coarse cell that was not refined (or on its face, a
-// hanging node), where the mesh's displacement is the cell's trilinear field of its vertices —
-// which are always independent nodes. A point on a face shared with a refined cell gets the same
-// value from either cell: the field there depends on the face's four vertices alone.
+// Fills the lattice from the mesh's independent values (HybridMesh::FieldAt).
 void Prolong(const HybridMesh& mesh, const Eigen::VectorXd& values, std::vector<double>* lattice) {
   const int n = mesh.options().nodes_per_axis;
-  const int k = mesh.options().coarse_factor;
-  const int last_cell = (n - 1) / k - 1;
   lattice->assign(static_cast<size_t>(3) * n * n * n, 0.0);
   ObjectState index;
   index.nodes_per_axis = n;
+  std::array<GatherTerm, 8> terms;
   for (int ix = 0; ix < n; ++ix) {
     for (int iy = 0; iy < n; ++iy) {
       for (int iz = 0; iz < n; ++iz) {
         double* out = lattice->data() + index.Index(ix, iy, iz);
-        if (const int node = mesh.IndependentAt(ix, iy, iz); node >= 0) {
-          for (int c = 0; c < 3; ++c) out[c] = values[mesh.Dof(node, c)];
-          continue;
-        }
-        const std::array<int, 3> p{ix, iy, iz};
-        std::array<int, 3> cell;
-        std::array<double, 3> t;
-        for (int d = 0; d < 3; ++d) {
-          cell[d] = std::min(p[d] / k, last_cell);
-          t[d] = static_cast<double>(p[d] - cell[d] * k) / k;
-        }
-        for (int corner = 0; corner < 8; ++corner) {
-          double weight = 1;
-          std::array<int, 3> vertex;
-          for (int d = 0; d < 3; ++d) {
-            const int up = (corner >> d) & 1;
-            vertex[d] = (cell[d] + up) * k;
-            weight *= up ? t[d] : 1 - t[d];
-          }
-          const int node = mesh.IndependentAt(vertex[0], vertex[1], vertex[2]);
-          HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a coarse vertex is not a mesh node");
-          for (int c = 0; c < 3; ++c) out[c] += weight * values[mesh.Dof(node, c)];
+        const int count = mesh.FieldAt({ix, iy, iz}, &terms);
+        for (int i = 0; i < count; ++i) {
+          for (int c = 0; c < 3; ++c) out[c] += terms[i].weight * values[mesh.Dof(terms[i].independent, c)];
         }
       }
     }
