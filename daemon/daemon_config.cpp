@@ -46,90 +46,99 @@ int SmallInt(std::int64_t value) {
              : -1;
 }
 
-const std::map<std::string, Setter>& Setters() {
-  static const std::map<std::string, Setter> setters = [] {
-    std::map<std::string, Setter> s;
-    auto text = [&s](const std::string& key, std::string DaemonConfig::*field) {
-      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
-        c->*field = Get<std::string>(n, key, where, "a string");
-      };
+using SetterMap = std::map<std::string, Setter>;
+
+void Text(SetterMap& s, const std::string& key, std::string DaemonConfig::*field) {
+  s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+    c->*field = Get<std::string>(n, key, where, "a string");
+  };
+}
+void Real(SetterMap& s, const std::string& key, double DaemonConfig::*field) {
+  s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+    c->*field = Get<double>(n, key, where, "a number");
+  };
+}
+void Flag(SetterMap& s, const std::string& key, bool DaemonConfig::*field) {
+  s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+    c->*field = Get<bool>(n, key, where, "true or false");
+  };
+}
+
+// [device] and [realtime]: the force envelope and the region threads.
+void AddDeviceAndRealtimeKeys(SetterMap& s) {
+  Text(s, "device.input", &DaemonConfig::device_input);
+  auto port = [&s](const std::string& key, double PortGuardSettings::*field) {
+    s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
+      c->port.*field = Get<double>(n, key, where, "a number");
     };
-    auto real = [&s](const std::string& key, double DaemonConfig::*field) {
-      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
-        c->*field = Get<double>(n, key, where, "a number");
-      };
-    };
-    auto flag = [&s](const std::string& key, bool DaemonConfig::*field) {
-      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
-        c->*field = Get<bool>(n, key, where, "true or false");
-      };
-    };
-    text("scene.file", &DaemonConfig::scene_file);
-    flag("lcm.enabled", &DaemonConfig::lcm_enabled);
-    text("lcm.url", &DaemonConfig::lcm_url);
-    flag("lcm.allow_network", &DaemonConfig::lcm_allow_network);
-    text("lcm.device_channel", &DaemonConfig::device_channel);
-    text("lcm.force_channel", &DaemonConfig::force_channel);
-    text("lcm.status_channel", &DaemonConfig::status_channel);
-    text("lcm.command_channel", &DaemonConfig::command_channel);
-    flag("lcm.accept_commands", &DaemonConfig::lcm_accept_commands);
-    text("lcm.command_key_file", &DaemonConfig::lcm_command_key_file);
-    flag("control.enabled", &DaemonConfig::control_enabled);
-    text("control.socket", &DaemonConfig::control_socket);
-    text("control.group", &DaemonConfig::control_group);
-    flag("shm.enabled", &DaemonConfig::shm_enabled);
-    text("shm.socket", &DaemonConfig::shm_socket);
+  };
+  port("device.max_force_n", &PortGuardSettings::max_force_n);
+  port("device.max_force_rate_n_per_ms", &PortGuardSettings::max_force_rate_n_per_ms);
+  port("device.engage_rate_n_per_ms", &PortGuardSettings::engage_rate_n_per_ms);
+  port("device.fault_force_n", &PortGuardSettings::fault_force_n);
+  port("device.watchdog_s", &PortGuardSettings::watchdog_s);
+  port("device.max_damping_n_s_per_m", &PortGuardSettings::max_damping_n_s_per_m);
+  s["device.passivity"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
+    c->port.passivity = Get<bool>(n, "device.passivity", where, "true or false");
+  };
+  s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
+    c->fifo_priority =
+        SmallInt(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
+  };
+  s["realtime.cpus"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
+    const toml::array* list = n.as_array();
+    if (!list) throw Error(where + ": realtime.cpus must be a list of CPU numbers, e.g. [1]");
+    c->cpus.clear();
+    for (const toml::node& cpu : *list) {
+      c->cpus.push_back(SmallInt(Get<std::int64_t>(cpu, "realtime.cpus", where, "whole numbers")));
+    }
+  };
+  Flag(s, "realtime.lock_memory", &DaemonConfig::lock_memory);
+  Flag(s, "realtime.sleep_at_rest", &DaemonConfig::sleep_at_rest);
+}
+
+const SetterMap& Setters() {
+  static const SetterMap setters = [] {
+    SetterMap s;
+    Text(s, "scene.file", &DaemonConfig::scene_file);
+    Flag(s, "lcm.enabled", &DaemonConfig::lcm_enabled);
+    Text(s, "lcm.url", &DaemonConfig::lcm_url);
+    Flag(s, "lcm.allow_network", &DaemonConfig::lcm_allow_network);
+    Text(s, "lcm.device_channel", &DaemonConfig::device_channel);
+    Text(s, "lcm.force_channel", &DaemonConfig::force_channel);
+    Text(s, "lcm.status_channel", &DaemonConfig::status_channel);
+    Text(s, "lcm.command_channel", &DaemonConfig::command_channel);
+    Text(s, "lcm.deformation_channel", &DaemonConfig::deformation_channel);
+    Flag(s, "lcm.accept_commands", &DaemonConfig::lcm_accept_commands);
+    Text(s, "lcm.command_key_file", &DaemonConfig::lcm_command_key_file);
+    Flag(s, "control.enabled", &DaemonConfig::control_enabled);
+    Text(s, "control.socket", &DaemonConfig::control_socket);
+    Text(s, "control.group", &DaemonConfig::control_group);
+    Flag(s, "shm.enabled", &DaemonConfig::shm_enabled);
+    Text(s, "shm.socket", &DaemonConfig::shm_socket);
     s["shm.name"] = [](DaemonConfig*, const toml::node&, const std::string& where) {
       throw Error(where +
                   ": shm.name is gone: the segment has no name any more (no other process can "
                   "open or replace it). Drivers connect to shm.socket, a Unix socket path "
                   "(default /run/hapticsim/hapticsimd.sock), and get the segment from it");
     };
-    text("shm.group", &DaemonConfig::shm_group);
-    text("supervisor.error_map", &DaemonConfig::error_map);
-    real("supervisor.error_target_percent", &DaemonConfig::error_target_percent);
-    real("supervisor.status_rate_hz", &DaemonConfig::status_rate_hz);
-    real("input.stale_after_s", &DaemonConfig::stale_after_s);
-    flag("input.zero_force_when_stale", &DaemonConfig::zero_force_when_stale);
-    real("input.max_speed_m_per_s", &DaemonConfig::max_speed_m_per_s);
-    real("input.workspace_margin_m", &DaemonConfig::workspace_margin_m);
+    Text(s, "shm.group", &DaemonConfig::shm_group);
+    Text(s, "supervisor.error_map", &DaemonConfig::error_map);
+    Real(s, "supervisor.error_target_percent", &DaemonConfig::error_target_percent);
+    Real(s, "supervisor.status_rate_hz", &DaemonConfig::status_rate_hz);
+    Real(s, "input.stale_after_s", &DaemonConfig::stale_after_s);
+    Flag(s, "input.zero_force_when_stale", &DaemonConfig::zero_force_when_stale);
+    Real(s, "input.max_speed_m_per_s", &DaemonConfig::max_speed_m_per_s);
+    Real(s, "input.workspace_margin_m", &DaemonConfig::workspace_margin_m);
     s["input.max_force_n"] = [](DaemonConfig*, const toml::node&, const std::string& where) {
       throw Error(where +
                   ": input.max_force_n moved to [device] max_force_n, the device's force "
                   "ceiling (desktop devices: 8 N; a force above device.fault_force_n is a fault)");
     };
-    text("device.input", &DaemonConfig::device_input);
-    auto port = [&s](const std::string& key, double PortGuardSettings::*field) {
-      s[key] = [key, field](DaemonConfig* c, const toml::node& n, const std::string& where) {
-        c->port.*field = Get<double>(n, key, where, "a number");
-      };
-    };
-    port("device.max_force_n", &PortGuardSettings::max_force_n);
-    port("device.max_force_rate_n_per_ms", &PortGuardSettings::max_force_rate_n_per_ms);
-    port("device.engage_rate_n_per_ms", &PortGuardSettings::engage_rate_n_per_ms);
-    port("device.fault_force_n", &PortGuardSettings::fault_force_n);
-    port("device.watchdog_s", &PortGuardSettings::watchdog_s);
-    port("device.max_damping_n_s_per_m", &PortGuardSettings::max_damping_n_s_per_m);
-    s["device.passivity"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
-      c->port.passivity = Get<bool>(n, "device.passivity", where, "true or false");
-    };
-    s["realtime.fifo_priority"] = [](DaemonConfig* c, const toml::node& n, const std::string& w) {
-      c->fifo_priority =
-          SmallInt(Get<std::int64_t>(n, "realtime.fifo_priority", w, "a whole number"));
-    };
-    s["realtime.cpus"] = [](DaemonConfig* c, const toml::node& n, const std::string& where) {
-      const toml::array* list = n.as_array();
-      if (!list) throw Error(where + ": realtime.cpus must be a list of CPU numbers, e.g. [1]");
-      c->cpus.clear();
-      for (const toml::node& cpu : *list) {
-        c->cpus.push_back(
-            SmallInt(Get<std::int64_t>(cpu, "realtime.cpus", where, "whole numbers")));
-      }
-    };
-    flag("realtime.lock_memory", &DaemonConfig::lock_memory);
-    flag("realtime.sleep_at_rest", &DaemonConfig::sleep_at_rest);
-    text("log.level", &DaemonConfig::log_level);
-    real("log.max_lines_per_s", &DaemonConfig::max_log_lines_per_s);
+    AddDeviceAndRealtimeKeys(s);
+    Real(s, "deformation.rate_hz", &DaemonConfig::deformation_rate_hz);
+    Text(s, "log.level", &DaemonConfig::log_level);
+    Real(s, "log.max_lines_per_s", &DaemonConfig::max_log_lines_per_s);
     return s;
   }();
   return setters;
@@ -146,27 +155,11 @@ void DefaultAdaptivity(Scene* scene) {
   scene->adaptivity.secondary_rate_hz = PrimaryRateHz(*scene);
 }
 
-}  // namespace
-
-void ValidateDaemonConfig(const DaemonConfig& c) {
+// [device]'s force envelope: ceilings a hand and a desk set.
+void ValidatePortGuard(const PortGuardSettings& p) {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw Error(message);
   };
-  require(std::isfinite(c.error_target_percent) && c.error_target_percent > 0 &&
-              c.error_target_percent <= 100,
-          "supervisor.error_target_percent must be in (0, 100] %");
-  require(std::isfinite(c.status_rate_hz) && c.status_rate_hz >= 0.1 && c.status_rate_hz <= 100,
-          "supervisor.status_rate_hz must be from 0.1 to 100 Hz");
-  require(std::isfinite(c.stale_after_s) && c.stale_after_s >= 0.002 && c.stale_after_s <= 10,
-          "input.stale_after_s must be from 0.002 to 10 s");
-  // Ceilings a hand and a desk set: a limit of 1e300 checks nothing.
-  require(
-      std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0 && c.max_speed_m_per_s <= 100,
-      "input.max_speed_m_per_s must be in (0, 100] m/s; a hand moves at most a few m/s");
-  require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0 &&
-              c.workspace_margin_m <= 10,
-          "input.workspace_margin_m must be from 0 to 10 m");
-  const PortGuardSettings& p = c.port;
   auto value = [](double v) { return " (it is " + FormatReal(v) + ")"; };
   require(std::isfinite(p.max_force_n) && p.max_force_n > 0 && p.max_force_n <= 100,
           "device.max_force_n must be in (0, 100] N; desktop devices are rated 3–9 N peak" +
@@ -194,12 +187,38 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
       std::isfinite(p.max_damping_n_s_per_m) && p.max_damping_n_s_per_m >= 0 &&
           p.max_damping_n_s_per_m <= 1000,
       "device.max_damping_n_s_per_m must be from 0 to 1000 N·s/m" + value(p.max_damping_n_s_per_m));
+}
+
+}  // namespace
+
+void ValidateDaemonConfig(const DaemonConfig& c) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw Error(message);
+  };
+  require(std::isfinite(c.error_target_percent) && c.error_target_percent > 0 &&
+              c.error_target_percent <= 100,
+          "supervisor.error_target_percent must be in (0, 100] %");
+  require(std::isfinite(c.status_rate_hz) && c.status_rate_hz >= 0.1 && c.status_rate_hz <= 100,
+          "supervisor.status_rate_hz must be from 0.1 to 100 Hz");
+  require(std::isfinite(c.stale_after_s) && c.stale_after_s >= 0.002 && c.stale_after_s <= 10,
+          "input.stale_after_s must be from 0.002 to 10 s");
+  // Ceilings a hand and a desk set: a limit of 1e300 checks nothing.
+  require(
+      std::isfinite(c.max_speed_m_per_s) && c.max_speed_m_per_s > 0 && c.max_speed_m_per_s <= 100,
+      "input.max_speed_m_per_s must be in (0, 100] m/s; a hand moves at most a few m/s");
+  require(std::isfinite(c.workspace_margin_m) && c.workspace_margin_m >= 0 &&
+              c.workspace_margin_m <= 10,
+          "input.workspace_margin_m must be from 0 to 10 m");
+  ValidatePortGuard(c.port);
   require(c.device_input.empty() || c.device_input == "lcm" || c.device_input == "shm",
           "device.input must be \"lcm\" or \"shm\" (it is \"" + c.device_input + "\")");
   require(c.device_input != "shm" || c.shm_enabled,
           "device.input = \"shm\" needs shm.enabled = true");
   require(c.device_input != "lcm" || c.lcm_enabled,
           "device.input = \"lcm\" needs lcm.enabled = true");
+  require(std::isfinite(c.deformation_rate_hz) && c.deformation_rate_hz >= 0 &&
+              c.deformation_rate_hz <= 240,
+          "deformation.rate_hz must be from 0 (off) to 240 frames per second (a display's rate)");
   require(c.fifo_priority >= 0 && c.fifo_priority <= 99,
           "realtime.fifo_priority must be from 0 (off) to 99");
   for (int cpu : c.cpus) require(cpu >= 0 && cpu < 4096, "realtime.cpus: CPU numbers are >= 0");
@@ -213,7 +232,8 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   for (const auto& [key, channel] : {std::pair{"lcm.device_channel", &c.device_channel},
                                      {"lcm.force_channel", &c.force_channel},
                                      {"lcm.status_channel", &c.status_channel},
-                                     {"lcm.command_channel", &c.command_channel}}) {
+                                     {"lcm.command_channel", &c.command_channel},
+                                     {"lcm.deformation_channel", &c.deformation_channel}}) {
     require(!channel->empty() && channel->size() <= 63,
             std::string(key) + " must be a channel name of 1 to 63 characters");
   }
@@ -384,6 +404,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "force_channel = " << quote(c.force_channel) << "\n"
       << "status_channel = " << quote(c.status_channel) << "\n"
       << "command_channel = " << quote(c.command_channel) << "\n"
+      << "deformation_channel = " << quote(c.deformation_channel)
+      << "  # the deformed surface (deformation_t), at [deformation] rate_hz\n"
       << "accept_commands = " << (c.lcm_accept_commands ? "true" : "false")
       << "  # commands come from hapticsim ctl ([control]); true: signed LCM commands too\n"
       << "command_key_file = " << quote(c.lcm_command_key_file)
@@ -410,7 +432,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << (c.device_input.empty()
               ? "# input: unset, so shared memory's when [shm] enabled = true, else LCM's (now \"" +
                     DeviceInputOf(c) + "\")\n"
-              : "input = " + quote(c.device_input) + "  # \"lcm\" or \"shm\": the other is refused\n")
+              : "input = " + quote(c.device_input) +
+                    "  # \"lcm\" or \"shm\": the other is refused\n")
       << "max_force_n = " << real(c.port.max_force_n) << "\n"
       << "max_force_rate_n_per_ms = " << real(c.port.max_force_rate_n_per_ms) << "\n"
       << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"
@@ -423,6 +446,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
   out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n"
       << "sleep_at_rest = " << (c.sleep_at_rest ? "true" : "false")
       << "  # untouched and at rest: regions not stepped, ~0 CPU\n\n"
+      << "[deformation]  # the deformed surface out (deformation_t on lcm.deformation_channel)\n"
+      << "rate_hz = " << real(c.deformation_rate_hz) << "  # frames per second, 0: none\n\n"
       << "[log]\nlevel = " << quote(c.log_level) << "\n"
       << "max_lines_per_s = " << real(c.max_log_lines_per_s) << "\n";
   return out.str();

@@ -27,6 +27,7 @@ struct DaemonConfig {
   std::string force_channel = "HAPTIC_FORCE";
   std::string status_channel = "HAPTIC_STATUS";
   std::string command_channel = "HAPTIC_COMMAND";
+  std::string deformation_channel = "HAPTIC_DEFORMATION";  ///< deformation_t, at deformation_rate_hz
   /// Commands on command_channel are refused unless this is set: anyone who can send on the bus
   /// could otherwise reset the simulation or pin a configuration. `hapticsim ctl` uses [control].
   /// Set, only commands signed with the key in lcm_command_key_file are taken
@@ -61,6 +62,10 @@ struct DaemonConfig {
   std::vector<int> cpus;      ///< CPUs the region threads are pinned to (empty: any)
   bool lock_memory = false;   ///< mlockall(MCL_CURRENT | MCL_FUTURE)
   bool sleep_at_rest = true;  ///< regions at rest with nothing touching them are not stepped
+  // [deformation]: the deformed surface out, for a simulator or a viewer to draw
+  /// Frames per second of deformation_t on LCM and of the snapshot in every shared-memory
+  /// session (0: none); made by a thread of its own, off the real-time path.
+  double deformation_rate_hz = 60;
   // [log]
   std::string log_level = "info";   ///< trace, debug, info, warn, error
   double max_log_lines_per_s = 10;  ///< rate limit of repeated warnings

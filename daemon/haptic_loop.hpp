@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -148,6 +149,28 @@ class HapticLoop {
    *         left as it was).
    */
   void Reconfigure(const Scene& scene, Handover handover = Handover::kFromRest);
+  /** The object's deformed surface as the running regions published it (TakeSurface). */
+  struct SurfaceFrame {
+    /** Regions installed since the loop was made when it was taken: changes with every
+     *  Reconfigure (another configuration, a move, a restart). */
+    std::int64_t configuration_id = -1;
+    AdaptivitySettings configuration;    ///< the regions' (primary_size, secondary_lod, rates)
+    LatticeIndex centre{};               ///< the node the regions are centred on
+    bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
+    std::vector<std::int32_t> ids;       ///< AsyncRegions::surface_ids (the same for every one)
+    std::vector<double> displacement_m;  ///< 3 per id, m
+    std::int64_t asked_ns = 0;           ///< CLOCK_MONOTONIC when the regions were asked
+    bool complete = true;  ///< every region published after being asked (else its last part)
+  };
+  /**
+   * The deformation thread (any thread but the region threads): asks the running regions for the
+   * surface and waits until every region has published its part after its next step, at most
+   * `max_wait_ns` (a parked or stalled region keeps its last part; regions asleep are at rest
+   * and are read at once), then reads it into `frame`. The region threads only copy their part
+   * when asked (AsyncRegions::RequestSurface); the lock taken here is the supervisor's and this
+   * thread's alone. False when the regions were replaced meanwhile (ask again).
+   */
+  bool TakeSurface(std::int64_t max_wait_ns, SurfaceFrame* frame);
   /** The node the tool wants the regions centred on (see ContactTracker::wanted_node). */
   std::optional<LatticeIndex> wanted_contact_node() const;
   /** True while the tip is inside on a node the regions are not centred on (force zero). */
@@ -349,6 +372,10 @@ class HapticLoop {
   std::int64_t origin_ns_ = 0;         // the primary release grid: origin + k · period
   LatticeIndex centre_{};              // written only while the primary has paused the regions
   std::int64_t reconfigurations_ = 0;  // supervisor thread only
+  // Held by the supervisor while it replaces regions_ (Install) and by the deformation thread
+  // while it reads them (TakeSurface); never by a region thread.
+  std::mutex surface_mutex_;
+  std::int64_t installs_ = 0;  // under surface_mutex_
 
   // The handshake of a reconfiguration (supervisor ↔ primary thread).
   std::atomic<bool> pause_requested_{false}, paused_{false};

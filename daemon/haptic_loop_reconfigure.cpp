@@ -13,8 +13,12 @@
 namespace hapticsim {
 
 void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions) {
-  scene_ = scene;
-  regions_ = std::move(regions);
+  {
+    const std::lock_guard<std::mutex> lock(surface_mutex_);
+    scene_ = scene;
+    regions_ = std::move(regions);
+    ++installs_;
+  }
   centre_ = ContactNode(scene);
   const int count = regions_->num_regions();
   tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());

@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -54,6 +55,31 @@ LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters
   }
   lcm_.subscribe(config.device_channel, &LcmBridge::OnDevice, this)->setQueueCapacity(1000);
   lcm_.subscribe(config.command_channel, &LcmBridge::OnCommand, this)->setQueueCapacity(100);
+  LogRoute(config);
+}
+
+void LcmBridge::LogRoute(const DaemonConfig& config) {
+  spdlog::info("LCM on {} (device {}, force {}, status {}, command {}, deformation {})",
+               config.lcm_url, config.device_channel, config.force_channel, config.status_channel,
+               config.command_channel, config.deformation_channel);
+  if (const std::string source = MulticastSourceOffLoopback(config.lcm_url); !source.empty()) {
+    spdlog::warn(
+        "LCM's multicast group is routed off loopback (source address {}): machines on that "
+        "network can send device input to the daemon, and under the systemd unit, whose IP "
+        "filter admits only localhost, local LCM clients' packets (source {}) are dropped. "
+        "Route the group through loopback: ip route replace 224.0.0.0/4 dev lo",
+        source, source);
+  }
+  if (LcmUrlLeavesHost(config.lcm_url)) {
+    spdlog::warn(
+        "LCM traffic LEAVES THIS HOST (lcm.url = {}, allowed by lcm.allow_network = true): any "
+        "machine on that network can read the forces and send device input and commands",
+        config.lcm_url);
+  }
+}
+
+void LcmBridge::PublishDeformation(const deformation_t& frame) {
+  lcm_.publish(config_.deformation_channel, &frame);
 }
 
 void LcmBridge::OnDevice(const lcm::ReceiveBuffer* buffer, const std::string&) {

@@ -12,6 +12,7 @@
 #include "daemon/input_counters.hpp"
 #include "daemon/input_intake.hpp"
 #include "hapticsim/command_t.hpp"
+#include "hapticsim/deformation_t.hpp"
 #include "hapticsim/status_t.hpp"
 #include "ipc/command_signature.hpp"
 
@@ -49,6 +50,8 @@ class LcmBridge {
   void Poll(const timespec& timeout);
   void Publish(const ForceRecord& record);
   void PublishPendingStatus();
+  /** Any thread (LCM's calls are internally synchronized): the deformation thread's frames. */
+  void PublishDeformation(const deformation_t& frame);
 
   void PostStatus(const status_t& status);
   std::optional<command_t> PopCommand();
@@ -61,6 +64,8 @@ class LcmBridge {
   Refusals CommandRefusals();
 
  private:
+  // Says at start where LCM traffic goes, and warns where it reaches beyond this host's clients.
+  static void LogRoute(const DaemonConfig& config);
   void OnDevice(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void OnCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel);
 

@@ -42,6 +42,7 @@
 #include "daemon/control_line.hpp"
 #include "daemon/control_server.hpp"
 #include "daemon/daemon_config.hpp"
+#include "daemon/deformation_publisher.hpp"
 #include "daemon/error_map_loading.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
@@ -236,23 +237,6 @@ int Serve(const Arguments& args) {
   std::unique_ptr<LcmBridge> bridge;
   if (config.lcm_enabled) {
     bridge = std::make_unique<LcmBridge>(config, loop, counters, LcmCommandGateOf(config));
-    spdlog::info("LCM on {} (device {}, force {}, status {}, command {})", config.lcm_url,
-                 config.device_channel, config.force_channel, config.status_channel,
-                 config.command_channel);
-    if (const std::string source = MulticastSourceOffLoopback(config.lcm_url); !source.empty()) {
-      spdlog::warn(
-          "LCM's multicast group is routed off loopback (source address {}): machines on that "
-          "network can send device input to the daemon, and under the systemd unit, whose IP "
-          "filter admits only localhost, local LCM clients' packets (source {}) are dropped. "
-          "Route the group through loopback: ip route replace 224.0.0.0/4 dev lo",
-          source, source);
-    }
-    if (LcmUrlLeavesHost(config.lcm_url)) {
-      spdlog::warn(
-          "LCM traffic LEAVES THIS HOST (lcm.url = {}, allowed by lcm.allow_network = true): any "
-          "machine on that network can read the forces and send device input and commands",
-          config.lcm_url);
-    }
   }
   std::unique_ptr<ShmServer> shm;
   if (config.shm_enabled) {
@@ -331,6 +315,8 @@ int Serve(const Arguments& args) {
   }
   systemd.Notify("READY=1\nSTATUS=serving");
   spdlog::info("serving: {} regions running", loop.regions().num_regions());
+  std::optional<DeformationPublisher> deformation;  // the deformed surface out, off the RT path
+  if (config.deformation_rate_hz > 0) deformation.emplace(config, loop, bridge.get());
 
   std::vector<MissLogger> miss_loggers;
   // One per region thread; the count changes when a reconfiguration changes the regions.
@@ -849,6 +835,7 @@ int Serve(const Arguments& args) {
   mover.RequestStop();
   stop_io = true;
   if (io.joinable()) io.join();
+  deformation.reset();
   loop.Stop();
   for (auto& m : miss_loggers) m.Flush(HapticLoop::NowNs(), true);
   spdlog::info("stopped cleanly");

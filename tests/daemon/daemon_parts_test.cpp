@@ -131,6 +131,14 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 120\n").find("realtime.fifo_priority"),
             std::string::npos);
+  for (const char* rate : {"-1", "1000", "nan", "\"fast\""}) {
+    const std::string text = std::string("[deformation]\nrate_hz = ") + rate + "\n";
+    EXPECT_NE(ConfigError(text).find("deformation.rate_hz must be"), std::string::npos)
+        << ConfigError(text);
+  }
+  EXPECT_NE(ConfigError("[lcm]\ndeformation_channel = \"\"\n")
+                .find("lcm.deformation_channel must be a channel name"),
+            std::string::npos);
   EXPECT_NE(ConfigError("[realtime]\nsleep_at_rest = 3\n")
                 .find("realtime.sleep_at_rest must be true or false"),
             std::string::npos)

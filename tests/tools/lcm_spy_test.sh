@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # lcm-spy on a running hapticsimd, the way docs/operations.md says to open it: under Xvfb, in the
 # private network namespace this test runs in (tests/support/in_private_netns.sh). Passes when
-# lcm-spy starts, finds the hapticsim types on its class path ("Found N LCM types", N ≥ 5) and is
+# lcm-spy starts, finds the hapticsim types on its class path ("Found N LCM types", N ≥ 6: deformation_t among them) and is
 # still running after the daemon and a simulated device have talked for two seconds.
 # Usage: lcm_spy_test.sh HAPTICSIMD HAPTICSIM LCM_SPY_SH WORK_DIR
 set -euo pipefail
@@ -29,7 +29,7 @@ for _ in $(seq 1 100); do
   sleep 0.1
 done
 found=$(sed -n 's/^Found \([0-9]*\) LCM types.*/\1/p' "$work/spy.log" | head -1)
-if [ -z "$found" ] || [ "$found" -lt 5 ]; then
+if [ -z "$found" ] || [ "$found" -lt 6 ]; then
   echo "lcm-spy did not find the hapticsim types; its output:"; cat "$work/spy.log"; exit 1
 fi
 kill -0 "$spy_pid" 2>/dev/null || { echo "lcm-spy exited:"; cat "$work/spy.log"; exit 1; }

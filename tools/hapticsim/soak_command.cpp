@@ -27,6 +27,7 @@
 #include "device/device_session.hpp"
 #include "ipc/control_client.hpp"
 #include "tools/hapticsim/command.hpp"
+#include "tools/hapticsim/deformation_watch.hpp"
 #include "tools/hapticsim/device_report.hpp"
 #include "tools/hapticsim/line_chart.hpp"
 
@@ -51,6 +52,7 @@ struct SoakOptions {
   double min_answered_percent = 95;
   bool no_port_guard = false;  // hapticsimd --no-port-guard: the coupling alone behind the port
   double switch_every_s = 0;   // pin another configuration this often (0: never)
+  double deformation_rate_hz = 60;  // the daemon's [deformation] rate_hz, watched on LCM
   bool json = false;
 };
 
@@ -215,7 +217,8 @@ int RunSoak(const SoakOptions& o) {
   {
     std::ofstream c(config);
     c << "# written by hapticsim soak\n[shm]\nenabled = true\nsocket = \"" << shm_socket << "\"\n"
-      << "[control]\nsocket = \"" << control_socket << "\"\n";
+      << "[control]\nsocket = \"" << control_socket << "\"\n"
+      << "[deformation]\nrate_hz = " << o.deformation_rate_hz << "\n";
     if (!o.error_map.empty()) {
       c << "[supervisor]\nerror_map = \"" << fs::absolute(o.error_map).string() << "\"\n";
     }
@@ -264,6 +267,7 @@ int RunSoak(const SoakOptions& o) {
   }
   auto monitor = device::MakeLcmLink(device::kHostLocalLcmUrl, "HAPTIC_DEVICE", "HAPTIC_FORCE",
                                      "HAPTIC_STATUS");
+  DeformationWatch deformation(device::kHostLocalLcmUrl, "HAPTIC_DEFORMATION");
 
   // Load as on a user's desktop: busy threads at normal priority, no real-time privileges, for
   // the whole run.
@@ -318,6 +322,7 @@ int RunSoak(const SoakOptions& o) {
       });
   if (terminal) std::fprintf(stderr, "\n");
   sampling = false;
+  deformation.Stop();
   sampler.join();
   switcher.Join();
   const double load_cpu_s = load->Stop();
@@ -374,6 +379,10 @@ int RunSoak(const SoakOptions& o) {
       {"configurations_switched",
        o.switch_every_s <= 0 || (switcher.refused == 0 && switcher.ok >= 2 &&
                                  last_status.reconfigurations >= switcher.ok - 1)},
+      // The deformed surface at its rate (a tenth may be lost to a loaded host) and finite.
+      {"deformation_at_rate",
+       deformation.frames() >= 0.9 * o.deformation_rate_hz * (o.duration_s - 1) &&
+           deformation.Summary()["deformation_nonfinite"] == 0},
       {"daemon_stopped_cleanly", clean_exit}};
   bool passed = true;
   for (const auto& [name, ok] : checks.items()) passed = passed && ok.get<bool>();
@@ -429,6 +438,8 @@ int RunSoak(const SoakOptions& o) {
        {{"json", (dir / "soak.json").string()},
         {"html", (dir / "soak.html").string()},
         {"daemon_log", log.string()}}}};
+  summary["deformation_rate_hz"] = o.deformation_rate_hz;
+  summary.update(deformation.Summary());
   nlohmann::json full = summary;
   full["device"] = ReportJson(report);
   nlohmann::json samples = nlohmann::json::array();
@@ -543,6 +554,11 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
                   "`hapticsim ctl pin` does): the daemon switches them in contact too, carrying "
                   "the object's motion; checks every pin but the last switched. 0: never")
       ->check(CLI::NonNegativeNumber);
+  app->add_option("--deformation-rate", options->deformation_rate_hz,
+                  "The daemon's deformed-surface frames per second ([deformation] rate_hz, Hz; "
+                  "0: none), received on LCM as a viewer would")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 240.0));
   app->add_flag("--json", options->json, "Print the summary as JSON");
   return {app, [options, argc, argv] {
             if (!std::getenv(kInNetnsVariable)) ReexecInPrivateNetns(argc, argv);

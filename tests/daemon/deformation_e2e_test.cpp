@@ -1,0 +1,184 @@
+// The deformed surface out of a running hapticsimd (deformation_t on LCM), end to end on a real
+// LCM bus inside the private network namespace the test binary runs in
+// (tests/support/in_private_netns.sh). Checked against what the test itself drives: the tool's
+// depth at the touched node, a surface at rest before the touch, and the frame rate asked for.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "hapticsim/deformation_t.hpp"
+#include "tests/support/daemon_harness.hpp"
+#include "tests/support/private_socket.hpp"
+#include "tests/support/run_command.hpp"
+
+namespace hapticsim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Every deformation_t on HAPTIC_DEFORMATION, with when it arrived.
+class DeformationListener {
+ public:
+  DeformationListener() : lcm_("udpm://239.255.76.67:7667?ttl=0") {
+    EXPECT_TRUE(lcm_.good());
+    lcm_.subscribe("HAPTIC_DEFORMATION", &DeformationListener::On, this)->setQueueCapacity(1000);
+    thread_ = std::thread([this] {
+      while (!stop_) lcm_.handleTimeout(10);
+    });
+  }
+  ~DeformationListener() {
+    stop_ = true;
+    thread_.join();
+  }
+  struct Received {
+    deformation_t message;
+    Clock::time_point at;
+  };
+  std::vector<Received> Frames() {
+    std::lock_guard lock(mutex_);
+    return frames_;
+  }
+
+ private:
+  void On(const lcm::ReceiveBuffer*, const std::string&, const deformation_t* d) {
+    std::lock_guard lock(mutex_);
+    frames_.push_back({*d, Clock::now()});
+  }
+  lcm::LCM lcm_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  std::mutex mutex_;
+  std::vector<Received> frames_;
+};
+
+// The displacement of node `id` in frame `d`, given the ids last sent; nullopt if it has none.
+std::optional<std::array<float, 3>> NodeDisplacement(const deformation_t& d,
+                                                     const std::vector<int32_t>& ids, int32_t id) {
+  const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+  if (it == ids.end() || *it != id || ids.size() != static_cast<size_t>(d.num_nodes)) {
+    return std::nullopt;
+  }
+  const auto& row = d.displacement_m[it - ids.begin()];
+  return std::array<float, 3>{row[0], row[1], row[2]};
+}
+
+TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthAtTheTouchedNode) {
+  const std::string dir = ::testing::TempDir() + "hapticsimd_deformation";
+  std::filesystem::create_directories(dir);
+  const std::string config = dir + "/hapticsimd.toml", control = testing::PrivateSocketPath();
+  std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
+                        << "[control]\nsocket = \"" << control << "\"\n"
+                        << "[deformation]\nrate_hz = 60\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, dir + "/daemon.log");
+  DeformationListener listener;
+  testing::Client client;
+  testing::WaitUntilServing(daemon);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // asleep at rest: frames still
+
+  // The default cube: 13 nodes per axis, the touched node (6, 6, 0) in the middle of the front
+  // face; pressing in is +z. 1 cm in over 0.5 s, then held for 0.8 s.
+  constexpr double kEdge = 0.25, kDepth = 0.01;
+  constexpr int n = 13;
+  // A support (a back corner, held at zero) and the front face's corner beside the touched node.
+  constexpr int32_t kTouched = (6 * n + 6) * n + 0, kSupport = (0 * n + 0) * n + (n - 1),
+                    kFrontCorner = 0;
+  const auto press_start = Clock::now();
+  auto next = press_start;
+  for (std::int64_t seq = 1; seq <= 1600; ++seq) {
+    const double z = seq <= 300 ? -0.005 : kDepth * std::min(1.0, (seq - 300) / 500.0);
+    client.Send(seq, kEdge / 2, kEdge / 2, z);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::vector<DeformationListener::Received> frames = listener.Frames();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  std::filesystem::remove_all(std::filesystem::path(control).parent_path());
+  ASSERT_GT(frames.size(), 100u) << daemon.Log();
+
+  // Ids: all of them in the first frame, again at least every second, ascending; the surface of
+  // a 13³ lattice has 13³ − 11³ nodes.
+  const deformation_t& first = frames.front().message;
+  ASSERT_EQ(first.num_ids, n * n * n - 11 * 11 * 11);
+  EXPECT_EQ(first.nodes_per_axis, n);
+  EXPECT_DOUBLE_EQ(first.spacing_m, kEdge / (n - 1));
+  EXPECT_TRUE(std::is_sorted(first.node_ids.begin(), first.node_ids.end()));
+  std::vector<int32_t> ids;
+  Clock::time_point ids_at = frames.front().at;
+  double largest_id_gap_s = 0, largest_latency_ms = 0;
+  int at_rest_before = 0, frames_in_press = 0, held = 0;
+  int64_t lost = 0;
+  float touched_held_z = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const deformation_t& d = frames[i].message;
+    if (d.num_ids > 0) {
+      ids = d.node_ids;
+      largest_id_gap_s =
+          std::max(largest_id_gap_s, std::chrono::duration<double>(frames[i].at - ids_at).count());
+      ids_at = frames[i].at;
+    }
+    if (i > 0) lost += d.frame - frames[i - 1].message.frame - 1;
+    ASSERT_EQ(d.num_nodes, first.num_ids);
+    largest_latency_ms = std::max(largest_latency_ms, static_cast<double>(d.latency_ms));
+    float largest = 0;
+    for (const auto& row : d.displacement_m) {
+      for (float v : row) {
+        ASSERT_TRUE(std::isfinite(v));
+        largest = std::max(largest, std::abs(v));
+      }
+    }
+    const double since_press = std::chrono::duration<double>(frames[i].at - press_start).count();
+    if (since_press < 0) {
+      EXPECT_LT(largest, 1e-6) << "the surface moved before anything touched it";
+      ++at_rest_before;
+      continue;
+    }
+    ++frames_in_press;
+    // Held at 1 cm for the last 0.8 s: from 0.9 s (the regions have followed the tip) to 1.55 s.
+    if (since_press > 0.9 && since_press < 1.55) {
+      const auto touched = NodeDisplacement(d, ids, kTouched);
+      const auto support = NodeDisplacement(d, ids, kSupport);
+      const auto corner = NodeDisplacement(d, ids, kFrontCorner);
+      ASSERT_TRUE(touched && support && corner);
+      EXPECT_TRUE(d.in_contact);
+      // The touched node is where the tool is (the daemon follows the tip within a few periods).
+      EXPECT_NEAR((*touched)[2], kDepth, 5e-4) << "frame " << d.frame;
+      EXPECT_LT(std::abs((*touched)[0]) + std::abs((*touched)[1]), 1e-4);
+      // The support stays where it is; the front face's corner, 18 cm from the tool, is drawn
+      // in far less than the touched node.
+      EXPECT_EQ((*support)[0], 0.0f);
+      EXPECT_EQ((*support)[2], 0.0f);
+      EXPECT_LT(std::abs((*corner)[2]), 0.5 * kDepth);
+      EXPECT_GT((*corner)[2], 0.0f) << "the whole cube is drawn in by the press";
+      touched_held_z = (*touched)[2];
+      ++held;
+    }
+  }
+  EXPECT_GT(at_rest_before, 30) << "frames while asleep before the press";
+  EXPECT_GT(held, 30);
+  EXPECT_NEAR(touched_held_z, kDepth, 5e-4);
+  EXPECT_LE(largest_id_gap_s, 1.0 + 0.1);
+  // 60 frames per second: over the 1.6 s press, 96; the daemon may lose a few on a busy host.
+  const double press_s = 1.7;
+  EXPECT_NEAR(frames_in_press / press_s, 60.0, 6.0) << frames_in_press << " frames";
+  EXPECT_LE(lost, static_cast<int64_t>(frames.size() / 50)) << "frames lost on the way";
+  EXPECT_LT(largest_latency_ms, 40.0);
+  std::printf(
+      "deformation: %zu frames, %d in the press, touched node held at %.5f m, largest "
+      "latency %.2f ms, ids every %.2f s at most, %lld lost\n",
+      frames.size(), frames_in_press, touched_held_z, largest_latency_ms, largest_id_gap_s,
+      static_cast<long long>(lost));
+}
+
+}  // namespace
+}  // namespace hapticsim
