@@ -181,8 +181,8 @@ class AsyncRegions {
   void RestoreState(const ObjectState& state);
 
   /**
-   * The object's surface, for drawing it (hapticsimd's deformation_t, `hapticsim simulate
-   * --vtk`): the lattice points on the cube's faces as ids (ix · n + iy) · n + iz, ascending, in
+   * The object's surface, for drawing it while the regions run (hapticsimd's deformation_t):
+   * the lattice points on the cube's faces as ids (ix · n + iy) · n + iz, ascending, in
    * the order ReadSurface gives their displacements.
    */
   const std::vector<std::int32_t>& surface_ids() const { return surface_.ids; }
@@ -195,6 +195,9 @@ class AsyncRegions {
   /** Any thread: whether every region has published its part since request `request` was made
    *  (a region that does not step — parked, or skipping a stall — publishes nothing). */
   bool SurfaceServed(std::uint64_t request) const noexcept;
+  /** Times region `region` has published its part of the surface (Reset, RestoreState and the
+   *  steps asked to). Any thread. */
+  std::uint64_t surface_publications(RegionIndex region) const noexcept;
   /**
    * Any thread: the surface's displacements as the regions last published them, 3 per surface
    * point in surface_ids' order, m. Each point has the value of the region that owns it, as
@@ -286,6 +289,9 @@ class AsyncRegions {
   TrialResult RunTrial();
   /** A trial of another input on the same regions (the sweep reuses one set per configuration). */
   TrialResult RunTrial(const InputSettings& input);
+  /** The scene's own input, from rest, with frames of the whole object (CaptureState) as asked:
+   *  what `hapticsim simulate --vtk` writes. */
+  TrialResult RunTrial(const TrialFrames& frames);
   /**
    * The same trial from SetRandomState(seed) instead of rest, so every mode starts excited (the
    * stability stress test: an unstable mode cannot hide behind a smooth input).
@@ -324,7 +330,8 @@ class AsyncRegions {
   /** Reset, then every region's copy of the state set to displacements `u` and velocities `v`
    *  (u⁻ = u − v·h with its own substep h), the boundaries published from it. */
   void StartFrom(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
-  TrialResult RunTrialFromCurrentState(const InputSettings& input);
+  TrialResult RunTrialFromCurrentState(const InputSettings& input,
+                                       const TrialFrames& frames = {});
   void PublishInward(RegionIndex region) noexcept;
   void PublishOutward(RegionIndex region) noexcept;
   /** After a step: the boundaries for the neighbours, and the surface if a reader asked. */

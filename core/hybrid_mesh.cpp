@@ -220,6 +220,37 @@ int HybridMesh::FieldAt(const std::array<int, 3>& p, std::array<GatherTerm, 8>* 
   return count;
 }
 
+std::vector<RegionIndex> HybridMesh::RegionPerLatticeCell() const {
+  const int n = options_.nodes_per_axis;
+  // Each element's corner 0 (local offsets 0, 0, 0) is its lowest lattice point.
+  std::vector<std::array<int, 3>> lattice_of_node(gather_start_.size() - 1, {-1, -1, -1});
+  for (int iz = 0; iz < n; ++iz) {
+    for (int iy = 0; iy < n; ++iy) {
+      for (int ix = 0; ix < n; ++ix) {
+        const int node = node_at_lattice_[ix + n * (iy + n * iz)];
+        if (node >= 0) lattice_of_node[node] = {ix, iy, iz};
+      }
+    }
+  }
+  std::vector<RegionIndex> region(static_cast<size_t>(n - 1) * (n - 1) * (n - 1), -1);
+  for (const HybridElement& element : elements_) {
+    const std::array<int, 3> origin = lattice_of_node[element.nodes[0]];
+    HAPTICSIM_THROW_UNLESS(origin[0] >= 0, "internal: an element's corner is not on the lattice");
+    const int s = element.size_factor;
+    for (int dx = 0; dx < s; ++dx) {
+      for (int dy = 0; dy < s; ++dy) {
+        for (int dz = 0; dz < s; ++dz) {
+          const size_t cell =
+              (static_cast<size_t>(origin[0] + dx) * (n - 1) + origin[1] + dy) * (n - 1) +
+              origin[2] + dz;
+          region[cell] = element.region;
+        }
+      }
+    }
+  }
+  return region;
+}
+
 Eigen::VectorXd HybridMesh::DofMass(double density_kg_m3) const {
   const int nr = num_independent();
   Eigen::VectorXd node_mass = Eigen::VectorXd::Zero(nr);

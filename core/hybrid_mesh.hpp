@@ -80,6 +80,11 @@ class HybridMesh {
    * number of terms written.
    */
   int FieldAt(const std::array<int, 3>& point, std::array<GatherTerm, 8>* terms) const;
+  /**
+   * The region of the element covering each fine lattice cell ((n − 1)³ cells, ix slowest): a
+   * coarse element gives its region to the k³ fine cells inside it.
+   */
+  std::vector<RegionIndex> RegionPerLatticeCell() const;
   /** Lattice indices of an independent node. */
   const std::array<int, 3>& LatticeOf(int independent) const {
     return independent_lattice_[independent];

@@ -7,6 +7,29 @@
 #include "core/contact_trajectory.hpp"
 
 namespace hapticsim {
+namespace {
+
+// The integrator's displacement in the lattice's order (the grid's nodes are its points).
+ObjectState LatticeState(const ElasticModel& model, const CentralDifferenceIntegrator& integrator) {
+  const HexGrid& grid = model.grid();
+  ObjectState state;
+  state.nodes_per_axis = grid.nx();
+  const int n = state.nodes_per_axis;
+  state.displacement_m.resize(static_cast<size_t>(3) * n * n * n);
+  const Eigen::VectorXd& u = integrator.displacement();
+  for (int ix = 0; ix < n; ++ix) {
+    for (int iy = 0; iy < n; ++iy) {
+      for (int iz = 0; iz < n; ++iz) {
+        const int node = grid.Node(ix, iy, iz);
+        for (int c = 0; c < 3; ++c)
+          state.displacement_m[state.Index(ix, iy, iz) + c] = u[grid.Dof(node, c)];
+      }
+    }
+  }
+  return state;
+}
+
+}  // namespace
 
 std::string_view TrialOutcomeName(TrialOutcome outcome) {
   switch (outcome) {
@@ -47,6 +70,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
   std::array<double, 3> reaction_at_start{};
   for (long n = 0; n <= steps; ++n) {
     const double t = n * dt;
+    if (options.frames.Due(n)) options.frames.observe(t, LatticeState(model, integrator));
     StepStatus status = StepStatus::kOk;
     for (int q = 1; q <= result.substeps && status == StepStatus::kOk; ++q) {
       status = integrator.Step(trajectory.DisplacementAt(t + q * h));

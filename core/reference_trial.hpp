@@ -1,10 +1,12 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string_view>
 #include <vector>
 
 #include "core/cube_scene.hpp"
+#include "core/object_state.hpp"
 #include "core/stability_estimate.hpp"
 
 namespace hapticsim {
@@ -41,6 +43,17 @@ struct TrialResult {
   }
 };
 
+/**
+ * Frames of a trial for looking at it offline (hapticsim simulate --vtk): the whole object's
+ * displacement on the fine lattice (ObjectState, velocities left empty) at the start of every
+ * `every_periods`-th period of solver.dt from period 0, with that period's time, s.
+ */
+struct TrialFrames {
+  long every_periods = 0;  ///< 0: no frames
+  std::function<void(double t_s, const ObjectState& state)> observe;
+  bool Due(long period) const { return every_periods > 0 && period % every_periods == 0; }
+};
+
 struct TrialOptions {
   /** Run even when the prediction says dt is past the stability limit (to watch detection). */
   bool run_if_predicted_unstable = false;
@@ -50,6 +63,7 @@ struct TrialOptions {
    * sample per dt. (The paper: "a sufficiently low time-step to maintain stability".)
    */
   bool substep_to_stability = false;
+  TrialFrames frames;
 };
 
 /**

@@ -78,6 +78,10 @@ bool AsyncRegions::SurfaceServed(std::uint64_t request) const noexcept {
   });
 }
 
+std::uint64_t AsyncRegions::surface_publications(RegionIndex region) const noexcept {
+  return regions_[region]->surface->writes();
+}
+
 bool AsyncRegions::ReadSurface(std::vector<double>* displacement_m) const {
   constexpr int kAttempts = 64;
   std::vector<std::vector<double>> parts(regions_.size());

@@ -216,9 +216,10 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
           "device.input = \"shm\" needs shm.enabled = true");
   require(c.device_input != "lcm" || c.lcm_enabled,
           "device.input = \"lcm\" needs lcm.enabled = true");
-  require(std::isfinite(c.deformation_rate_hz) && c.deformation_rate_hz >= 0 &&
-              c.deformation_rate_hz <= 240,
-          "deformation.rate_hz must be from 0 (off) to 240 frames per second (a display's rate)");
+  require(
+      c.deformation_rate_hz == 0 || (c.deformation_rate_hz >= 1 && c.deformation_rate_hz <= 240),
+      "deformation.rate_hz must be 0 (off) or from 1 to 240 frames per second (a display's "
+      "rate)");
   require(c.fifo_priority >= 0 && c.fifo_priority <= 99,
           "realtime.fifo_priority must be from 0 (off) to 99");
   for (int cpu : c.cpus) require(cpu >= 0 && cpu < 4096, "realtime.cpus: CPU numbers are >= 0");

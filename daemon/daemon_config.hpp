@@ -63,8 +63,8 @@ struct DaemonConfig {
   bool lock_memory = false;   ///< mlockall(MCL_CURRENT | MCL_FUTURE)
   bool sleep_at_rest = true;  ///< regions at rest with nothing touching them are not stepped
   // [deformation]: the deformed surface out, for a simulator or a viewer to draw
-  /// Frames per second of deformation_t on LCM and of the snapshot in every shared-memory
-  /// session (0: none); made by a thread of its own, off the real-time path.
+  /// Frames per second of deformation_t on LCM (0: none; else 1 to 240); made by a thread of its
+  /// own, off the real-time path.
   double deformation_rate_hz = 60;
   // [log]
   std::string log_level = "info";   ///< trace, debug, info, warn, error

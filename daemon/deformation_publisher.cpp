@@ -32,6 +32,7 @@ deformation_t DeformationPublisher::Message(const HapticLoop::SurfaceFrame& fram
   out.secondary_rate_hz = frame.configuration.secondary_rate_hz;
   for (int c = 0; c < 3; ++c) out.contact_node[c] = frame.centre[c];
   out.in_contact = frame.in_contact;
+  out.complete = frame.complete;
   out.nodes_per_axis = scene.mesh.nodes;
   out.spacing_m = scene.mesh.edge_m / (scene.mesh.nodes - 1);
   if (with_ids) out.node_ids = frame.ids;
@@ -55,12 +56,15 @@ void DeformationPublisher::Run() {
   while (!stop_.load()) {
     const std::int64_t now = HapticLoop::NowNs();
     if (now < next_ns) {
-      std::this_thread::sleep_for(std::chrono::nanoseconds(std::min(next_ns - now, 20'000'000L)));
+      std::this_thread::sleep_for(
+          std::chrono::nanoseconds(std::min<std::int64_t>(next_ns - now, 20'000'000)));
       continue;
     }
     // The next frame on the grid, not a burst to catch up after a late one.
     next_ns += period_ns * std::max<std::int64_t>(1, (now - next_ns) / period_ns + 1);
-    if (!loop_.TakeSurface(period_ns, &frame)) continue;  // regions replaced: the next frame
+    // A region that has not stepped within this long is stalled: its last part is sent.
+    const std::int64_t max_wait_ns = std::min<std::int64_t>(period_ns, 50'000'000);
+    if (!loop_.TakeSurface(max_wait_ns, &frame)) continue;  // regions replaced: the next frame
     const bool with_ids = frame.configuration_id != ids_configuration ||
                           HapticLoop::NowNs() - ids_sent_ns >= kIdsEvery_s * 1e9;
     deformation_t message = Message(frame, config_.scene, number, with_ids);

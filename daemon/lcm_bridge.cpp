@@ -79,6 +79,7 @@ void LcmBridge::LogRoute(const DaemonConfig& config) {
 }
 
 void LcmBridge::PublishDeformation(const deformation_t& frame) {
+  std::lock_guard lock(publish_mutex_);
   lcm_.publish(config_.deformation_channel, &frame);
 }
 
@@ -126,7 +127,10 @@ void LcmBridge::Publish(const ForceRecord& record) {
   for (int c = 0; c < 3; ++c) out.force[c] = record.force_n[c];
   out.error_percent = record.error_percent;
   out.flags = record.flags;
-  lcm_.publish(config_.force_channel, &out);
+  {
+    std::lock_guard lock(publish_mutex_);
+    lcm_.publish(config_.force_channel, &out);
+  }
   counters_.forces_published.fetch_add(1);
 }
 
@@ -154,7 +158,10 @@ void LcmBridge::PublishPendingStatus() {
     std::lock_guard lock(mutex_);
     status.swap(status_);
   }
-  if (status) lcm_.publish(config_.status_channel, &*status);
+  if (status) {
+    std::lock_guard lock(publish_mutex_);
+    lcm_.publish(config_.status_channel, &*status);
+  }
 }
 
 }  // namespace hapticsim

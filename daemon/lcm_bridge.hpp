@@ -50,7 +50,7 @@ class LcmBridge {
   void Poll(const timespec& timeout);
   void Publish(const ForceRecord& record);
   void PublishPendingStatus();
-  /** Any thread (LCM's calls are internally synchronized): the deformation thread's frames. */
+  /** The deformation thread's frames (publishes serialised with the I/O thread's). */
   void PublishDeformation(const deformation_t& frame);
 
   void PostStatus(const status_t& status);
@@ -74,6 +74,9 @@ class LcmBridge {
   lcm::LCM lcm_;
   InputIntake intake_;
   std::optional<SignedCommandGate> gate_;  // the I/O thread's alone
+  // Held around every publish: the I/O thread's and the deformation thread's. LCM's udpm and memq
+  // providers lock their own sends, its tcpq provider does not (a message is several writes).
+  std::mutex publish_mutex_;
   std::mutex mutex_;  // guards what follows (never touched by real-time threads)
   std::optional<status_t> status_;
   std::deque<command_t> commands_;

@@ -13,6 +13,7 @@ packages=(
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libspdlog-dev default-jdk-headless
   iproute2 util-linux systemd strace
   python3 universal-ctags
+  python3-vtk9 python3-numpy
   libopenmpi-dev openmpi-bin
   chromium
   xvfb

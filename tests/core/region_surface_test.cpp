@@ -112,12 +112,24 @@ TEST(RegionSurface, IsPublishedByTheNextStepOfEveryRegionWhenAsked) {
     }
     return contact;
   };
+  std::vector<std::uint64_t> at_rest;
+  for (int a = 0; a < regions.num_regions(); ++a) {
+    at_rest.push_back(regions.surface_publications(a));
+    EXPECT_GE(at_rest.back(), 1u) << "the constructor's Reset publishes every part";
+  }
   press(250, false);
+  for (int a = 0; a < regions.num_regions(); ++a) {
+    EXPECT_EQ(regions.surface_publications(a), at_rest[a])
+        << "region " << a << " published unasked";
+  }
   const std::uint64_t request = regions.RequestSurface();
   EXPECT_FALSE(regions.SurfaceServed(request)) << "served before any region stepped";
   // Every region steps within the slowest one's period (4 ms at 250 Hz).
   const std::array<double, 3> contact = press(6, true);
   ASSERT_TRUE(regions.SurfaceServed(request));
+  for (int a = 0; a < regions.num_regions(); ++a) {
+    EXPECT_GT(regions.surface_publications(a), at_rest[a]) << "region " << a;
+  }
   std::vector<double> surface;
   ASSERT_TRUE(regions.ReadSurface(&surface));
   const ObjectState state = regions.CaptureState();

@@ -131,7 +131,7 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(ConfigError("[realtime]\nfifo_priority = 120\n").find("realtime.fifo_priority"),
             std::string::npos);
-  for (const char* rate : {"-1", "1000", "nan", "\"fast\""}) {
+  for (const char* rate : {"-1", "0.5", "1000", "nan", "\"fast\""}) {
     const std::string text = std::string("[deformation]\nrate_hz = ") + rate + "\n";
     EXPECT_NE(ConfigError(text).find("deformation.rate_hz must be"), std::string::npos)
         << ConfigError(text);

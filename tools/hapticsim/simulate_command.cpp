@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -13,6 +15,7 @@
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/scene_options.hpp"
 #include "tools/hapticsim/svg_plot.hpp"
+#include "tools/hapticsim/vtk_series.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -24,7 +27,41 @@ struct SimulateOptions {
   bool allow_unstable = false;
   bool compare_reference = false;
   bool threads = false;
+  std::string vtk_dir;
+  double vtk_rate_hz = 30;
 };
+
+// Where --vtk writes, and what it wrote (the .pvd of each run).
+struct VtkOutput {
+  std::filesystem::path dir;
+  double rate_hz = 30;
+  std::vector<std::filesystem::path> written;
+};
+
+// Frames of a trial into `series` at `rate_hz` (every period when that is faster than solver.dt).
+TrialFrames FramesInto(VtkSeries& series, const Scene& scene, double rate_hz) {
+  TrialFrames frames;
+  frames.every_periods = std::max(1L, std::lround(1.0 / (rate_hz * scene.solver.dt_s)));
+  frames.observe = [&series](double t_s, const ObjectState& state) { series.Write(t_s, state); };
+  return frames;
+}
+
+// The full-resolution reference, with frames into `vtk` ("reference") when asked.
+TrialResult RunReference(const Scene& scene, TrialOptions options, VtkOutput* vtk) {
+  std::optional<VtkSeries> series;
+  if (vtk) {
+    const int n = scene.mesh.nodes;
+    series.emplace(vtk->dir, "reference", scene,
+                   std::vector<RegionIndex>(static_cast<size_t>(n - 1) * (n - 1) * (n - 1), 0));
+    options.frames = FramesInto(*series, scene, vtk->rate_hz);
+  }
+  TrialResult result = RunReferenceTrial(CubeScene(scene), options);
+  if (series) {
+    series->Finish();
+    vtk->written.push_back(series->collection());
+  }
+  return result;
+}
 
 void WriteCsv(const std::string& path, const TrialResult& result) {
   std::ofstream out(path);
@@ -75,13 +112,20 @@ nlohmann::json ErrorJson(const ForceError& e) {
 // Nothing refused: each region takes the substeps its own limit asks for and the interface
 // controllers keep the exchange from adding energy (docs/regions.md). The bare exchange's
 // estimate is reported: the daemon runs only what is stable without the controllers.
-TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report) {
+TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report, VtkOutput* vtk) {
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
   report->coupled = regions.EstimateCoupledStability();
   regions.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
+  // Frames come from the virtual-time run, the schedule the error map measures.
+  std::optional<VtkSeries> series;
+  TrialFrames frames;
+  if (vtk) {
+    series.emplace(vtk->dir, "adaptive", scene, regions.partition().mesh().RegionPerLatticeCell());
+    frames = FramesInto(*series, scene, vtk->rate_hz);
+  }
   TrialResult result;
   if (threads) {
-    const TrialResult virtual_time = regions.RunTrial();
+    const TrialResult virtual_time = regions.RunTrial(frames);
     RealTimeSchedule schedule(regions);
     result = schedule.RunTrial();
     for (int r = 0; r < regions.num_regions(); ++r) report->deadlines.push_back(schedule.stats(r));
@@ -89,7 +133,11 @@ TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report
       report->threaded_vs_virtual = CompareForces(result.samples, virtual_time.samples);
     }
   } else {
-    result = regions.RunTrial();
+    result = regions.RunTrial(frames);
+  }
+  if (series) {
+    series->Finish();
+    vtk->written.push_back(series->collection());
   }
   report->energy = regions.Energies();
   const double simulated_ms = std::max<double>(result.steps, 1) * scene.solver.dt_s * 1e3;
@@ -115,8 +163,11 @@ int Run(const SimulateOptions& options) {
         "--threads runs the asynchronous regions on real threads: set "
         "adaptivity.primary_size >= 1 too");
   }
-  const TrialResult result = adaptive ? RunAdaptive(scene, options.threads, &report)
-                                      : RunReferenceTrial(CubeScene(scene), trial_options);
+  std::optional<VtkOutput> vtk;
+  if (!options.vtk_dir.empty()) vtk = VtkOutput{options.vtk_dir, options.vtk_rate_hz, {}};
+  VtkOutput* frames = vtk ? &*vtk : nullptr;
+  const TrialResult result = adaptive ? RunAdaptive(scene, options.threads, &report, frames)
+                                      : RunReference(scene, trial_options, frames);
   std::optional<ForceError> error;
   std::optional<TrialResult> reference;
   if (options.compare_reference && !result.samples.empty()) {
@@ -124,7 +175,7 @@ int Run(const SimulateOptions& options) {
     reference_scene.adaptivity.primary_size = 0;
     TrialOptions reference_options;
     reference_options.substep_to_stability = true;
-    reference = RunReferenceTrial(CubeScene(reference_scene), reference_options);
+    reference = RunReference(reference_scene, reference_options, adaptive ? frames : nullptr);
     if (reference->outcome != TrialOutcome::kCompleted) {
       throw Error("the full-resolution reference of this scene did not complete (" +
                   std::string(TrialOutcomeName(reference->outcome)) + "); lower solver.dt below " +
@@ -137,6 +188,14 @@ int Run(const SimulateOptions& options) {
     error = CompareForces(result.samples, matched);
   }
 
+  // --vtk writes the reference beside an adaptive run, whether or not it is compared.
+  if (vtk && adaptive && !reference) {
+    Scene reference_scene = scene;
+    reference_scene.adaptivity.primary_size = 0;
+    TrialOptions reference_options;
+    reference_options.substep_to_stability = true;
+    RunReference(reference_scene, reference_options, frames);
+  }
   const bool wrote_series = !options.csv_path.empty() && !result.samples.empty();
   if (wrote_series) WriteCsv(options.csv_path, result);
   if (!options.plot_path.empty() && !result.samples.empty()) {
@@ -203,6 +262,9 @@ int Run(const SimulateOptions& options) {
       out["reference_peak_force_N"] = error->reference_peak_n;
       out["reference_compute_us_per_simulated_ms"] =
           reference->wall_time_s * 1e6 / (reference->steps * scene.solver.dt_s * 1e3);
+    }
+    if (vtk) {
+      for (const auto& pvd : vtk->written) out["vtk"].push_back(pvd.string());
     }
     std::cout << out.dump(2) << "\n";
   } else {
@@ -277,6 +339,12 @@ int Run(const SimulateOptions& options) {
     if (!options.plot_path.empty() && !result.samples.empty()) {
       std::cout << "  plot: " << options.plot_path << "\n";
     }
+    if (vtk) {
+      for (const auto& pvd : vtk->written) {
+        std::cout << "  VTK time series (open in ParaView; Warp By Vector on displacement_m): "
+                  << pvd.string() << "\n";
+      }
+    }
   }
   return result.outcome == TrialOutcome::kCompleted ? kExitOk : kExitUnstable;
 }
@@ -305,6 +373,14 @@ Command AddSimulateCommand(CLI::App& parent) {
   app->add_flag("--threads", options->threads,
                 "Run the asynchronous regions on real threads (one per region, on real clocks) "
                 "and report deadlines and the difference from the virtual-time run");
+  app->add_option("--vtk", options->vtk_dir,
+                  "Write the run as a VTK time series ParaView opens: DIR/adaptive.pvd and "
+                  "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame with "
+                  "displacement (m), von Mises stress (Pa) and region id")
+      ->type_name("DIR");
+  app->add_option("--vtk-rate", options->vtk_rate_hz, "Frames per simulated second of --vtk, Hz")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 1000.0));
   return {app, [options] { return Run(*options); }};
 }
 
