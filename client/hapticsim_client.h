@@ -79,11 +79,25 @@ typedef struct hapticsim_status {
   int64_t poses_sent;     /* hapticsim_send_pose calls in this session */
 } hapticsim_status;
 
+/** One frame of the deformed surface (hapticsim_read_deformation). */
+typedef struct hapticsim_deformation {
+  int64_t frame;            /* frames the daemon made since it started ([deformation] rate_hz) */
+  int64_t utime_us;         /* when it was made, daemon's CLOCK_MONOTONIC, µs */
+  int64_t configuration_id; /* changes whenever the regions are replaced (ids may then differ) */
+  int32_t in_contact;       /* 1: the tool engaged within the last 5 primary periods */
+  int32_t complete;         /* 1: every region published its part after being asked */
+  int32_t nodes_per_axis;   /* n: node id = (ix * n + iy) * n + iz */
+  int32_t contact_node[3];  /* lattice indices the regions are centred on */
+  double spacing_m;         /* lattice spacing, m: a node rests at (ix, iy, iz) * spacing_m */
+  int32_t num_nodes;        /* surface nodes written into the caller's arrays */
+} hapticsim_deformation;
+
 /**
  * Connects to hapticsimd's service socket (NULL: HAPTICSIM_DEFAULT_SOCKET) and maps the shared
- * memory it hands over; waits up to 2 s to connect and 2 s for the daemon's answer. Returns NULL when it cannot, with the
- * reason in `error` (what to fix: no daemon there, not in its group, another driver holds the
- * session, a socket another user could have put there), truncated to `error_size` bytes.
+ * memory it hands over; waits up to 2 s to connect and 2 s for the daemon's answer. Returns NULL
+ * when it cannot, with the reason in `error` (what to fix: no daemon there, not in its group,
+ * another driver holds the session, a socket another user could have put there), truncated to
+ * `error_size` bytes.
  */
 HAPTICSIM_API hapticsim_client* hapticsim_connect(const char* socket_path, char* error,
                                                   size_t error_size);
@@ -116,6 +130,22 @@ HAPTICSIM_API int hapticsim_is_live(const hapticsim_client* client, int64_t now_
 
 /** The session's status into `out`. Returns 0, or -1 when an argument is NULL. Wait-free. */
 HAPTICSIM_API int hapticsim_read_status(const hapticsim_client* client, hapticsim_status* out);
+
+/** Surface nodes in each frame of the deformed surface: the arrays' size, in nodes, that
+ *  hapticsim_read_deformation needs. 0 for NULL. */
+HAPTICSIM_API int32_t hapticsim_deformation_nodes(const hapticsim_client* client);
+
+/**
+ * The newest frame of the deformed surface (docs/simulator.md, "The deformed shape"): its facts
+ * into `out`, the surface node ids into `node_ids` and their displacements into `displacement_m`
+ * (x, y, z per node, m, object frame), each with room for `capacity_nodes` nodes
+ * (hapticsim_deformation_nodes); either array may be NULL. Returns 1 when there is a frame, 0 when
+ * the daemon has written none yet ([deformation] rate_hz = 0, or just started), -1 when `client`
+ * or `out` is NULL or the arrays are too small. Wait-free: it may be called from a render thread.
+ */
+HAPTICSIM_API int hapticsim_read_deformation(const hapticsim_client* client,
+                                             hapticsim_deformation* out, int32_t* node_ids,
+                                             double* displacement_m, int32_t capacity_nodes);
 
 /**
  * After a daemon restart: a new session at the same socket. Returns 1 when it connected, 0 when

@@ -447,7 +447,7 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
   out << "]\nlock_memory = " << (c.lock_memory ? "true" : "false") << "\n"
       << "sleep_at_rest = " << (c.sleep_at_rest ? "true" : "false")
       << "  # untouched and at rest: regions not stepped, ~0 CPU\n\n"
-      << "[deformation]  # the deformed surface out (deformation_t on lcm.deformation_channel)\n"
+      << "[deformation]  # the deformed surface out: deformation_t on LCM, and in shared memory\n"
       << "rate_hz = " << real(c.deformation_rate_hz) << "  # frames per second, 0: none\n\n"
       << "[log]\nlevel = " << quote(c.log_level) << "\n"
       << "max_lines_per_s = " << real(c.max_log_lines_per_s) << "\n";

@@ -27,7 +27,8 @@ struct DaemonConfig {
   std::string force_channel = "HAPTIC_FORCE";
   std::string status_channel = "HAPTIC_STATUS";
   std::string command_channel = "HAPTIC_COMMAND";
-  std::string deformation_channel = "HAPTIC_DEFORMATION";  ///< deformation_t, at deformation_rate_hz
+  std::string deformation_channel =
+      "HAPTIC_DEFORMATION";  ///< deformation_t, at deformation_rate_hz
   /// Commands on command_channel are refused unless this is set: anyone who can send on the bus
   /// could otherwise reset the simulation or pin a configuration. `hapticsim ctl` uses [control].
   /// Set, only commands signed with the key in lcm_command_key_file are taken
@@ -63,8 +64,8 @@ struct DaemonConfig {
   bool lock_memory = false;   ///< mlockall(MCL_CURRENT | MCL_FUTURE)
   bool sleep_at_rest = true;  ///< regions at rest with nothing touching them are not stepped
   // [deformation]: the deformed surface out, for a simulator or a viewer to draw
-  /// Frames per second of deformation_t on LCM (0: none; else 1 to 240); made by a thread of its
-  /// own, off the real-time path.
+  /// Frames per second of the deformed surface (0: none; else 1 to 240), as deformation_t on LCM
+  /// and in the shared-memory session; made by a thread of its own, off the real-time path.
   double deformation_rate_hz = 60;
   // [log]
   std::string log_level = "info";   ///< trace, debug, info, warn, error

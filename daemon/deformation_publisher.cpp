@@ -7,13 +7,15 @@
 #include <cmath>
 
 #include "daemon/lcm_bridge.hpp"
+#include "daemon/shm_server.hpp"
 
 namespace hapticsim {
 
 DeformationPublisher::DeformationPublisher(const DaemonConfig& config, HapticLoop& loop,
-                                           LcmBridge* bridge)
-    : config_(config), loop_(loop), bridge_(bridge) {
-  thread_ = std::thread([this] { Run(); });
+                                           LcmBridge* bridge, ShmServer* shm)
+    : config_(config), loop_(loop), bridge_(bridge), shm_(shm) {
+  // Nowhere to send frames: the regions are not asked for any.
+  if (bridge_ || shm_) thread_ = std::thread([this] { Run(); });
 }
 
 DeformationPublisher::~DeformationPublisher() {
@@ -72,6 +74,7 @@ void DeformationPublisher::Run() {
     message.utime = sent_ns / 1000;
     message.latency_ms = static_cast<float>((sent_ns - frame.asked_ns) * 1e-6);
     if (bridge_) bridge_->PublishDeformation(message);
+    if (shm_) shm_->OfferDeformation(frame, message.utime, number);
     if (with_ids) {
       ids_configuration = frame.configuration_id;
       ids_sent_ns = sent_ns;

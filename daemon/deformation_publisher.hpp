@@ -11,10 +11,12 @@
 namespace hapticsim {
 
 class LcmBridge;
+class ShmServer;
 
 /**
  * The deformation thread: at [deformation] rate_hz it takes the deformed surface from the loop
- * (HapticLoop::TakeSurface) and publishes it as deformation_t on lcm.deformation_channel. It runs
+ * (HapticLoop::TakeSurface), publishes it as deformation_t on lcm.deformation_channel and offers it
+ * to the shared-memory session (ShmServer::OfferDeformation; the I/O thread writes it). It runs
  * at normal priority, off the real-time path: the region threads only copy their part of the
  * surface when asked. A frame late by more than a period is not made up: the next is taken on the
  * next free tick of its grid.
@@ -24,9 +26,10 @@ class DeformationPublisher {
   /** Node ids are sent in the first frame of each configuration and at least this often. */
   static constexpr double kIdsEvery_s = 1.0;
 
-  /** `bridge`: where frames go (null: nowhere yet, but they are still counted). Starts the
-   *  thread. */
-  DeformationPublisher(const DaemonConfig& config, HapticLoop& loop, LcmBridge* bridge);
+  /** `bridge`, `shm`: where frames go (either may be null; both null, no thread starts). Starts
+   *  the thread. */
+  DeformationPublisher(const DaemonConfig& config, HapticLoop& loop, LcmBridge* bridge,
+                       ShmServer* shm);
   ~DeformationPublisher();
   DeformationPublisher(const DeformationPublisher&) = delete;
   DeformationPublisher& operator=(const DeformationPublisher&) = delete;
@@ -45,6 +48,7 @@ class DeformationPublisher {
   const DaemonConfig& config_;
   HapticLoop& loop_;
   LcmBridge* bridge_;
+  ShmServer* shm_;
   std::atomic<bool> stop_{false};
   std::atomic<std::int64_t> frames_{0};
   std::atomic<double> max_latency_ms_{0};

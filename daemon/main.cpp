@@ -316,7 +316,7 @@ int Serve(const Arguments& args) {
   systemd.Notify("READY=1\nSTATUS=serving");
   spdlog::info("serving: {} regions running", loop.regions().num_regions());
   std::optional<DeformationPublisher> deformation;  // the deformed surface out, off the RT path
-  if (bridge && config.deformation_rate_hz > 0) deformation.emplace(config, loop, bridge.get());
+  if (config.deformation_rate_hz > 0) deformation.emplace(config, loop, bridge.get(), shm.get());
 
   std::vector<MissLogger> miss_loggers;
   // One per region thread; the count changes when a reconfiguration changes the regions.

@@ -23,6 +23,9 @@ ShmServer::ShmServer(const std::string& socket_path, const std::string& group,
                      bool owns_input)
     : listener_(socket_path, group),
       intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input),
+      surface_nodes_(static_cast<std::uint32_t>(loop.regions().surface_ids().size())),
+      nodes_per_axis_(mesh.nodes),
+      spacing_m_(mesh.edge_m / (mesh.nodes - 1)),
       counters_(counters),
       min_log_gap_ns_(1e9 / max_log_lines_per_s) {}
 
@@ -75,7 +78,7 @@ void ShmServer::Admit(shm::Connection connection) {
   }
   try {
     // A new segment per session: the previous driver's mapping is left to it alone.
-    shm::MappedSegment fresh = shm::MappedSegment::CreateSealed("hapticsim");
+    shm::MappedSegment fresh = shm::MappedSegment::CreateSealed("hapticsim", surface_nodes_);
     if (!shm::SendMessage(connection.socket.get(), shm::SessionGreeting(), fresh.fd())) return;
     mapping_.reset();  // says the previous session's daemon is gone (daemon_pid = 0)
     mapping_.emplace(std::move(fresh));
@@ -83,6 +86,10 @@ void ShmServer::Admit(shm::Connection connection) {
     intake_.Reset();  // a new driver's first seq and tip are not "old" or "a jump"
     session_ = std::move(connection.socket);
     session_peer_ = peer;
+    {
+      const std::lock_guard<std::mutex> lock(deformation_mutex_);
+      deformation_fresh_ = deformation_meta_.frame >= 0;  // the newest, into the new segment
+    }
     counters_.shm_sessions.fetch_add(1);
     Log(spdlog::level::info, "shared memory: a session for pid {} (uid {}) started", peer.pid,
         peer.uid);
@@ -104,6 +111,7 @@ void ShmServer::PollInput() {
   inputs_.ReadNew(mapping_->segment(), [this](const shm::ShmDeviceInput& input) {
     intake_.Offer(input.seq, {input.position_m[0], input.position_m[1], input.position_m[2]});
   });
+  PublishPendingDeformation();
 }
 
 void ShmServer::Publish(const ForceRecord& record) {
@@ -120,6 +128,31 @@ void ShmServer::Publish(const ForceRecord& record) {
   segment.outputs[record.period % shm::kOutputSlots].Write(out);
   segment.newest_output.store(record.period, std::memory_order_release);
   segment.header.daemon_heartbeat_ns.store(record.utime_us * 1000, std::memory_order_relaxed);
+}
+
+void ShmServer::OfferDeformation(const HapticLoop::SurfaceFrame& frame, std::int64_t utime_us,
+                                 std::int64_t number) {
+  const std::lock_guard<std::mutex> lock(deformation_mutex_);
+  if (frame.ids.size() != surface_nodes_) return;  // not this object's surface: nothing to write
+  deformation_meta_.frame = number;
+  deformation_meta_.utime = utime_us;
+  deformation_meta_.configuration_id = frame.configuration_id;
+  deformation_meta_.in_contact = frame.in_contact;
+  deformation_meta_.complete = frame.complete;
+  deformation_meta_.nodes_per_axis = nodes_per_axis_;
+  deformation_meta_.spacing_m = spacing_m_;
+  for (int c = 0; c < 3; ++c) deformation_meta_.contact_node[c] = frame.centre[c];
+  deformation_ids_ = frame.ids;
+  deformation_u_ = frame.displacement_m;
+  deformation_fresh_ = true;
+}
+
+void ShmServer::PublishPendingDeformation() {
+  if (!mapping_) return;
+  std::unique_lock<std::mutex> lock(deformation_mutex_, std::try_to_lock);
+  if (!lock.owns_lock() || !deformation_fresh_) return;
+  mapping_->deformation().Write(deformation_meta_, deformation_ids_.data(), deformation_u_.data());
+  deformation_fresh_ = false;
 }
 
 }  // namespace hapticsim

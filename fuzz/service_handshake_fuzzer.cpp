@@ -36,12 +36,13 @@ std::size_t OpenDescriptors() {
 // A segment file as hapticsimd makes one, its first bytes replaced by `overlay`.
 int SegmentFile(const std::string& overlay, bool sealed) {
   const int fd = memfd_create("hapticsim-fuzz", MFD_CLOEXEC | MFD_ALLOW_SEALING);
-  if (fd < 0 || ftruncate(fd, sizeof(shm::ShmSegment)) != 0) __builtin_trap();
-  void* memory = mmap(nullptr, sizeof(shm::ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  const std::size_t bytes = shm::SegmentBytes(0);
+  if (fd < 0 || ftruncate(fd, static_cast<off_t>(bytes)) != 0) __builtin_trap();
+  void* memory = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (memory == MAP_FAILED) __builtin_trap();
   shm::FormatSegment(memory, 1);
   std::memcpy(memory, overlay.data(), std::min(overlay.size(), sizeof(shm::ShmHeader)));
-  munmap(memory, sizeof(shm::ShmSegment));
+  munmap(memory, bytes);
   if (sealed && fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0) {
     __builtin_trap();
   }

@@ -1,8 +1,9 @@
 // Fuzz target: a shared segment written by someone else. The fuzzer's bytes overwrite part of a
 // well-formed segment image (the first two bytes choose where), which is then put in a real
 // memory file, sealed when the third byte is even, and adopted as a driver adopts what it is
-// handed (MappedSegment::Adopt checks the seals, the size and the header); when it maps, the device-input slot is read as the daemon reads it (a torn or
-// half-written slot reads as nothing) and checked by the InputGuard.
+// handed (MappedSegment::Adopt checks the seals, the size and the header); when it maps, the
+// device-input slot is read as the daemon reads it (a torn or half-written slot reads as nothing)
+// and checked by the InputGuard.
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
@@ -23,10 +24,13 @@ namespace shm = hapticsim::shm;
 
 namespace {
 
+// A surface of 3 nodes: a deformation area small enough for the fuzzer to reach every byte.
+constexpr std::uint32_t kNodes = 3;
+
 // A well-formed image, as hapticsimd creates it.
 std::vector<std::uint8_t> GoodImage() {
-  std::vector<std::uint8_t> image(sizeof(shm::ShmSegment));
-  shm::FormatSegment(image.data(), 0);
+  std::vector<std::uint8_t> image(shm::SegmentBytes(kNodes));
+  shm::FormatSegment(image.data(), 0, kNodes);
   return image;
 }
 
@@ -68,6 +72,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
     });
     if (read > shm::kInputSlots) __builtin_trap();
+    // The deformed surface read as a viewer reads it: inside the mapping whatever its words say.
+    const shm::ShmDeformationArea area = mapping.deformation();
+    std::vector<std::int32_t> ids(area.nodes());
+    std::vector<double> displacement(3 * std::size_t{area.nodes()});
+    shm::ShmDeformationFrame frame;
+    (void)area.Read(&frame, ids.data(), displacement.data());
   } catch (const hapticsim::Error&) {
   }
   return 0;

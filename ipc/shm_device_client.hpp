@@ -10,6 +10,10 @@
 //   client.ReadForcesSince(last_period, [&](const ShmForceOutput& f) { /* log every answer */ });
 //   if (client.Source(now_ns) == ForceSource::kNone) { /* render zero; client.Reconnect() off
 //                                                           the device thread, now and then */ }
+//   std::vector<int32_t> ids(client.deformation_nodes());   // the deformed surface, for drawing
+//   std::vector<double> u(3 * ids.size());
+//   ShmDeformationFrame frame;
+//   if (client.ReadDeformation(&frame, ids.data(), u.data())) { /* draw rest + u */ }
 //
 // All but Reconnect are wait-free: no locks, no allocation, no system calls (the clock is read
 // by the caller). Link hapticsim_ipc.
@@ -47,7 +51,7 @@ class ShmDeviceClient {
   explicit ShmDeviceClient(const std::string& socket_path = kDefaultSocket)
       : socket_path_(socket_path) {
     sessions_.push_back(ConnectToService(socket_path, kConnectTimeout_ms));
-    segment_.store(&sessions_.back().segment.segment(), std::memory_order_release);
+    Publish(sessions_.back());
   }
 
   /**
@@ -80,7 +84,7 @@ class ShmDeviceClient {
     } catch (const std::exception&) {
       return false;
     }
-    segment_.store(&sessions_.back().segment.segment(), std::memory_order_release);
+    Publish(sessions_.back());
     sessions_[sessions_.size() - 2].connection.reset();  // that session is over
     if (sessions_.size() > kKeptSessions) sessions_.pop_front();
     return true;
@@ -122,6 +126,23 @@ class ShmDeviceClient {
     }
     return std::max(after, newest);
   }
+  /**
+   * The newest frame of the deformed surface the daemon wrote (docs/simulator.md, "The deformed
+   * shape"): its facts into `frame`, deformation_nodes() ids into `ids` and 3 × as many
+   * displacements (x, y, z per node, m) into `displacement_m`; either array may be null. False
+   * when the daemon has written none yet (deformation.rate_hz = 0, or just started) or its writes
+   * raced every try. Wait-free.
+   */
+  bool ReadDeformation(ShmDeformationFrame* frame, std::int32_t* ids,
+                       double* displacement_m) const {
+    return mapping_.load(std::memory_order_acquire)->deformation().Read(frame, ids, displacement_m);
+  }
+  /** Surface nodes in every frame of this session's segment (the arrays' sizes for
+   *  ReadDeformation). The same after a Reconnect to the same object. */
+  std::uint32_t deformation_nodes() const {
+    return mapping_.load(std::memory_order_acquire)->deformation().nodes();
+  }
+
   /** True while the daemon that created the segment runs and serves this session. */
   bool DaemonRunning() const { return segment().header.daemon_pid.load() != 0; }
 
@@ -138,6 +159,12 @@ class ShmDeviceClient {
   std::string socket_path_;
   std::deque<ServiceSession> sessions_;        // newest last (a deque: the others never move)
   std::atomic<ShmSegment*> segment_{nullptr};  // the newest session's, for the wait-free calls
+  std::atomic<const MappedSegment*> mapping_{nullptr};  // and its mapping (the deformation area)
+
+  void Publish(ServiceSession& session) {
+    mapping_.store(&session.segment, std::memory_order_release);
+    segment_.store(&session.segment.segment(), std::memory_order_release);
+  }
 };
 
 }  // namespace hapticsim::shm

@@ -8,6 +8,7 @@
 //
 //   ShmHeader | newest_input, kInputSlots × SeqlockSlot<ShmDeviceInput> (the driver writes)
 //             | newest_output, kOutputSlots × SeqlockSlot<ShmForceOutput> (the daemon writes)
+//             | the deformed surface: two seqlocked frames (ShmDeformationArea, the daemon writes)
 //
 // Both directions are rings with a single writer: write number w goes to slot w % slots, then w
 // is published as the newest. Each slot is a seqlock over relaxed atomic words (lock-free and
@@ -18,7 +19,9 @@
 // (every input gets its answer); the output ring does the same for the driver.
 
 #include <atomic>
+#include <bit>
 #include <climits>
+#include <cstddef>
 #include <cstdint>
 
 #include "core/seqlock_slot.hpp"
@@ -26,7 +29,7 @@
 namespace hapticsim::shm {
 
 inline constexpr char kMagic[8] = {'H', 'S', 'I', 'M', 'S', 'H', 'M', '1'};
-inline constexpr std::uint32_t kLayoutVersion = 3;
+inline constexpr std::uint32_t kLayoutVersion = 4;
 
 /** The tool tip, written by the driver every device period. Object frame, as in LCM. */
 struct ShmDeviceInput {
@@ -63,6 +66,11 @@ struct ShmHeader {
   std::uint64_t total_bytes;
   std::atomic<std::int64_t> daemon_pid;           ///< 0 once the daemon has stopped
   std::atomic<std::int64_t> daemon_heartbeat_ns;  ///< CLOCK_MONOTONIC of its last output
+  /// The deformed surface's area (ShmDeformationArea): bytes from the segment's start (right
+  /// after ShmSegment), and the surface nodes each of its frames holds. total_bytes covers it.
+  std::uint64_t deformation_offset;
+  std::uint32_t deformation_nodes;
+  std::uint32_t reserved;
 };
 
 struct ShmSegment {
@@ -127,6 +135,127 @@ class ShmInputReader {
 
  private:
   std::int64_t last_ = -1;
+};
+
+/** One frame of the deformed surface as a reader gets it (ShmDeformationArea::Read). */
+struct ShmDeformationFrame {
+  std::int64_t frame = -1;             ///< frames the daemon made since it started
+  std::int64_t utime = 0;              ///< when it was made, µs (the daemon's CLOCK_MONOTONIC)
+  std::int64_t configuration_id = -1;  ///< changes whenever the regions are replaced
+  bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
+  bool complete = true;                ///< every region published its part after being asked
+  std::int32_t nodes_per_axis = 0;     ///< n: node id = (ix · n + iy) · n + iz
+  double spacing_m = 0;                ///< lattice spacing, m: rest position = index · spacing
+  std::int32_t contact_node[3] = {};   ///< the node the regions are centred on
+};
+
+/**
+ * The deformed surface in the segment (docs/simulator.md, "The deformed shape"): two frames, each
+ * behind a seqlock, written in turn by the daemon's I/O thread at [deformation] rate_hz; the
+ * newest written is published, so a reader copies a whole frame while the next is written into
+ * the other. All words are relaxed atomics (address-free across processes). Per frame, in 8-byte
+ * words: sequence, frame, utime, configuration_id, flags (1 in contact, 2 complete),
+ * nodes_per_axis, spacing_m, contact node (ix | iy << 16 | iz << 32), then `nodes` ids and
+ * 3 × `nodes` displacements (x, y, z per node, m, as doubles).
+ */
+class ShmDeformationArea {
+ public:
+  static constexpr std::size_t kMetaWords = 8;
+  static constexpr std::size_t kNewestWords = 8;  // the newest frame's index, on a line of its own
+  static std::size_t FrameWords(std::uint32_t nodes) { return kMetaWords + 4 * std::size_t{nodes}; }
+  static std::size_t Bytes(std::uint32_t nodes) {
+    return 8 * (kNewestWords + 2 * FrameWords(nodes));
+  }
+
+  ShmDeformationArea(std::atomic<std::uint64_t>* words, std::uint32_t nodes)
+      : words_(words), nodes_(nodes) {}
+  std::uint32_t nodes() const { return nodes_; }
+
+  /** Marks the area empty (the daemon, formatting a segment). */
+  void Clear() {
+    for (std::size_t i = 0; i < Bytes(nodes_) / 8; ++i)
+      words_[i].store(0, std::memory_order_relaxed);
+    words_[0].store(static_cast<std::uint64_t>(-1), std::memory_order_release);
+  }
+
+  /** The daemon's I/O thread, the single writer: `ids` and `displacement_m` hold nodes() and
+   *  3 × nodes() values. */
+  void Write(const ShmDeformationFrame& meta, const std::int32_t* ids,
+             const double* displacement_m) {
+    const auto newest = static_cast<std::int64_t>(words_[0].load(std::memory_order_relaxed));
+    const std::int64_t next = newest >= 0 ? newest + 1 : 0;
+    std::atomic<std::uint64_t>* f = Frame(next);
+    const std::uint64_t seq = f[0].load(std::memory_order_relaxed);
+    f[0].store(seq + 1, std::memory_order_relaxed);  // odd: writing
+    std::atomic_thread_fence(std::memory_order_release);
+    auto put = [&](std::size_t i, std::uint64_t v) { f[i].store(v, std::memory_order_relaxed); };
+    put(1, static_cast<std::uint64_t>(meta.frame));
+    put(2, static_cast<std::uint64_t>(meta.utime));
+    put(3, static_cast<std::uint64_t>(meta.configuration_id));
+    put(4, (meta.in_contact ? 1u : 0u) | (meta.complete ? 2u : 0u));
+    put(5, static_cast<std::uint64_t>(meta.nodes_per_axis));
+    put(6, std::bit_cast<std::uint64_t>(meta.spacing_m));
+    put(7, static_cast<std::uint64_t>(static_cast<std::uint16_t>(meta.contact_node[0])) |
+               static_cast<std::uint64_t>(static_cast<std::uint16_t>(meta.contact_node[1])) << 16 |
+               static_cast<std::uint64_t>(static_cast<std::uint16_t>(meta.contact_node[2])) << 32);
+    for (std::size_t i = 0; i < nodes_; ++i) {
+      put(kMetaWords + i, static_cast<std::uint64_t>(static_cast<std::uint32_t>(ids[i])));
+    }
+    for (std::size_t i = 0; i < 3 * std::size_t{nodes_}; ++i) {
+      put(kMetaWords + nodes_ + i, std::bit_cast<std::uint64_t>(displacement_m[i]));
+    }
+    f[0].store(seq + 2, std::memory_order_release);  // even: whole
+    words_[0].store(static_cast<std::uint64_t>(next), std::memory_order_release);
+  }
+
+  /**
+   * Any reader: the newest whole frame. `ids` (nodes() of them) and `displacement_m` (3 ×
+   * nodes()) may each be null to skip them. False when no frame was written yet, or writes raced
+   * every attempt (the writer lapped this reader 16 times). Wait-free: no lock, no allocation.
+   */
+  bool Read(ShmDeformationFrame* meta, std::int32_t* ids, double* displacement_m) const {
+    for (int attempt = 0; attempt < 16; ++attempt) {
+      const auto newest = static_cast<std::int64_t>(words_[0].load(std::memory_order_acquire));
+      if (newest < 0) return false;
+      const std::atomic<std::uint64_t>* f = Frame(newest);
+      const std::uint64_t before = f[0].load(std::memory_order_acquire);
+      if (before == 0 || (before & 1)) continue;
+      auto get = [&](std::size_t i) { return f[i].load(std::memory_order_relaxed); };
+      ShmDeformationFrame m;
+      m.frame = static_cast<std::int64_t>(get(1));
+      m.utime = static_cast<std::int64_t>(get(2));
+      m.configuration_id = static_cast<std::int64_t>(get(3));
+      m.in_contact = get(4) & 1;
+      m.complete = get(4) & 2;
+      m.nodes_per_axis = static_cast<std::int32_t>(get(5));
+      m.spacing_m = std::bit_cast<double>(get(6));
+      for (int c = 0; c < 3; ++c) {
+        m.contact_node[c] = static_cast<std::int32_t>((get(7) >> (16 * c)) & 0xffff);
+      }
+      if (ids) {
+        for (std::size_t i = 0; i < nodes_; ++i) {
+          ids[i] = static_cast<std::int32_t>(get(kMetaWords + i));
+        }
+      }
+      if (displacement_m) {
+        for (std::size_t i = 0; i < 3 * std::size_t{nodes_}; ++i) {
+          displacement_m[i] = std::bit_cast<double>(get(kMetaWords + nodes_ + i));
+        }
+      }
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (f[0].load(std::memory_order_relaxed) != before) continue;
+      *meta = m;
+      return true;
+    }
+    return false;
+  }
+
+ private:
+  std::atomic<std::uint64_t>* Frame(std::int64_t number) const {
+    return words_ + kNewestWords + static_cast<std::size_t>(number % 2) * FrameWords(nodes_);
+  }
+  std::atomic<std::uint64_t>* words_;
+  std::uint32_t nodes_;
 };
 
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&

@@ -20,23 +20,42 @@ std::string Why() { return std::strerror(errno); }
 /** The seals a segment must carry: its size is fixed for good. */
 constexpr int kRequiredSeals = F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL;
 
+/** The most surface nodes a segment is made for: a 400³ lattice's surface (in ~3 GB). */
+constexpr std::uint32_t kMaxDeformationNodes = 1'000'000;
+
 }  // namespace
 
-ShmSegment* FormatSegment(void* memory, std::int64_t daemon_pid) {
+std::size_t SegmentBytes(std::uint32_t deformation_nodes) {
+  return sizeof(ShmSegment) + ShmDeformationArea::Bytes(deformation_nodes);
+}
+
+ShmSegment* FormatSegment(void* memory, std::int64_t daemon_pid, std::uint32_t deformation_nodes) {
   auto* segment = new (memory) ShmSegment();
   ShmHeader& h = segment->header;
   h.layout_version = kLayoutVersion;
   h.header_bytes = sizeof(ShmHeader);
   h.input_slot_bytes = sizeof(SeqlockSlot<ShmDeviceInput>);
   h.output_slot_bytes = sizeof(SeqlockSlot<ShmForceOutput>);
-  h.total_bytes = sizeof(ShmSegment);
+  h.total_bytes = SegmentBytes(deformation_nodes);
+  h.deformation_offset = sizeof(ShmSegment);
+  h.deformation_nodes = deformation_nodes;
+  h.reserved = 0;
+  ShmDeformationArea(reinterpret_cast<std::atomic<std::uint64_t>*>(static_cast<char*>(memory) +
+                                                                   sizeof(ShmSegment)),
+                     deformation_nodes)
+      .Clear();
   h.daemon_pid.store(daemon_pid);
   std::atomic_thread_fence(std::memory_order_release);
   std::memcpy(h.magic, kMagic, sizeof kMagic);  // last: a reader sees the magic only when ready
   return segment;
 }
 
-MappedSegment MappedSegment::CreateSealed(const std::string& label) {
+MappedSegment MappedSegment::CreateSealed(const std::string& label,
+                                          std::uint32_t deformation_nodes) {
+  HAPTICSIM_THROW_UNLESS(deformation_nodes <= kMaxDeformationNodes,
+                         "cannot make a shared segment for " + std::to_string(deformation_nodes) +
+                             " surface nodes: at most " + std::to_string(kMaxDeformationNodes));
+  const std::size_t bytes = SegmentBytes(deformation_nodes);
   const int fd = memfd_create(label.c_str(), MFD_CLOEXEC | MFD_ALLOW_SEALING);
   HAPTICSIM_THROW_UNLESS(fd >= 0, "cannot create the shared segment: memfd_create: " + Why());
   auto fail = [&](const std::string& what) {
@@ -44,13 +63,13 @@ MappedSegment MappedSegment::CreateSealed(const std::string& label) {
     close(fd);
     throw Error("cannot " + what + " the shared segment: " + why);
   };
-  if (ftruncate(fd, sizeof(ShmSegment)) != 0) fail("size");
+  if (ftruncate(fd, static_cast<off_t>(bytes)) != 0) fail("size");
   // Sealed before any other process holds it: nobody, the daemon included, can change its size.
   if (fcntl(fd, F_ADD_SEALS, kRequiredSeals) != 0) fail("seal");
-  void* memory = mmap(nullptr, sizeof(ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  void* memory = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (memory == MAP_FAILED) fail("map");
-  ShmSegment* segment = FormatSegment(memory, getpid());
-  return MappedSegment(segment, fd, true);
+  ShmSegment* segment = FormatSegment(memory, getpid(), deformation_nodes);
+  return MappedSegment(segment, bytes, deformation_nodes, fd, true);
 }
 
 MappedSegment MappedSegment::Adopt(int fd, const std::string& from) {
@@ -68,15 +87,19 @@ MappedSegment MappedSegment::Adopt(int fd, const std::string& from) {
   }
   struct stat info {};
   if (fstat(fd, &info) != 0) refuse("cannot be examined: " + Why());
-  if (static_cast<size_t>(info.st_size) != sizeof(ShmSegment)) {
-    refuse("has " + std::to_string(info.st_size) + " bytes; this client expects " +
+  const auto bytes = static_cast<std::size_t>(info.st_size);
+  if (info.st_size < 0 || bytes < sizeof(ShmSegment) ||
+      bytes > SegmentBytes(kMaxDeformationNodes)) {
+    refuse("has " + std::to_string(info.st_size) + " bytes; this client expects from " +
            std::to_string(sizeof(ShmSegment)) + " (another layout version?)");
   }
-  void* memory = mmap(nullptr, sizeof(ShmSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  void* memory = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (memory == MAP_FAILED) refuse("cannot be mapped: " + Why());
   close(fd);
   auto* segment = static_cast<ShmSegment*>(memory);
   const ShmHeader& h = segment->header;
+  // Read once: the other side can write the header meanwhile (what is checked is what is used).
+  const std::uint32_t deformation_nodes = h.deformation_nodes;
   std::string problem;
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) {
     problem = "has no hapticsim signature (not hapticsimd's)";
@@ -86,18 +109,24 @@ MappedSegment MappedSegment::Adopt(int fd, const std::string& from) {
   } else if (h.header_bytes != sizeof(ShmHeader) ||
              h.input_slot_bytes != sizeof(SeqlockSlot<ShmDeviceInput>) ||
              h.output_slot_bytes != sizeof(SeqlockSlot<ShmForceOutput>) ||
-             h.total_bytes != sizeof(ShmSegment)) {
+             h.deformation_offset != sizeof(ShmSegment) ||
+             deformation_nodes > kMaxDeformationNodes || SegmentBytes(deformation_nodes) != bytes ||
+             h.total_bytes != bytes) {
     problem = "has other slot sizes than this client (built from another version?)";
   }
   if (!problem.empty()) {
-    munmap(memory, sizeof(ShmSegment));
+    munmap(memory, bytes);
     throw Error("the shared segment from " + from + " " + problem);
   }
-  return MappedSegment(segment, -1, false);
+  return MappedSegment(segment, bytes, deformation_nodes, -1, false);
 }
 
 MappedSegment::MappedSegment(MappedSegment&& other) noexcept
-    : segment_(other.segment_), fd_(other.fd_), owner_(other.owner_) {
+    : segment_(other.segment_),
+      bytes_(other.bytes_),
+      deformation_nodes_(other.deformation_nodes_),
+      fd_(other.fd_),
+      owner_(other.owner_) {
   other.segment_ = nullptr;
   other.fd_ = -1;
 }
@@ -105,12 +134,12 @@ MappedSegment::MappedSegment(MappedSegment&& other) noexcept
 MappedSegment::~MappedSegment() {
   if (!segment_) return;
   if (owner_) segment_->header.daemon_pid.store(0);
-  munmap(segment_, sizeof(ShmSegment));
+  munmap(segment_, bytes_);
   if (fd_ >= 0) {
     // The driver may keep its descriptor for ever: the pages go back now, or a driver that
     // starts session after session and keeps each would pile them up in the daemon's memory.
     // What it reads after this is zeros: no signature, daemon_pid 0, "no force source".
-    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, 0, sizeof(ShmSegment));
+    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, 0, static_cast<off_t>(bytes_));
     close(fd_);
   }
 }

@@ -18,6 +18,7 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/error.hpp"
 #include "ipc/shm_device_client.hpp"
@@ -101,7 +102,7 @@ TEST(SealedSegment, NeitherItsMakerNorItsDriverCanChangeItsSizeOrItsSeals) {
   EXPECT_NE(fcntl(driver, F_ADD_SEALS, F_SEAL_WRITE), 0);  // sealed: no more seals either
   struct stat info {};
   ASSERT_EQ(fstat(driver, &info), 0);
-  EXPECT_EQ(static_cast<std::size_t>(info.st_size), sizeof(ShmSegment));
+  EXPECT_EQ(static_cast<std::size_t>(info.st_size), SegmentBytes(0));
   // The driver's mapping is the daemon's memory.
   MappedSegment mapped = MappedSegment::Adopt(driver, "the test");
   daemon.segment().newest_output.store(42);
@@ -130,6 +131,62 @@ TEST(SealedSegment, ADriverRefusesAnUnsealedFileAWrongSizeAndAForeignHeader) {
   unlink(path);
   ASSERT_EQ(ftruncate(regular, sizeof(ShmSegment)), 0);
   EXPECT_NE(verdict(regular).find("not a sealable memory file"), std::string::npos);
+}
+
+// The deformed surface's area: a frame written by the daemon reads back whole in the driver's
+// mapping, and its size is what each side saw when the segment was made or adopted, whatever
+// the other side writes into the header afterwards (a driver could otherwise make the daemon
+// write past its mapping).
+TEST(SealedSegment, TheDeformationAreaReadsBackAndKeepsTheSizeItWasMadeWith) {
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test", 10);
+  MappedSegment driver = MappedSegment::Adopt(dup(daemon.fd()), "the test");
+  ASSERT_EQ(driver.deformation().nodes(), 10u);
+  ShmDeformationFrame meta;
+  EXPECT_FALSE(driver.deformation().Read(&meta, nullptr, nullptr)) << "nothing written yet";
+  driver.segment().header.deformation_nodes = 1'000'000;  // a hostile driver
+  ASSERT_EQ(daemon.deformation().nodes(), 10u);
+  std::vector<std::int32_t> ids(10);
+  std::vector<double> u(30);
+  for (int i = 0; i < 10; ++i) ids[i] = 100 + i;
+  for (int i = 0; i < 30; ++i) u[i] = 1e-3 * i - 0.01;
+  ShmDeformationFrame written;
+  written.frame = 7;
+  written.utime = 123456;
+  written.configuration_id = 3;
+  written.in_contact = true;
+  written.complete = false;
+  written.nodes_per_axis = 13;
+  written.spacing_m = 0.25 / 12;
+  written.contact_node[0] = 6, written.contact_node[1] = 6, written.contact_node[2] = 0;
+  daemon.deformation().Write(written, ids.data(), u.data());
+  written.frame = 8;
+  u[29] = 0.5;
+  daemon.deformation().Write(written, ids.data(), u.data());  // the other of the two frames
+  std::vector<std::int32_t> ids_read(10);
+  std::vector<double> u_read(30);
+  ASSERT_TRUE(driver.deformation().Read(&meta, ids_read.data(), u_read.data()));
+  EXPECT_EQ(meta.frame, 8);
+  EXPECT_EQ(meta.utime, 123456);
+  EXPECT_EQ(meta.configuration_id, 3);
+  EXPECT_TRUE(meta.in_contact);
+  EXPECT_FALSE(meta.complete);
+  EXPECT_EQ(meta.nodes_per_axis, 13);
+  EXPECT_EQ(meta.spacing_m, 0.25 / 12);
+  EXPECT_EQ(meta.contact_node[0], 6);
+  EXPECT_EQ(meta.contact_node[2], 0);
+  EXPECT_EQ(ids_read, ids);
+  EXPECT_EQ(u_read, u);
+}
+
+TEST(SealedSegment, ADriverRefusesAHeaderWhoseSurfaceIsNotTheSegmentsSize) {
+  MappedSegment daemon = MappedSegment::CreateSealed("hapticsim-test", 10);
+  daemon.segment().header.deformation_nodes = 11;
+  try {
+    MappedSegment::Adopt(dup(daemon.fd()), "the server");
+    ADD_FAILURE() << "a header claiming more surface than the segment holds was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("other slot sizes"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ServiceSocket, ADriverMapsTheSegmentItsDaemonHandsOver) {

@@ -1,13 +1,17 @@
-// The C API's real-time calls (hapticsim_send_pose, _read_force, _is_live, _read_status) never
-// touch the heap, measured on a session with a real daemon (LCM off: no network) while it
-// answers a press; and the session follows a restarted daemon (hapticsim_reconnect).
+// The C API's real-time calls (hapticsim_send_pose, _read_force, _is_live, _read_status,
+// _read_deformation) never touch the heap, measured on a session with a real daemon (LCM off: no
+// network) while it answers a press; the deformed surface read through it has the touched node
+// where the tool is; and the session follows a restarted daemon (hapticsim_reconnect).
 #include <gtest/gtest.h>
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "hapticsim_client.h"
 #include "tests/support/allocation_counter.hpp"
@@ -35,8 +39,14 @@ TEST(ClientCApi, TheRealTimeCallsNeverAllocateAndASessionFollowsARestartedDaemon
   hapticsim_client* client = hapticsim_connect(socket.c_str(), why, sizeof why);
   ASSERT_NE(client, nullptr) << why;
 
+  // The default cube's surface: 13³ − 11³ nodes.
+  const std::int32_t nodes = hapticsim_deformation_nodes(client);
+  ASSERT_EQ(nodes, 13 * 13 * 13 - 11 * 11 * 11);
+  std::vector<std::int32_t> ids(static_cast<size_t>(nodes));
+  std::vector<double> displacement(3 * ids.size());
+  hapticsim_deformation surface{};
   std::size_t allocations = 0;
-  int forces = 0, live = 0, in_contact = 0;
+  int forces = 0, live = 0, in_contact = 0, frames = 0;
   for (int seq = 1; seq <= 600; ++seq) {
     const double position[3] = {0.125, 0.125, seq < 100 ? -0.002 : 0.004};
     hapticsim_force force{};
@@ -48,6 +58,10 @@ TEST(ClientCApi, TheRealTimeCallsNeverAllocateAndASessionFollowsARestartedDaemon
       read = hapticsim_read_force(client, &force) == 1;
       live += hapticsim_is_live(client, NowNs());
       hapticsim_read_status(client, &status);
+      if (seq % 10 == 0) {
+        frames +=
+            hapticsim_read_deformation(client, &surface, ids.data(), displacement.data(), nodes);
+      }
       allocations += count.count();
     }
     forces += read;
@@ -63,6 +77,27 @@ TEST(ClientCApi, TheRealTimeCallsNeverAllocateAndASessionFollowsARestartedDaemon
   ASSERT_EQ(hapticsim_read_status(client, &status), 0);
   EXPECT_EQ(status.daemon_pid, daemon.pid());
   EXPECT_EQ(status.poses_sent, 600);
+
+  // The deformed surface (60 frames per second by default): the touched node (6, 6, 0) where the
+  // tool held it, 4 mm in, for the last 0.5 s.
+  EXPECT_GT(frames, 20) << "frames read of 60";
+  ASSERT_EQ(hapticsim_read_deformation(client, &surface, ids.data(), displacement.data(), nodes),
+            1);
+  EXPECT_EQ(surface.num_nodes, nodes);
+  EXPECT_EQ(surface.nodes_per_axis, 13);
+  EXPECT_DOUBLE_EQ(surface.spacing_m, 0.25 / 12);
+  EXPECT_EQ(surface.in_contact, 1);
+  EXPECT_GE(surface.frame, 0);
+  const std::int32_t touched = (6 * 13 + 6) * 13 + 0;
+  const auto at = std::lower_bound(ids.begin(), ids.end(), touched);
+  ASSERT_TRUE(at != ids.end() && *at == touched);
+  const size_t i = static_cast<size_t>(at - ids.begin());
+  EXPECT_NEAR(displacement[3 * i + 2], 0.004, 5e-4);
+  EXPECT_LT(std::abs(displacement[3 * i]) + std::abs(displacement[3 * i + 1]), 1e-4);
+  // Arrays too small, or nowhere to put the facts: refused, nothing written.
+  EXPECT_EQ(hapticsim_read_deformation(client, &surface, ids.data(), nullptr, nodes - 1), -1);
+  EXPECT_EQ(hapticsim_read_deformation(client, nullptr, nullptr, nullptr, 0), -1);
+  EXPECT_EQ(hapticsim_read_deformation(client, &surface, nullptr, nullptr, 0), 1);
 
   // The daemon stops: not live within 20 ms, its pid cleared; a new one at the same socket is
   // reached by hapticsim_reconnect, and answers.
