@@ -106,14 +106,18 @@ int32_t hapticsim_deformation_nodes(const hapticsim_client* client) {
 
 int hapticsim_read_deformation(const hapticsim_client* client, hapticsim_deformation* out,
                                int32_t* node_ids, double* displacement_m, int32_t capacity_nodes) {
-  if (client == nullptr || out == nullptr) return -1;
-  const std::uint32_t nodes = client->shm.deformation_nodes();
-  const bool arrays = node_ids != nullptr || displacement_m != nullptr;
-  if (arrays && (capacity_nodes < 0 || static_cast<std::uint32_t>(capacity_nodes) < nodes)) {
-    return -1;
-  }
+  using Read = hapticsim::shm::ShmDeviceClient::DeformationRead;
+  if (client == nullptr || out == nullptr || capacity_nodes < 0) return -1;
   hapticsim::shm::ShmDeformationFrame frame;
-  if (!client->shm.ReadDeformation(&frame, node_ids, displacement_m)) return 0;
+  switch (client->shm.ReadDeformation(&frame, node_ids, displacement_m,
+                                      static_cast<std::uint32_t>(capacity_nodes))) {
+    case Read::kArraysTooSmall:
+      return -1;
+    case Read::kNoneYet:
+      return 0;
+    case Read::kRead:
+      break;
+  }
   out->frame = frame.frame;
   out->utime_us = frame.utime;
   out->configuration_id = frame.configuration_id;
@@ -122,7 +126,7 @@ int hapticsim_read_deformation(const hapticsim_client* client, hapticsim_deforma
   out->nodes_per_axis = frame.nodes_per_axis;
   for (int c = 0; c < 3; ++c) out->contact_node[c] = frame.contact_node[c];
   out->spacing_m = frame.spacing_m;
-  out->num_nodes = static_cast<int32_t>(nodes);
+  out->num_nodes = static_cast<int32_t>(frame.num_nodes);
   return 1;
 }
 

@@ -17,10 +17,12 @@
  *   }
  *   hapticsim_disconnect(c);
  *
- * hapticsim_send_pose, hapticsim_read_force, hapticsim_read_status and hapticsim_is_live are
- * wait-free (no locks, no allocation, no system calls): call them from the device's real-time
- * loop. hapticsim_connect, hapticsim_reconnect and hapticsim_disconnect are not. A client is used
- * by one real-time thread (one writer of poses) and, for hapticsim_reconnect, one other thread.
+ * hapticsim_send_pose, hapticsim_read_force, hapticsim_read_status, hapticsim_is_live and
+ * hapticsim_read_deformation are wait-free (no locks, no allocation, no system calls): call them
+ * from the device's real-time loop. hapticsim_connect, hapticsim_reconnect and
+ * hapticsim_disconnect are not. A client is used by one real-time thread (one writer of poses),
+ * any threads that only read (a render thread reading the deformed surface) and, for
+ * hapticsim_reconnect, one other thread.
  *
  * Units: metres, newtons, microseconds (utime) and nanoseconds (CLOCK_MONOTONIC), as on LCM.
  * Link: -lhapticsim_client (pkg-config hapticsim-client; CMake: hapticsim::client).
@@ -139,9 +141,13 @@ HAPTICSIM_API int32_t hapticsim_deformation_nodes(const hapticsim_client* client
  * The newest frame of the deformed surface (docs/simulator.md, "The deformed shape"): its facts
  * into `out`, the surface node ids into `node_ids` and their displacements into `displacement_m`
  * (x, y, z per node, m, object frame), each with room for `capacity_nodes` nodes
- * (hapticsim_deformation_nodes); either array may be NULL. Returns 1 when there is a frame, 0 when
- * the daemon has written none yet ([deformation] rate_hz = 0, or just started), -1 when `client`
- * or `out` is NULL or the arrays are too small. Wait-free: it may be called from a render thread.
+ * (hapticsim_deformation_nodes); either array may be NULL. Returns 1 when there is a frame
+ * (out->num_nodes filled), 0 when the daemon has written none yet ([deformation] rate_hz = 0, or
+ * just started) or its writes raced every try (the arrays may then hold parts of several frames),
+ * -1, nothing written, when `client` or `out` is NULL or the surface has more nodes than
+ * `capacity_nodes` (after hapticsim_reconnect to a daemon of another object: ask
+ * hapticsim_deformation_nodes again). Wait-free: it may be called from another thread of the
+ * driver's process, a render thread, while the device thread sends poses.
  */
 HAPTICSIM_API int hapticsim_read_deformation(const hapticsim_client* client,
                                              hapticsim_deformation* out, int32_t* node_ids,

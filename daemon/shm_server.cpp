@@ -86,10 +86,8 @@ void ShmServer::Admit(shm::Connection connection) {
     intake_.Reset();  // a new driver's first seq and tip are not "old" or "a jump"
     session_ = std::move(connection.socket);
     session_peer_ = peer;
-    {
-      const std::lock_guard<std::mutex> lock(deformation_mutex_);
-      deformation_fresh_ = deformation_meta_.frame >= 0;  // the newest, into the new segment
-    }
+    deformation_writes_ = 0;
+    deformation_for_new_session_ = true;  // the newest frame, at the next poll
     counters_.shm_sessions.fetch_add(1);
     Log(spdlog::level::info, "shared memory: a session for pid {} (uid {}) started", peer.pid,
         peer.uid);
@@ -150,9 +148,13 @@ void ShmServer::OfferDeformation(const HapticLoop::SurfaceFrame& frame, std::int
 void ShmServer::PublishPendingDeformation() {
   if (!mapping_) return;
   std::unique_lock<std::mutex> lock(deformation_mutex_, std::try_to_lock);
-  if (!lock.owns_lock() || !deformation_fresh_) return;
-  mapping_->deformation().Write(deformation_meta_, deformation_ids_.data(), deformation_u_.data());
+  if (!lock.owns_lock()) return;  // the deformation thread is storing one: at the next poll
+  if (!deformation_fresh_ && !deformation_for_new_session_) return;
+  if (deformation_meta_.frame < 0) return;  // none offered yet
+  mapping_->deformation().Write(deformation_writes_++, deformation_meta_, deformation_ids_.data(),
+                                deformation_u_.data());
   deformation_fresh_ = false;
+  deformation_for_new_session_ = false;
 }
 
 }  // namespace hapticsim

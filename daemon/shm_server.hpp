@@ -68,6 +68,10 @@ class ShmServer {
   std::vector<std::int32_t> deformation_ids_;
   std::vector<double> deformation_u_;
   bool deformation_fresh_ = false;
+  // The I/O thread's own: frames written into this session's segment, and whether a new session
+  // still needs the newest frame.
+  std::int64_t deformation_writes_ = 0;
+  bool deformation_for_new_session_ = false;
   InputCounters& counters_;  // sessions started and connections refused are counted there
   double min_log_gap_ns_;
   std::int64_t last_log_ns_ = 0, unlogged_ = 0;

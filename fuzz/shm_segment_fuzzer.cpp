@@ -73,11 +73,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     });
     if (read > shm::kInputSlots) __builtin_trap();
     // The deformed surface read as a viewer reads it: inside the mapping whatever its words say.
-    const shm::ShmDeformationArea area = mapping.deformation();
+    shm::ShmDeformationArea area = mapping.deformation();
     std::vector<std::int32_t> ids(area.nodes());
     std::vector<double> displacement(3 * std::size_t{area.nodes()});
     shm::ShmDeformationFrame frame;
     (void)area.Read(&frame, ids.data(), displacement.data());
+    // And written as the daemon writes it, over whatever the driver left in its words.
+    area.Write(size > 0 ? std::int64_t{data[0]} : 0, frame, ids.data(), displacement.data());
   } catch (const hapticsim::Error&) {
   }
   return 0;

@@ -13,7 +13,8 @@
 //   std::vector<int32_t> ids(client.deformation_nodes());   // the deformed surface, for drawing
 //   std::vector<double> u(3 * ids.size());
 //   ShmDeformationFrame frame;
-//   if (client.ReadDeformation(&frame, ids.data(), u.data())) { /* draw rest + u */ }
+//   if (client.ReadDeformation(&frame, ids.data(), u.data(), ids.size()) ==
+//       ShmDeviceClient::DeformationRead::kRead) { /* draw rest + u for frame.num_nodes */ }
 //
 // All but Reconnect are wait-free: no locks, no allocation, no system calls (the clock is read
 // by the caller). Link hapticsim_ipc.
@@ -126,19 +127,29 @@ class ShmDeviceClient {
     }
     return std::max(after, newest);
   }
+  /** What ReadDeformation did. */
+  enum class DeformationRead { kRead, kNoneYet, kArraysTooSmall };
   /**
    * The newest frame of the deformed surface the daemon wrote (docs/simulator.md, "The deformed
-   * shape"): its facts into `frame`, deformation_nodes() ids into `ids` and 3 × as many
-   * displacements (x, y, z per node, m) into `displacement_m`; either array may be null. False
-   * when the daemon has written none yet (deformation.rate_hz = 0, or just started) or its writes
-   * raced every try. Wait-free.
+   * shape"): its facts into `frame` (frame->num_nodes: the surface's nodes), that many ids into
+   * `ids` and 3 × as many displacements (x, y, z per node, m) into `displacement_m`, each with
+   * room for `capacity_nodes` nodes; either array may be null. kNoneYet when the daemon has
+   * written none (deformation.rate_hz = 0, or just started) or its writes raced every try (the
+   * arrays may then hold parts of several frames); kArraysTooSmall, nothing written, when the
+   * surface has more nodes than `capacity_nodes` (a Reconnect on another thread may have reached a
+   * daemon of another object: the count is the one read here, from one session). Wait-free.
    */
-  bool ReadDeformation(ShmDeformationFrame* frame, std::int32_t* ids,
-                       double* displacement_m) const {
-    return mapping_.load(std::memory_order_acquire)->deformation().Read(frame, ids, displacement_m);
+  DeformationRead ReadDeformation(ShmDeformationFrame* frame, std::int32_t* ids,
+                                  double* displacement_m, std::uint32_t capacity_nodes) const {
+    const ShmDeformationArea area = mapping_.load(std::memory_order_acquire)->deformation();
+    if ((ids != nullptr || displacement_m != nullptr) && area.nodes() > capacity_nodes) {
+      return DeformationRead::kArraysTooSmall;
+    }
+    return area.Read(frame, ids, displacement_m) ? DeformationRead::kRead
+                                                 : DeformationRead::kNoneYet;
   }
-  /** Surface nodes in every frame of this session's segment (the arrays' sizes for
-   *  ReadDeformation). The same after a Reconnect to the same object. */
+  /** Surface nodes in every frame of the newest session's segment: the room ReadDeformation's
+   *  arrays need. A Reconnect to a daemon of another object changes it. */
   std::uint32_t deformation_nodes() const {
     return mapping_.load(std::memory_order_acquire)->deformation().nodes();
   }

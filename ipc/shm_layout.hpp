@@ -147,6 +147,7 @@ struct ShmDeformationFrame {
   std::int32_t nodes_per_axis = 0;     ///< n: node id = (ix · n + iy) · n + iz
   double spacing_m = 0;                ///< lattice spacing, m: rest position = index · spacing
   std::int32_t contact_node[3] = {};   ///< the node the regions are centred on
+  std::uint32_t num_nodes = 0;         ///< surface nodes in the frame (ShmDeformationArea::nodes)
 };
 
 /**
@@ -178,14 +179,16 @@ class ShmDeformationArea {
     words_[0].store(static_cast<std::uint64_t>(-1), std::memory_order_release);
   }
 
-  /** The daemon's I/O thread, the single writer: `ids` and `displacement_m` hold nodes() and
-   *  3 × nodes() values. */
-  void Write(const ShmDeformationFrame& meta, const std::int32_t* ids,
+  /**
+   * The daemon's I/O thread, the single writer: write number `write` (0, 1, 2, … counted by the
+   * writer itself, never read back from the segment, which the driver can write too) into frame
+   * `write` & 1, then publishes it. `ids` and `displacement_m` hold nodes() and 3 × nodes() values.
+   */
+  void Write(std::int64_t write, const ShmDeformationFrame& meta, const std::int32_t* ids,
              const double* displacement_m) {
-    const auto newest = static_cast<std::int64_t>(words_[0].load(std::memory_order_relaxed));
-    const std::int64_t next = newest >= 0 ? newest + 1 : 0;
-    std::atomic<std::uint64_t>* f = Frame(next);
-    const std::uint64_t seq = f[0].load(std::memory_order_relaxed);
+    std::atomic<std::uint64_t>* f = Frame(write);
+    // The driver may have written the sequence word: odd or not, the next store makes it odd.
+    const std::uint64_t seq = f[0].load(std::memory_order_relaxed) & ~std::uint64_t{1};
     f[0].store(seq + 1, std::memory_order_relaxed);  // odd: writing
     std::atomic_thread_fence(std::memory_order_release);
     auto put = [&](std::size_t i, std::uint64_t v) { f[i].store(v, std::memory_order_relaxed); };
@@ -205,13 +208,14 @@ class ShmDeformationArea {
       put(kMetaWords + nodes_ + i, std::bit_cast<std::uint64_t>(displacement_m[i]));
     }
     f[0].store(seq + 2, std::memory_order_release);  // even: whole
-    words_[0].store(static_cast<std::uint64_t>(next), std::memory_order_release);
+    words_[0].store(static_cast<std::uint64_t>(write), std::memory_order_release);
   }
 
   /**
    * Any reader: the newest whole frame. `ids` (nodes() of them) and `displacement_m` (3 ×
    * nodes()) may each be null to skip them. False when no frame was written yet, or writes raced
-   * every attempt (the writer lapped this reader 16 times). Wait-free: no lock, no allocation.
+   * every attempt (the writer lapped this reader 16 times): the arrays may then hold parts of
+   * several frames. Wait-free: no lock, no allocation.
    */
   bool Read(ShmDeformationFrame* meta, std::int32_t* ids, double* displacement_m) const {
     for (int attempt = 0; attempt < 16; ++attempt) {
@@ -228,6 +232,7 @@ class ShmDeformationArea {
       m.in_contact = get(4) & 1;
       m.complete = get(4) & 2;
       m.nodes_per_axis = static_cast<std::int32_t>(get(5));
+      m.num_nodes = nodes_;
       m.spacing_m = std::bit_cast<double>(get(6));
       for (int c = 0; c < 3; ++c) {
         m.contact_node[c] = static_cast<std::int32_t>((get(7) >> (16 * c)) & 0xffff);
@@ -252,7 +257,7 @@ class ShmDeformationArea {
 
  private:
   std::atomic<std::uint64_t>* Frame(std::int64_t number) const {
-    return words_ + kNewestWords + static_cast<std::size_t>(number % 2) * FrameWords(nodes_);
+    return words_ + kNewestWords + static_cast<std::size_t>(number & 1) * FrameWords(nodes_);
   }
   std::atomic<std::uint64_t>* words_;
   std::uint32_t nodes_;

@@ -20,8 +20,11 @@ std::string Why() { return std::strerror(errno); }
 /** The seals a segment must carry: its size is fixed for good. */
 constexpr int kRequiredSeals = F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL;
 
-/** The most surface nodes a segment is made for: a 400³ lattice's surface (in ~3 GB). */
-constexpr std::uint32_t kMaxDeformationNodes = 1'000'000;
+/**
+ * The most surface nodes a segment is made for: a 130³ lattice's surface, 6.4 MB a frame (the
+ * I/O thread writes each frame; the default 13³ cube's 866 nodes are 28 KB).
+ */
+constexpr std::uint32_t kMaxDeformationNodes = 100'000;
 
 }  // namespace
 
@@ -99,7 +102,9 @@ MappedSegment MappedSegment::Adopt(int fd, const std::string& from) {
   auto* segment = static_cast<ShmSegment*>(memory);
   const ShmHeader& h = segment->header;
   // Read once: the other side can write the header meanwhile (what is checked is what is used).
-  const std::uint32_t deformation_nodes = h.deformation_nodes;
+  const std::uint32_t deformation_nodes =
+      std::atomic_ref<std::uint32_t>(segment->header.deformation_nodes)
+          .load(std::memory_order_relaxed);
   std::string problem;
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) {
     problem = "has no hapticsim signature (not hapticsimd's)";

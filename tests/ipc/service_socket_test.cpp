@@ -143,8 +143,10 @@ TEST(SealedSegment, TheDeformationAreaReadsBackAndKeepsTheSizeItWasMadeWith) {
   ASSERT_EQ(driver.deformation().nodes(), 10u);
   ShmDeformationFrame meta;
   EXPECT_FALSE(driver.deformation().Read(&meta, nullptr, nullptr)) << "nothing written yet";
-  driver.segment().header.deformation_nodes = 1'000'000;  // a hostile driver
+  driver.segment().header.deformation_nodes = 100'000;  // a hostile driver
   ASSERT_EQ(daemon.deformation().nodes(), 10u);
+  // What a driver adopting the segment now would check is refused (the area is 10 nodes long).
+  EXPECT_THROW(MappedSegment::Adopt(dup(daemon.fd()), "the test"), Error);
   std::vector<std::int32_t> ids(10);
   std::vector<double> u(30);
   for (int i = 0; i < 10; ++i) ids[i] = 100 + i;
@@ -158,10 +160,16 @@ TEST(SealedSegment, TheDeformationAreaReadsBackAndKeepsTheSizeItWasMadeWith) {
   written.nodes_per_axis = 13;
   written.spacing_m = 0.25 / 12;
   written.contact_node[0] = 6, written.contact_node[1] = 6, written.contact_node[2] = 0;
-  daemon.deformation().Write(written, ids.data(), u.data());
+  // The driver scribbles over the newest index and both sequence words: the writer counts its
+  // writes itself and still publishes whole frames.
+  auto* words = reinterpret_cast<std::atomic<std::uint64_t>*>(
+      reinterpret_cast<char*>(&driver.segment()) + sizeof(ShmSegment));
+  words[0].store(static_cast<std::uint64_t>(INT64_MAX));
+  words[ShmDeformationArea::kNewestWords].store(12345);  // frame 0's sequence, odd
+  daemon.deformation().Write(0, written, ids.data(), u.data());
   written.frame = 8;
   u[29] = 0.5;
-  daemon.deformation().Write(written, ids.data(), u.data());  // the other of the two frames
+  daemon.deformation().Write(1, written, ids.data(), u.data());  // the other of the two frames
   std::vector<std::int32_t> ids_read(10);
   std::vector<double> u_read(30);
   ASSERT_TRUE(driver.deformation().Read(&meta, ids_read.data(), u_read.data()));
@@ -174,6 +182,7 @@ TEST(SealedSegment, TheDeformationAreaReadsBackAndKeepsTheSizeItWasMadeWith) {
   EXPECT_EQ(meta.spacing_m, 0.25 / 12);
   EXPECT_EQ(meta.contact_node[0], 6);
   EXPECT_EQ(meta.contact_node[2], 0);
+  EXPECT_EQ(meta.num_nodes, 10u);
   EXPECT_EQ(ids_read, ids);
   EXPECT_EQ(u_read, u);
 }

@@ -3,7 +3,9 @@
 // while they go to sleep and wake, every frame taken is whole and finite, and the seqlocked
 // array under it never hands a reader a torn copy. Run under ThreadSanitizer too (scripts/test.sh).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,6 +15,7 @@
 #include "core/seqlock_array.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/supervisor.hpp"
+#include "ipc/shm_segment.hpp"
 #include "tests/support/play_device.hpp"
 
 namespace hapticsim {
@@ -46,6 +49,45 @@ TEST(SeqlockArray, ReadersNeverSeeATornCopy) {
   EXPECT_GT(consistent, 100) << "the reader hardly ever got a copy";
   EXPECT_GT(array.writes(), 100u) << "the writer hardly raced the reader";
   std::printf("seqlock array: %d whole copies, %d reads raced by a write\n", consistent, raced);
+}
+
+// The shared-memory surface (ShmDeformationArea) between two mappings of one segment: a reader
+// racing the writer's two alternating frames gets whole frames only (every value of frame k is k).
+TEST(ShmDeformationArea, AReaderGetsWholeFramesWhileTheWriterAlternates) {
+  constexpr std::uint32_t kNodes = 500;
+  shm::MappedSegment daemon = shm::MappedSegment::CreateSealed("hapticsim-test", kNodes);
+  shm::MappedSegment driver = shm::MappedSegment::Adopt(dup(daemon.fd()), "the test");
+  std::atomic<bool> stop{false};
+  std::atomic<std::int64_t> written{0};
+  std::thread writer([&] {
+    std::vector<std::int32_t> ids(kNodes);
+    std::vector<double> u(3 * kNodes);
+    shm::ShmDeformationFrame meta;
+    for (std::int64_t k = 0; !stop; ++k) {
+      std::fill(ids.begin(), ids.end(), static_cast<std::int32_t>(k));
+      std::fill(u.begin(), u.end(), static_cast<double>(k));
+      meta.frame = k;
+      daemon.deformation().Write(k, meta, ids.data(), u.data());
+      written = k + 1;
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+  });
+  while (written == 0) std::this_thread::yield();
+  std::vector<std::int32_t> ids(kNodes);
+  std::vector<double> u(3 * kNodes);
+  int whole = 0;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while ((whole < 2000 || written < 1000) && std::chrono::steady_clock::now() < end) {
+    shm::ShmDeformationFrame meta;
+    if (!driver.deformation().Read(&meta, ids.data(), u.data())) continue;
+    for (std::int32_t id : ids) ASSERT_EQ(id, meta.frame) << "ids of another frame";
+    for (double v : u) ASSERT_EQ(v, static_cast<double>(meta.frame)) << "a torn frame";
+    ++whole;
+  }
+  stop = true;
+  writer.join();
+  EXPECT_GT(whole, 100);
+  EXPECT_GT(written, 100) << "the writer hardly raced the reader";
 }
 
 TEST(SurfaceHandover, FramesStayWholeWhileTheRegionsAreReplacedAndSleep) {
