@@ -10,8 +10,11 @@
 #include "core/contact_trajectory.hpp"
 
 namespace hapticsim {
+namespace {
 
 using Clock = std::chrono::steady_clock;
+
+}  // namespace
 
 TrialResult AsyncRegions::RunTrial() { return RunTrial(partition_.scene().input); }
 

@@ -1,10 +1,10 @@
 #include "tools/hapticsim/deformation_watch.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <ctime>
 
 #include "core/error.hpp"
+#include "device/device_session.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -13,13 +13,6 @@ std::int64_t MonotonicUs() {
   timespec now{};
   clock_gettime(CLOCK_MONOTONIC, &now);
   return static_cast<std::int64_t>(now.tv_sec) * 1'000'000 + now.tv_nsec / 1000;
-}
-
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0;
-  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
 }
 
 }  // namespace
@@ -52,7 +45,7 @@ void DeformationWatch::On(const lcm::ReceiveBuffer*, const std::string&,
   if (last_frame_ >= 0 && frame->frame > last_frame_ + 1) lost_ += frame->frame - last_frame_ - 1;
   last_frame_ = frame->frame;
   if (!finite) ++nonfinite_;
-  latency_ms_.push_back(frame->latency_ms + way_ms);
+  latency_us_.push_back((frame->latency_ms + way_ms) * 1e3);
 }
 
 std::int64_t DeformationWatch::frames() const {
@@ -62,15 +55,15 @@ std::int64_t DeformationWatch::frames() const {
 
 nlohmann::json DeformationWatch::Summary() const {
   std::lock_guard lock(mutex_);
-  return {
-      {"deformation_frames", frames_},
-      {"deformation_frames_lost", lost_},
-      {"deformation_nonfinite", nonfinite_},
-      {"deformation_latency_ms",
-       {{"median", Quantile(latency_ms_, 0.5)},
-        {"p99", Quantile(latency_ms_, 0.99)},
-        {"max",
-         latency_ms_.empty() ? 0.0 : *std::max_element(latency_ms_.begin(), latency_ms_.end())}}}};
+  std::vector<double> latency_us = latency_us_;
+  const device::LatencySummary latency = device::Summarise(latency_us);
+  return {{"deformation_frames", frames_},
+          {"deformation_frames_lost", lost_},
+          {"deformation_nonfinite", nonfinite_},
+          {"deformation_latency_ms",
+           {{"median", latency.median_us * 1e-3},
+            {"p99", latency.p99_us * 1e-3},
+            {"max", latency.max_us * 1e-3}}}};
 }
 
 }  // namespace hapticsim::cli

@@ -41,7 +41,7 @@ class DeformationWatch {
   std::thread thread_;
   mutable std::mutex mutex_;
   std::int64_t frames_ = 0, lost_ = 0, nonfinite_ = 0, last_frame_ = -1;
-  std::vector<double> latency_ms_;
+  std::vector<double> latency_us_;  // asked to arrived, per frame
 };
 
 }  // namespace hapticsim::cli

@@ -170,12 +170,16 @@ int Run(const SimulateOptions& options) {
                                       : RunReference(scene, trial_options, frames);
   std::optional<ForceError> error;
   std::optional<TrialResult> reference;
-  if (options.compare_reference && !result.samples.empty()) {
+  // The full-resolution reference: to compare against, and beside an adaptive run in --vtk.
+  const bool compare = options.compare_reference && !result.samples.empty();
+  if (compare || (vtk && adaptive)) {
     Scene reference_scene = scene;
     reference_scene.adaptivity.primary_size = 0;
     TrialOptions reference_options;
     reference_options.substep_to_stability = true;
     reference = RunReference(reference_scene, reference_options, adaptive ? frames : nullptr);
+  }
+  if (compare) {
     if (reference->outcome != TrialOutcome::kCompleted) {
       throw Error("the full-resolution reference of this scene did not complete (" +
                   std::string(TrialOutcomeName(reference->outcome)) + "); lower solver.dt below " +
@@ -186,15 +190,6 @@ int Run(const SimulateOptions& options) {
         reference->samples.begin() +
             static_cast<long>(std::min(reference->samples.size(), result.samples.size())));
     error = CompareForces(result.samples, matched);
-  }
-
-  // --vtk writes the reference beside an adaptive run, whether or not it is compared.
-  if (vtk && adaptive && !reference) {
-    Scene reference_scene = scene;
-    reference_scene.adaptivity.primary_size = 0;
-    TrialOptions reference_options;
-    reference_options.substep_to_stability = true;
-    RunReference(reference_scene, reference_options, frames);
   }
   const bool wrote_series = !options.csv_path.empty() && !result.samples.empty();
   if (wrote_series) WriteCsv(options.csv_path, result);
