@@ -33,6 +33,7 @@ Command AddLogCommand(CLI::App& parent);
 Command AddStressCommand(CLI::App& parent);
 Command AddBenchCommand(CLI::App& parent);
 Command AddCtlCommand(CLI::App& parent);
+Command AddViewCommand(CLI::App& parent);
 /** argc/argv: soak runs itself again inside a private network namespace. */
 Command AddSoakCommand(CLI::App& parent, int argc, char** argv);
 

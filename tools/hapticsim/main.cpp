@@ -12,6 +12,7 @@
 //   hapticsim soak [--duration 60] [--json]                      daemon + device, checked
 //   hapticsim ctl reset | release | pin 3 2 600 | set-error-target 5    a command to the daemon
 //   hapticsim log SESSION.lcmlog [--csv out.csv]                 a recorded session
+//   hapticsim view [--port 8765]                                 live view in the browser
 //
 // Exit status: 0 success, 2 bad input (the message names the key), 3 unstable or diverged,
 // 4 a device or soak limit exceeded, 1 anything else.
@@ -38,7 +39,8 @@ int main(int argc, char** argv) {
                                       AddLookupCommand(app),    AddAnalyzeCommand(app),
                                       AddDeviceCommand(app),    AddSoakCommand(app, argc, argv),
                                       AddLogCommand(app),       AddStressCommand(app),
-                                      AddBenchCommand(app),     AddCtlCommand(app)};
+                                      AddBenchCommand(app),     AddCtlCommand(app),
+                                      AddViewCommand(app)};
   if (argc > 1 && argv[1][0] != '-') {
     const std::string chosen = argv[1];
     bool known = false;

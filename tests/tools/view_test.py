@@ -1,0 +1,217 @@
+#!/usr/bin/python3
+"""hapticsim view in a real headless Chromium, on a real daemon and a real LCM bus.
+
+Runs inside a private network namespace (tests/support/in_private_netns.sh): hapticsimd, the
+view's server, a simulated device pressing and Chromium all talk on its loopback only.
+
+Checks, as the issue asks:
+  - the page loads without console errors (the browser's log has no SEVERE entry);
+  - a screenshot shows the object (most of the picture outside the panel is not background);
+  - a second screenshot taken during a press differs where the tool is (around the tool tip's
+    point on the screen, and the change is centred near it), and the surface drawn under the
+    tool is at the tool's depth (the touched node is held there);
+  - the server answers only itself: other paths 404, another Host or Origin 403;
+  - Ctrl-C stops it cleanly, every message decoded.
+
+Usage: view_test.py HAPTICSIMD HAPTICSIM WORK_DIR [HAPTICSIMD ARGUMENTS...]
+(docs/images/view.png is WORK_DIR/during.png of a run with --error-map build/maps/default-scene.hsmap)
+"""
+import http.client
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from PIL import Image, ImageChops
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+
+daemon_bin, cli, work = sys.argv[1:4]
+daemon_args = sys.argv[4:]
+os.makedirs(work, exist_ok=True)
+processes = []
+
+
+def start(args, log_name, **kwargs):
+    log = open(os.path.join(work, log_name), "w")
+    p = subprocess.Popen(args, stdout=kwargs.pop("stdout", log), stderr=log, text=True, **kwargs)
+    processes.append(p)
+    return p
+
+
+def fail(message):
+    print("FAIL:", message)
+    for name in sorted(os.listdir(work)):
+        if name.endswith(".log"):
+            print(f"--- {name}:\n" + open(os.path.join(work, name)).read()[-3000:])
+    sys.exit(1)
+
+
+def wait_for(what, condition, timeout_s):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.1)
+    fail(f"timed out after {timeout_s} s waiting for {what}")
+
+
+def request(port, path, headers):
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=5)
+    c.request("GET", path, headers=headers)
+    r = c.getresponse()
+    r.read()
+    c.close()
+    return r.status
+
+
+def changed_fraction(image, background, panel):
+    """The share of pixels outside the panel that are not the page's background colour."""
+    px = image.convert("RGB").load()
+    w, h = image.size
+    changed = total = 0
+    for y in range(0, h, 2):
+        for x in range(0, w, 2):
+            if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
+                continue
+            total += 1
+            if sum(abs(a - b) for a, b in zip(px[x, y], background)) > 30:
+                changed += 1
+    return changed / total
+
+
+try:
+    start([daemon_bin, *daemon_args], "daemon.log")
+    view = start([cli, "view", "--port", "0", "--open", "no"], "view.log", stdout=subprocess.PIPE)
+    line = view.stdout.readline()
+    if "serving http://127.0.0.1:" not in line:
+        fail(f"hapticsim view did not say where it serves: {line!r}")
+    url = line.split("serving ")[1].split()[0]
+    port = int(url.rsplit(":", 1)[1].strip("/"))
+    print("view at", url)
+
+    # The server answers its own page only.
+    host = {"Host": f"127.0.0.1:{port}"}
+    assert request(port, "/", host) == 200
+    assert request(port, "/three.module.js", host) == 200
+    for path in ["/../../etc/passwd", "/etc/passwd", "/view.js/../x", "/node_modules/three"]:
+        status = request(port, path, host)
+        if status != 404:
+            fail(f"GET {path} answered {status}, not 404")
+    if request(port, "/", {"Host": "evil.example:80"}) != 403:
+        fail("a request for another Host was not refused (DNS rebinding)")
+    ws = {**host, "Upgrade": "websocket", "Connection": "Upgrade", "Sec-WebSocket-Version": "13",
+          "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ==", "Origin": "http://evil.example"}
+    if request(port, "/feed", ws) != 403:
+        fail("a WebSocket from another web site's Origin was not refused")
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = "/usr/bin/chromium"
+    for a in ["--headless=new", "--no-sandbox", "--use-angle=swiftshader",
+              "--enable-unsafe-swiftshader", "--window-size=1000,700", "--disable-gpu-sandbox",
+              f"--user-data-dir={work}/chromium-profile"]:
+        options.add_argument(a)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver",
+                                               log_output=os.path.join(work, "chromedriver.log")),
+                               options=options)
+    try:
+        browser.get(url)
+        wait_for("5 surface frames on the page",
+                 lambda: int(browser.find_element("tag name", "body").get_attribute("data-frames")) >= 5,
+                 30)
+        time.sleep(0.5)
+        before_path = os.path.join(work, "before.png")
+        browser.save_screenshot(before_path)
+        panel = browser.execute_script(
+            "const r = document.getElementById('panel').getBoundingClientRect();"
+            "return [r.left, r.top, r.right, r.bottom];")
+        scale = browser.execute_script("return window.devicePixelRatio")
+        panel = [v * scale for v in panel]
+        before = Image.open(before_path)
+        shown = changed_fraction(before, (0x1d, 0x21, 0x27), panel)
+        print(f"before the press: {100 * shown:.1f} % of the picture outside the panel is the object")
+        if shown < 0.05:
+            fail(f"the screenshot does not show the object ({100 * shown:.1f} % not background)")
+
+        # A 10 mm press at the front face's centre, 4 s per press.
+        device = start([cli, "device", "--input", "press", "--amplitude", "0.01",
+                        "--frequency", "0.25", "--duration", "6"], "device.log")
+        state_js = ("const v = window.hapticsimView, s = v.state; return {"
+                    "tool: v.toolOnScreen(), contact: s.deformation && s.deformation.in_contact,"
+                    "force: s.force ? Math.hypot(...s.force.force_n) : 0,"
+                    "toolZ: s.toolPosition ? s.toolPosition[2] : null, drawnZ: v.touchedNodeDrawn()};")
+        wait_for("the press to reach 8 mm on the page",
+                 lambda: (lambda s: s["contact"] and s["toolZ"] is not None and s["toolZ"] > 0.008 and s)(
+                     browser.execute_script(state_js)), 10)
+        during_path = os.path.join(work, "during.png")
+        browser.save_screenshot(during_path)
+        s = browser.execute_script(state_js)
+        print(f"during the press: tool at {1e3 * s['toolZ']:.2f} mm, the surface under it drawn at "
+              f"{1e3 * s['drawnZ'][2]:.2f} mm, force {s['force']:.3f} N, tool on screen at "
+              f"({s['tool']['x']:.0f}, {s['tool']['y']:.0f}) px")
+        # The touched node is held at the tool's depth; the page's frame is up to ~1/60 s older.
+        if abs(s["drawnZ"][2] - s["toolZ"]) > 1.5e-3:
+            fail("the surface under the tool is not drawn at the tool's depth")
+        if not 0.2 < s["force"] < 5:
+            fail(f"the page shows {s['force']:.3f} N during a 10 mm press")
+
+        during = Image.open(during_path)
+        diff = ImageChops.difference(before.convert("L"), during.convert("L"))
+        tx, ty = s["tool"]["x"] * scale, s["tool"]["y"] * scale
+        r = 25 * scale
+        near_box = (int(tx - r), int(ty - r), int(tx + r), int(ty + r))
+        px = diff.load()
+        w, h = diff.size
+        # How much changed near the tool and elsewhere outside the panel (its text changes too),
+        # and where the change is, weighted by how much.
+        near_sum = near_n = far_sum = far_n = 0
+        sx = sy = weight = 0.0
+        for y in range(h):
+            for x in range(w):
+                if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
+                    continue
+                v = px[x, y]
+                if near_box[0] <= x < near_box[2] and near_box[1] <= y < near_box[3]:
+                    near_sum, near_n = near_sum + v, near_n + 1
+                else:
+                    far_sum, far_n = far_sum + v, far_n + 1
+                if v > 20:
+                    sx, sy, weight = sx + x * v, sy + y * v, weight + v
+        if weight == 0:
+            fail("the screenshot during the press is the same as before it")
+        near, far = near_sum / near_n, far_sum / far_n
+        offset = math.hypot(sx / weight - tx, sy / weight - ty) / scale
+        print(f"change within 25 px of the tool: {near:.1f} of 255 on average, elsewhere "
+              f"{far:.2f}; the change is centred {offset:.0f} px from the tool")
+        if near < 5 or near < 5 * far:
+            fail("the picture does not change where the tool is")
+        if offset > 150:
+            fail("the picture changes mostly away from the tool")
+
+        errors = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+        if errors:
+            fail("console errors: " + json.dumps(errors, indent=1))
+        device.wait(timeout=20)
+    finally:
+        browser.quit()
+
+    view.send_signal(signal.SIGINT)
+    out, _ = view.communicate(timeout=10)
+    if view.returncode != 0 or "(0 undecodable)" not in out:
+        fail(f"hapticsim view did not stop cleanly: exit {view.returncode}, {out!r}")
+    print(out.strip())
+    print("PASS")
+finally:
+    for p in processes:
+        if p.poll() is None:
+            p.terminate()
+    for p in processes:
+        try:
+            p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            p.kill()
