@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
+#include "ipc/lcm_start.hpp"
 
 namespace hapticsim {
 
@@ -48,10 +49,8 @@ LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters
       intake_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s, loop,
               counters, DeviceInputOf(config) == "lcm"),
       gate_(std::move(gate)) {
-  if (!lcm_.good()) {
-    throw Error("LCM could not start on " + config.lcm_url +
-                " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
-                "224.0.0.0/4 dev lo`; set lcm.url in the config)");
+  if (const std::string problem = LcmStartProblem(lcm_, config.lcm_url); !problem.empty()) {
+    throw Error(problem + " (lcm.url in the config)");
   }
   lcm_.subscribe(config.device_channel, &LcmBridge::OnDevice, this)->setQueueCapacity(1000);
   lcm_.subscribe(config.command_channel, &LcmBridge::OnCommand, this)->setQueueCapacity(100);
@@ -67,8 +66,8 @@ void LcmBridge::LogRoute(const DaemonConfig& config) {
         "LCM's multicast group is routed off loopback (source address {}): machines on that "
         "network can send device input to the daemon, and under the systemd unit, whose IP "
         "filter admits only localhost, local LCM clients' packets (source {}) are dropped. "
-        "Route the group through loopback: ip route replace 224.0.0.0/4 dev lo",
-        source, source);
+        "Route the group through loopback: {}",
+        source, source, kLcmLoopbackRoute);
   }
   if (LcmUrlLeavesHost(config.lcm_url)) {
     spdlog::warn(

@@ -9,6 +9,7 @@
 #include "core/monotonic_clock.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
+#include "ipc/lcm_start.hpp"
 #include "ipc/shm_device_client.hpp"
 
 namespace hapticsim::device {
@@ -19,9 +20,8 @@ class LcmLink final : public DeviceLink {
   LcmLink(const std::string& url, std::string device_channel, const std::string& force_channel,
           const std::string& status_channel, bool listen_only)
       : lcm_(url), device_channel_(std::move(device_channel)), listen_only_(listen_only) {
-    if (!lcm_.good()) {
-      throw Error("LCM could not start on " + url +
-                  " (no multicast route? inside a private network namespace, add one on lo)");
+    if (const std::string problem = LcmStartProblem(lcm_, url); !problem.empty()) {
+      throw Error(problem);
     }
     lcm_.subscribe(force_channel, &LcmLink::OnForce, this);
     lcm_.subscribe(status_channel, &LcmLink::OnStatus, this);

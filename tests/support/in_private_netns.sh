@@ -12,4 +12,4 @@ if [ "${1:-}" = "--keep-users" ]; then
   [ "$(id -u)" -eq 0 ] && user_namespace=()
 fi
 exec unshare "${user_namespace[@]}" --net sh -c \
-  'ip link set lo up && ip route add 224.0.0.0/4 dev lo && exec "$@"' sh "$@"
+  'ip link set lo up && ip route add 224.0.0.0/4 dev lo src 127.0.0.1 && exec "$@"' sh "$@"

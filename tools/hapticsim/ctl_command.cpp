@@ -13,6 +13,7 @@
 #include "daemon/daemon_config.hpp"
 #include "ipc/command_signature.hpp"
 #include "ipc/control_client.hpp"
+#include "ipc/lcm_start.hpp"
 #include "tools/hapticsim/command.hpp"
 
 namespace hapticsim::cli {
@@ -59,8 +60,7 @@ int SendSignedOnLcm(const CtlOptions& o, const std::string& line) {
   SignCommand(&*command, o.channel, key);
   if (!lcm.good() || lcm.publish(o.channel, &*command) != 0) {
     throw Error("ctl: LCM could not send on " + o.lcm_url +
-                " (for udpm:// the interface needs a multicast route, e.g. `ip route add "
-                "224.0.0.0/4 dev lo`)");
+                " (for udpm:// the interface needs a multicast route: " + kLcmLoopbackRoute + ")");
   }
   std::cout << "sent, signed, on " << o.channel
             << ". LCM carries no answer: the daemon's status counts a refusal in "

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "device/device_session.hpp"
+#include "ipc/lcm_start.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -19,7 +20,8 @@ std::int64_t MonotonicUs() {
 
 DeformationWatch::DeformationWatch(const std::string& lcm_url, const std::string& channel)
     : lcm_(lcm_url) {
-  HAPTICSIM_THROW_UNLESS(lcm_.good(), "LCM could not start on " + lcm_url);
+  const std::string problem = LcmStartProblem(lcm_, lcm_url);
+  HAPTICSIM_THROW_UNLESS(problem.empty(), problem);
   lcm_.subscribe(channel, &DeformationWatch::On, this)->setQueueCapacity(200);
   thread_ = std::thread([this] {
     while (!stop_) lcm_.handleTimeout(20);

@@ -115,7 +115,7 @@ std::string DefaultDaemon() {
                                 "--net",
                                 "sh",
                                 "-c",
-                                "ip link set lo up && ip route add 224.0.0.0/4 dev lo && "
+                                "ip link set lo up && ip route add 224.0.0.0/4 dev lo src 127.0.0.1 && "
                                 "exec \"$@\"",
                                 "sh",
                                 SelfPath().string()};
