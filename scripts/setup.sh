@@ -42,8 +42,9 @@ fi
 # three.js for hapticsim view, compiled into the binary (tools/CMakeLists.txt): fetched once, again
 # only when the lock file is newer than what npm last installed (its node_modules/.package-lock.json).
 view="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/web/view"
-if ! [ "$view/node_modules/.package-lock.json" -nt "$view/package-lock.json" ]; then
+if ! [ "$view/node_modules/.package-lock.json" -nt "$view/package-lock.json" ] ||
+   ! [ -f "$view/node_modules/three/build/three.module.js" ]; then
   echo "setup: npm ci in web/view (three.js for hapticsim view)"
-  npm ci --prefix "$view" --no-audit --no-fund --loglevel=error >/dev/null
+  npm ci --prefix "$view" --no-audit --no-fund --ignore-scripts --loglevel=error >/dev/null
 fi
 echo "setup: done"

@@ -8,13 +8,17 @@ Checks, as the issue asks:
   - the page loads without console errors (the browser's log has no SEVERE entry);
   - a screenshot shows the object (most of the picture outside the panel is not background);
   - a second screenshot taken during a press differs where the tool is (around the tool tip's
-    point on the screen, and the change is centred near it), and the surface drawn under the
-    tool is at the tool's depth (the touched node is held there);
+    point on the screen, and the change is centred near it); with the tool and the arrow hidden,
+    the dent alone still changes the picture there; the surface mesh drawn under the tool is at
+    the tool's depth (the touched node is held there);
+  - the primary region drawn is the one the daemon's hybrid mesh makes: the coarse cells that
+    overlap the contact node ± primary_size (core/hybrid_mesh.cpp, CellOverlaps, written again
+    here);
   - the server answers only itself: other paths 404, another Host or Origin 403;
   - Ctrl-C stops it cleanly, every message decoded.
 
 Usage: view_test.py HAPTICSIMD HAPTICSIM WORK_DIR [HAPTICSIMD ARGUMENTS...]
-(docs/images/view.png is WORK_DIR/during.png of a run with --error-map build/maps/default-scene.hsmap)
+(docs/view.png is WORK_DIR/during.png of a run with --error-map MAP)
 """
 import http.client
 import json
@@ -117,7 +121,7 @@ try:
         options.add_argument(a)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver",
-                                               log_output=os.path.join(work, "chromedriver.log")),
+                                               log_path=os.path.join(work, "chromedriver.log")),
                                options=options)
     try:
         browser.get(url)
@@ -138,60 +142,98 @@ try:
         if shown < 0.05:
             fail(f"the screenshot does not show the object ({100 * shown:.1f} % not background)")
 
-        # A 10 mm press at the front face's centre, 4 s per press.
+        # The primary region the page draws against the daemon's rule, from the frame it drew.
+        d = browser.execute_script("return window.hapticsimView.state.deformation")
+        extent = browser.execute_script("return window.hapticsimView.primaryExtent()")
+        n, k, r = d["nodes_per_axis"], max(1, d["secondary_lod"]), d["primary_size"]
+        expected = {"lo": [], "hi": []}
+        for c in d["contact_node"]:
+            box_lo, box_hi = max(0, c - r), min(n - 1, c + r)
+            cells = [j for j in range((n - 1) // k) if j * k < box_hi and (j + 1) * k > box_lo]
+            expected["lo"].append(cells[0] * k)
+            expected["hi"].append((cells[-1] + 1) * k)
+        print(f"primary region drawn over lattice {extent}, the hybrid mesh's {expected}")
+        if extent != expected:
+            fail("the page draws another primary region than the daemon's")
+
+        # A 10 mm press at the front face's centre, 8 s per press: above 8 mm for 2.3 s.
         device = start([cli, "device", "--input", "press", "--amplitude", "0.01",
-                        "--frequency", "0.25", "--duration", "6"], "device.log")
+                        "--frequency", "0.125", "--duration", "9"], "device.log")
         state_js = ("const v = window.hapticsimView, s = v.state; return {"
                     "tool: v.toolOnScreen(), contact: s.deformation && s.deformation.in_contact,"
                     "force: s.force ? Math.hypot(...s.force.force_n) : 0,"
-                    "toolZ: s.toolPosition ? s.toolPosition[2] : null, drawnZ: v.touchedNodeDrawn()};")
-        wait_for("the press to reach 8 mm on the page",
-                 lambda: (lambda s: s["contact"] and s["toolZ"] is not None and s["toolZ"] > 0.008 and s)(
-                     browser.execute_script(state_js)), 10)
+                    "toolZ: s.toolPosition ? s.toolPosition[2] : null, drawnZ: v.touchedNodeDrawn(),"
+                    "surface: v.surfaceAtTouchedNode()};")
+        pressed = lambda: (lambda s: s["contact"] and s["toolZ"] is not None and s["toolZ"] > 0.008 and s)(
+            browser.execute_script(state_js))
+        wait_for("the press to reach 8 mm on the page", pressed, 12)
         during_path = os.path.join(work, "during.png")
         browser.save_screenshot(during_path)
-        s = browser.execute_script(state_js)
+        s = pressed()
+        if not s:
+            fail("the press left 8 mm while the screenshot was taken (a loaded machine?)")
+        # The same moment without the tool and the arrow: only the surface changed.
+        browser.execute_script("window.hapticsimView.showTool(false)")
+        time.sleep(0.2)
+        surface_path = os.path.join(work, "during-surface-only.png")
+        browser.save_screenshot(surface_path)
+        browser.execute_script("window.hapticsimView.showTool(true)")
+        if not pressed():
+            fail("the press left 8 mm while the surface-only screenshot was taken")
         print(f"during the press: tool at {1e3 * s['toolZ']:.2f} mm, the surface under it drawn at "
               f"{1e3 * s['drawnZ'][2]:.2f} mm, force {s['force']:.3f} N, tool on screen at "
               f"({s['tool']['x']:.0f}, {s['tool']['y']:.0f}) px")
         # The touched node is held at the tool's depth; the page's frame is up to ~1/60 s older.
         if abs(s["drawnZ"][2] - s["toolZ"]) > 1.5e-3:
-            fail("the surface under the tool is not drawn at the tool's depth")
+            fail("the lattice under the tool is not drawn at the tool's depth")
+        mesh_z = [v[2] for v in s["surface"]]
+        print(f"the surface mesh has the touched node in {len(mesh_z)} vertices, at "
+              f"{1e3 * min(mesh_z):.2f}–{1e3 * max(mesh_z):.2f} mm" if mesh_z else "no vertices")
+        if len(mesh_z) < 6 or any(abs(z - s["toolZ"]) > 1.5e-3 for z in mesh_z):
+            fail("the surface mesh under the tool is not drawn at the tool's depth")
         if not 0.2 < s["force"] < 5:
             fail(f"the page shows {s['force']:.3f} N during a 10 mm press")
 
-        during = Image.open(during_path)
-        diff = ImageChops.difference(before.convert("L"), during.convert("L"))
         tx, ty = s["tool"]["x"] * scale, s["tool"]["y"] * scale
-        r = 25 * scale
-        near_box = (int(tx - r), int(ty - r), int(tx + r), int(ty + r))
-        px = diff.load()
-        w, h = diff.size
-        # How much changed near the tool and elsewhere outside the panel (its text changes too),
-        # and where the change is, weighted by how much.
-        near_sum = near_n = far_sum = far_n = 0
-        sx = sy = weight = 0.0
-        for y in range(h):
-            for x in range(w):
-                if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
-                    continue
-                v = px[x, y]
-                if near_box[0] <= x < near_box[2] and near_box[1] <= y < near_box[3]:
-                    near_sum, near_n = near_sum + v, near_n + 1
-                else:
-                    far_sum, far_n = far_sum + v, far_n + 1
-                if v > 20:
-                    sx, sy, weight = sx + x * v, sy + y * v, weight + v
-        if weight == 0:
-            fail("the screenshot during the press is the same as before it")
-        near, far = near_sum / near_n, far_sum / far_n
-        offset = math.hypot(sx / weight - tx, sy / weight - ty) / scale
+
+        def change_near_tool(after_path, radius_px):
+            """Mean change within radius of the tool and elsewhere outside the panel (its text
+            changes too), the share of pixels that changed by more than 5 of 255 there and
+            elsewhere, and how far from the tool the change is centred, in px."""
+            diff = ImageChops.difference(before.convert("L"), Image.open(after_path).convert("L"))
+            r = radius_px * scale
+            box = (tx - r, ty - r, tx + r, ty + r)
+            px = diff.load()
+            w, h = diff.size
+            near_sum = near_n = far_sum = far_n = near_changed = far_changed = 0
+            sx = sy = weight = 0.0
+            for y in range(h):
+                for x in range(w):
+                    if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
+                        continue
+                    v = px[x, y]
+                    if box[0] <= x < box[2] and box[1] <= y < box[3]:
+                        near_sum, near_n, near_changed = near_sum + v, near_n + 1, near_changed + (v > 5)
+                    else:
+                        far_sum, far_n, far_changed = far_sum + v, far_n + 1, far_changed + (v > 5)
+                    if v > 20:
+                        sx, sy, weight = sx + x * v, sy + y * v, weight + v
+            offset = math.hypot(sx / weight - tx, sy / weight - ty) / scale if weight else math.inf
+            return (near_sum / near_n, far_sum / far_n, near_changed / near_n,
+                    far_changed / far_n, offset)
+
+        near, far, _, _, offset = change_near_tool(during_path, 25)
         print(f"change within 25 px of the tool: {near:.1f} of 255 on average, elsewhere "
               f"{far:.2f}; the change is centred {offset:.0f} px from the tool")
         if near < 5 or near < 5 * far:
             fail("the picture does not change where the tool is")
         if offset > 150:
             fail("the picture changes mostly away from the tool")
+        _, _, near, far, _ = change_near_tool(surface_path, 25)
+        print(f"the surface alone (tool and arrow hidden): {100 * near:.0f} % of the pixels within "
+              f"25 px of the tool changed, {100 * far:.1f} % elsewhere")
+        if near < 0.2 or near < 4 * far:
+            fail("the dent does not show where the tool presses")
 
         errors = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
         if errors:

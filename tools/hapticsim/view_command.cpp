@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "core/error.hpp"
@@ -31,14 +32,27 @@ struct ViewOptions {
   std::string open = "auto";
 };
 
+#if HAPTICSIM_WITH_VIEW
 std::atomic<bool> g_stop{false};
 void OnStopSignal(int) { g_stop = true; }
 
-// Starts the desktop's browser on the page (xdg-open), without waiting for it.
+// Starts the desktop's browser on the page (xdg-open), without waiting for it: in a session of
+// its own (Ctrl-C here does not close the browser) and with none of our descriptors (a browser
+// it starts must not keep LCM's sockets or the server's port).
 void OpenBrowser(const std::string& url) {
   const char* argv[] = {"xdg-open", url.c_str(), nullptr};
+  posix_spawnattr_t attributes;
+  posix_spawn_file_actions_t actions;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSID);
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
   pid_t pid = 0;
-  if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char**>(argv), environ) != 0) {
+  const int failed =
+      posix_spawnp(&pid, "xdg-open", &actions, &attributes, const_cast<char**>(argv), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  if (failed != 0) {
     std::cerr << "hapticsim view: could not run xdg-open; open " << url << " yourself\n";
     return;
   }
@@ -58,34 +72,44 @@ int Run(const ViewOptions& o) {
                                          {"force", channels.force},
                                          {"status", channels.status},
                                          {"deformation", channels.deformation}}}}
-                            .dump();
-  // The port first: a command line it refuses never starts LCM.
-  view::ViewServer server(settings);
-  view::ViewFeed feed(o.lcm_url, channels);
-  const std::string url = "http://127.0.0.1:" + std::to_string(server.port()) + "/";
-  std::cout << "hapticsim view: serving " << url << " (listening to " << o.lcm_url
-            << "); Ctrl-C stops" << std::endl;
-  const bool desktop = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
-  if (o.open == "yes" || (o.open == "auto" && desktop)) OpenBrowser(url);
-
+                            .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   struct sigaction action {};
   action.sa_handler = OnStopSignal;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
-  std::thread waiting([&feed, &o] {
-    for (int i = 0; i < 50 && !g_stop; ++i)
+  // The port first: a command line it refuses never starts LCM. The feed outlives the server's
+  // connection threads, which read it, whatever way Run ends.
+  std::optional<view::ViewFeed> feed;
+  view::ViewServer server(settings);
+  const std::string url = "http://127.0.0.1:" + std::to_string(server.port()) + "/";
+  const bool desktop = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
+  if (o.open == "yes" || (o.open == "auto" && desktop)) OpenBrowser(url);
+  feed.emplace(o.lcm_url, channels);
+  std::cout << "hapticsim view: serving " << url << " (listening to " << o.lcm_url
+            << "); Ctrl-C stops" << std::endl;
+  std::jthread waiting([&feed = *feed, &o] {
+    for (int i = 0; i < 50 && !g_stop; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
     if (!g_stop && feed.messages() == 0) {
       std::cerr << "hapticsim view: no message from hapticsimd on " << o.lcm_url
                 << " after 5 s: is it running, with [lcm] enabled, on this URL?\n";
     }
   });
-  server.Run(feed, g_stop);
+  server.Run(*feed, g_stop);
   waiting.join();
-  std::cout << "hapticsim view: stopped after " << feed.messages() << " messages ("
-            << feed.decode_errors() << " undecodable)" << std::endl;
+  std::cout << "hapticsim view: stopped after " << feed->messages() << " messages ("
+            << feed->decode_errors() << " undecodable)" << std::endl;
   return kExitOk;
 }
+#else
+int Run(const ViewOptions&) {
+  throw Error(
+      "this hapticsim was built without the live view: web/view/node_modules was missing when it "
+      "was configured; run scripts/setup.sh (npm ci in web/view fetches three.js), then build "
+      "again");
+}
+#endif
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "ipc/lcm_start.hpp"
 
 namespace hapticsim::view {
 namespace {
@@ -49,8 +50,7 @@ class ViewFeed::Handlers {
     if (!Decode(buffer, m)) return feed_.decode_errors_++, void();
     feed_.Publish(
         &FeedSnapshot::tool, &FeedSnapshot::tool_version,
-        json{{"type", "tool"}, {"position_m", {m.position[0], m.position[1], m.position[2]}}}
-            .dump());
+        json{{"type", "tool"}, {"position_m", {m.position[0], m.position[1], m.position[2]}}});
   }
 
   void OnForce(const lcm::ReceiveBuffer* buffer, const std::string&) {
@@ -62,8 +62,7 @@ class ViewFeed::Handlers {
              {"force_n", {m.force[0], m.force[1], m.force[2]}},
              {"error_percent", m.error_percent},
              {"in_contact", (m.flags & hapticsim::force_feedback_t::FLAG_IN_CONTACT) != 0},
-             {"flags", m.flags}}
-            .dump());
+             {"flags", m.flags}});
   }
 
   void OnStatus(const lcm::ReceiveBuffer* buffer, const std::string&) {
@@ -81,8 +80,7 @@ class ViewFeed::Handlers {
                        {"max_force_n", m.max_force_n},
                        {"fault_latched", m.fault_latched},
                        {"asleep", m.asleep},
-                       {"regions", RegionsJson(m)}}
-                      .dump());
+                       {"regions", RegionsJson(m)}});
   }
 
   // node_ids come in the first frame of each configuration and once a second; every frame the
@@ -117,8 +115,7 @@ class ViewFeed::Handlers {
                        {"nodes_per_axis", m.nodes_per_axis},
                        {"spacing_m", m.spacing_m},
                        {"node_ids", ids_},
-                       {"displacement_m", displacement}}
-                      .dump());
+                       {"displacement_m", displacement}});
   }
 
  private:
@@ -129,9 +126,8 @@ class ViewFeed::Handlers {
 
 ViewFeed::ViewFeed(const std::string& lcm_url, FeedChannels channels)
     : lcm_(std::make_unique<lcm::LCM>(lcm_url)), handlers_(std::make_unique<Handlers>(*this)) {
-  HAPTICSIM_THROW_UNLESS(lcm_->good(), "cannot start LCM on " + lcm_url +
-                                           ": check --lcm-url (on a host without a multicast "
-                                           "route: ip route add 224.0.0.0/4 dev lo)");
+  const std::string problem = LcmStartProblem(*lcm_, lcm_url);
+  HAPTICSIM_THROW_UNLESS(problem.empty(), problem + " (--lcm-url)");
   lcm_->subscribe(channels.device, &Handlers::OnDevice, handlers_.get());
   lcm_->subscribe(channels.force, &Handlers::OnForce, handlers_.get());
   lcm_->subscribe(channels.status, &Handlers::OnStatus, handlers_.get());
@@ -145,15 +141,22 @@ ViewFeed::~ViewFeed() {
 }
 
 void ViewFeed::Run() {
-  while (!stop_) lcm_->handleTimeout(100);
+  while (!stop_) {
+    // -1: LCM failed (a tcpq:// server gone); wait rather than spin.
+    if (lcm_->handleTimeout(100) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
 }
 
-void ViewFeed::Publish(std::string FeedSnapshot::*text, uint64_t FeedSnapshot::*version,
-                       std::string json_text) {
+void ViewFeed::Publish(FeedSnapshot::Text FeedSnapshot::*text, uint64_t FeedSnapshot::*version,
+                       const nlohmann::json& message) {
   messages_++;
+  // Text from the bus (a map's path, a region's name) may be any bytes: invalid UTF-8 is
+  // replaced, not thrown about.
+  auto shared = std::make_shared<const std::string>(
+      message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   {
     std::lock_guard lock(mutex_);
-    snapshot_.*text = std::move(json_text);
+    snapshot_.*text = std::move(shared);
     snapshot_.*version = ++snapshot_.version;
   }
   changed_.notify_all();

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <thread>
 #include <vector>
@@ -24,10 +25,12 @@ struct FeedChannels {
               deformation = "HAPTIC_DEFORMATION";
 };
 
-/** What the page is sent: one JSON text per kind of message, the newest, with a version each. */
+/** What the page is sent: one JSON text per kind of message, the newest, with a version each.
+ *  The texts are shared, not copied: a snapshot costs a few reference counts. */
 struct FeedSnapshot {
+  using Text = std::shared_ptr<const std::string>;
   uint64_t version = 0;  ///< grows with every message taken in; 0: nothing yet
-  std::string deformation, force, tool, status;
+  Text deformation, force, tool, status;
   uint64_t deformation_version = 0, force_version = 0, tool_version = 0, status_version = 0;
 };
 
@@ -49,7 +52,8 @@ class ViewFeed {
  private:
   class Handlers;
   void Run();
-  void Publish(std::string FeedSnapshot::*text, uint64_t FeedSnapshot::*version, std::string json);
+  void Publish(FeedSnapshot::Text FeedSnapshot::*text, uint64_t FeedSnapshot::*version,
+               const nlohmann::json& message);
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::unique_ptr<Handlers> handlers_;

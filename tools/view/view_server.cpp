@@ -1,5 +1,6 @@
 #include "tools/view/view_server.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/socket.h>
 
@@ -8,6 +9,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <system_error>
 
 #include "core/error.hpp"
 #include "tools/view/view_assets.hpp"
@@ -22,13 +24,16 @@ namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 using Request = http::request<http::string_body>;
 
+// Browsers leave the port out of Host and Origin when it is 80.
+std::string PortSuffix(int port) { return port == 80 ? "" : ":" + std::to_string(port); }
+
 bool HostIsOurs(std::string_view host, int port) {
-  const std::string p = ":" + std::to_string(port);
+  const std::string p = PortSuffix(port);
   return host == "127.0.0.1" + p || host == "localhost" + p;
 }
 
 bool OriginIsOurs(std::string_view origin, int port) {
-  const std::string p = ":" + std::to_string(port);
+  const std::string p = PortSuffix(port);
   return origin == "http://127.0.0.1" + p || origin == "http://localhost" + p;
 }
 
@@ -63,22 +68,48 @@ http::response<http::string_body> AssetOrError(const Request& request) {
                  "hapticsim view has no " + std::string(path) + "\n");
 }
 
+using Clock = std::chrono::steady_clock;
+
+// While alive, the blocking read or write it guards must end within `limit`, or the server shuts
+// the connection's socket down (ViewServer::Reap): asio's blocking calls wait out SO_RCVTIMEO,
+// so a peer that stops reading or sending would otherwise hold its slot for good.
+class Deadline {
+ public:
+  Deadline(std::atomic<int64_t>& deadline, std::chrono::seconds limit) : deadline_(deadline) {
+    deadline_ = (Clock::now() + limit).time_since_epoch().count();
+  }
+  ~Deadline() { deadline_ = 0; }
+  Deadline(const Deadline&) = delete;
+  Deadline& operator=(const Deadline&) = delete;
+
+ private:
+  std::atomic<int64_t>& deadline_;
+};
+
+constexpr std::chrono::seconds kReadLimit{10}, kWriteLimit{5};
+
 // Sends the hello, then the newest of each kind of message whenever the feed has a newer one, at
 // most frame_rate_hz times a second: a page that draws slower gets fewer, newer frames.
 void StreamFeed(websocket::stream<tcp::socket&>& ws, const ViewFeed& feed,
-                const ServerSettings& settings, const std::atomic<bool>& stopping) {
-  using Clock = std::chrono::steady_clock;
+                const ServerSettings& settings, const std::atomic<bool>& stopping,
+                std::atomic<int64_t>& deadline) {
   const auto frame = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / settings.frame_rate_hz));
   boost::system::error_code ec;
   ws.text(true);
-  ws.write(asio::buffer(settings.hello_json), ec);
+  {
+    Deadline limit(deadline, kWriteLimit);
+    ws.write(asio::buffer(settings.hello_json), ec);
+  }
   FeedSnapshot seen;
   auto next = Clock::now();
   while (!ec && !stopping) {
     const FeedSnapshot now = feed.WaitNewer(seen.version, std::chrono::milliseconds(200));
-    const auto send = [&](const std::string& text, uint64_t version, uint64_t seen_version) {
-      if (!ec && version > seen_version && !text.empty()) ws.write(asio::buffer(text), ec);
+    const auto send = [&](const FeedSnapshot::Text& text, uint64_t version, uint64_t seen_version) {
+      if (!ec && version > seen_version && text) {
+        Deadline limit(deadline, kWriteLimit);
+        ws.write(asio::buffer(*text), ec);
+      }
     };
     send(now.status, now.status_version, seen.status_version);
     send(now.deformation, now.deformation_version, seen.deformation_version);
@@ -88,8 +119,13 @@ void StreamFeed(websocket::stream<tcp::socket&>& ws, const ViewFeed& feed,
     next = std::max(next + frame, Clock::now());
     std::this_thread::sleep_until(next);
   }
-  if (stopping) ws.close(websocket::close_code::going_away, ec);
+  // No ws.close() at a stop: its teardown would close the socket, whose descriptor the server
+  // shuts down from its own thread (ViewServer::Reap); the browser sees the connection end.
 }
+
+// Descriptors of the server and its connections are not handed to programs it starts (xdg-open,
+// and the browser that may outlive it).
+void CloseOnExec(int fd) { ::fcntl(fd, F_SETFD, ::fcntl(fd, F_GETFD) | FD_CLOEXEC); }
 
 }  // namespace
 
@@ -99,6 +135,7 @@ struct ViewServer::Connection {
   int fd;
   std::thread thread;
   std::atomic<bool> done{false};
+  std::atomic<int64_t> deadline{0};  ///< Clock ticks a blocking call must end by; 0: none
 };
 
 class ViewServer::Impl {
@@ -111,13 +148,14 @@ ViewServer::ViewServer(ServerSettings settings)
     : settings_(std::move(settings)), impl_(std::make_unique<Impl>()) {
   HAPTICSIM_THROW_UNLESS(settings_.port >= 0 && settings_.port <= 65535,
                          "--port " + std::to_string(settings_.port) + ": use 0 to 65535");
-  HAPTICSIM_THROW_UNLESS(settings_.frame_rate_hz > 0 && settings_.frame_rate_hz <= 1000,
-                         "--frame-rate must be in (0, 1000] Hz");
+  HAPTICSIM_THROW_UNLESS(settings_.frame_rate_hz >= 1 && settings_.frame_rate_hz <= 1000,
+                         "--frame-rate must be 1 to 1000 Hz");
   const tcp::endpoint endpoint(asio::ip::address_v4::loopback(),
                                static_cast<unsigned short>(settings_.port));
   boost::system::error_code ec;
   auto& acceptor = impl_->acceptor;
   acceptor.open(endpoint.protocol(), ec);
+  if (!ec) CloseOnExec(acceptor.native_handle());
   if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
   if (!ec) acceptor.bind(endpoint, ec);
   if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
@@ -146,26 +184,34 @@ void ViewServer::Run(const ViewFeed& feed, const std::atomic<bool>& stop) {
     tcp::socket socket(impl_->io);
     acceptor.accept(socket, ec);
     if (ec) continue;
+    CloseOnExec(socket.native_handle());
     std::lock_guard lock(connections_mutex_);
     if (connections_.size() >= kMaxConnections) continue;  // closed as it goes out of scope
     Connection& c = connections_.emplace_back(std::move(socket));
-    c.thread = std::thread([this, &c] {
-      Serve(c);
-      c.done = true;
-    });
+    try {
+      c.thread = std::thread([this, &c] {
+        Serve(c);
+        c.done = true;
+      });
+    } catch (const std::system_error&) {
+      connections_.pop_back();  // no thread to serve it: closed
+    }
   }
   stopping_ = true;
   Reap(/*all=*/true);
 }
 
-// Joins the connections that ended; with all, first shuts every socket down, which ends any
-// read or write a connection's thread is blocked in.
+// Joins the connections that ended; shuts down those past their deadline and, with all, every
+// one, which ends any read or write a connection's thread is blocked in. A connection's
+// descriptor stays open until its thread is joined, so the one shut down is never another's.
 void ViewServer::Reap(bool all) {
   std::list<Connection> ended;
   {
     std::lock_guard lock(connections_mutex_);
+    const int64_t now = Clock::now().time_since_epoch().count();
     for (auto it = connections_.begin(); it != connections_.end();) {
-      if (all) ::shutdown(it->fd, SHUT_RDWR);
+      const int64_t deadline = it->deadline;
+      if (all || (deadline != 0 && now > deadline)) ::shutdown(it->fd, SHUT_RDWR);
       auto next = std::next(it);
       if (all || it->done) ended.splice(ended.end(), connections_, it);
       it = next;
@@ -181,7 +227,10 @@ void ViewServer::Serve(Connection& connection) {
     http::request_parser<http::string_body> parser;
     parser.header_limit(8 * 1024);
     parser.body_limit(4 * 1024);
-    http::read(connection.socket, buffer, parser, ec);
+    {
+      Deadline limit(connection.deadline, kReadLimit);
+      http::read(connection.socket, buffer, parser, ec);
+    }
     if (ec) return;
     Request request = parser.release();
     const auto host = request[http::field::host];
@@ -193,7 +242,7 @@ void ViewServer::Serve(Connection& connection) {
           ec);
       return;
     }
-    if (websocket::is_upgrade(request)) {
+    if (websocket::is_upgrade(request) && request.target() == "/feed") {
       const auto origin = request[http::field::origin];
       if (!OriginIsOurs(std::string_view(origin.data(), origin.size()), port_)) {
         http::write(connection.socket,
@@ -205,10 +254,13 @@ void ViewServer::Serve(Connection& connection) {
       websocket::stream<tcp::socket&> ws(connection.socket);
       ws.accept(request, ec);
       if (ec) return;
-      StreamFeed(ws, *feed_, settings_, stopping_);
+      StreamFeed(ws, *feed_, settings_, stopping_, connection.deadline);
       return;
     }
-    http::write(connection.socket, AssetOrError(request), ec);
+    {
+      Deadline limit(connection.deadline, kWriteLimit);
+      http::write(connection.socket, AssetOrError(request), ec);
+    }
     if (ec || !request.keep_alive()) return;
   }
 }

@@ -134,14 +134,34 @@ function buildObject(m) {
   if (!controls.userMoved) frameCamera();
 }
 
-// Primary region: the contact node ± primary_size along each axis, clipped to the object
-// (core/region_partition.cpp); a square with all four corners in it is the primary's, every
-// other square a coarser secondary region's. The lattice lines drawn are the regions' own: every
-// line in the primary, every secondary_lod-th line elsewhere.
+// The primary region: the coarse cells (secondary_lod fine cells a side) that overlap the box of
+// the contact node ± primary_size, clipped to the object — core/region_partition.cpp makes the
+// box, core/hybrid_mesh.cpp's CellOverlaps takes the cells. Its extent in lattice indices.
+function primaryExtent(m, n) {
+  const k = Math.max(1, m.secondary_lod), last = n - 1, r = m.primary_size;
+  const lo = [], hi = [];
+  m.contact_node.forEach((c, a) => {
+    const boxLo = Math.max(0, c - r), boxHi = Math.min(last, c + r);
+    let first = Infinity, end = -Infinity;
+    for (let j = 0; j * k < last; ++j) {
+      if (j * k < boxHi && (j + 1) * k > boxLo) { first = Math.min(first, j * k); end = (j + 1) * k; }
+    }
+    lo.push(first); hi.push(end);
+  });
+  return { lo, hi };
+}
+
+// A square with all four corners in the primary's extent is the primary's, every other square a
+// coarser secondary region's. The lattice lines drawn: every line in the primary, every
+// secondary_lod-th line elsewhere.
 function colourRegions(m) {
-  if (object.primaryBox) scene.remove(object.primaryBox);
-  const n = object.n, r = m.primary_size, c = m.contact_node, last = n - 1;
-  const lo = c.map((v) => Math.max(0, v - r)), hi = c.map((v) => Math.min(last, v + r));
+  if (object.primaryBox) {
+    scene.remove(object.primaryBox);
+    object.primaryBox.geometry.dispose();
+  }
+  const n = object.n;
+  const { lo, hi } = primaryExtent(m, n);
+  object.primary = { lo, hi };
   const inPrimary = (k) => nodeLattice(object.ids[k], n).every((v, a) => v >= lo[a] && v <= hi[a]);
   const colours = object.surface.geometry.attributes.color;
   for (let q = 0; q < object.quads.length; q += 4) {
@@ -158,6 +178,7 @@ function colourRegions(m) {
     if (onCoarseLine || (inPrimary(a) && inPrimary(b))) drawn.push(a, b);
   }
   object.lattice.geometry.setIndex(drawn);
+  const c = m.contact_node;
   object.contactIndex = object.ids.indexOf((c[0] * n + c[1]) * n + c[2]);
   const h = object.spacing;
   const box = new THREE.Box3(new THREE.Vector3(...lo).multiplyScalar(h),
@@ -214,11 +235,14 @@ function onDeformation(m) {
   document.body.dataset.frames = String(state.frames);
   document.body.dataset.inContact = String(m.in_contact);
   $('surface').textContent = `frame ${m.frame}, ${m.node_ids.length} nodes, ` +
-      `${m.latency_ms.toFixed(1)}\u00a0ms to send` +
+      `${shown(m.latency_ms, 1)}\u00a0ms to send` +
       (m.complete ? '' : state.status?.asleep ? ', at rest' : ', a region did not step in time');
 }
 
+const shown = (v, digits) => (Number.isFinite(v) ? v.toFixed(digits) : '–');
+
 function onForce(m) {
+  if (!m.force_n.every(Number.isFinite)) m.force_n = [0, 0, 0];  // drawn as none; the daemon flags it
   state.force = m;
   const [fx, fy, fz] = m.force_n, magnitude = Math.hypot(fx, fy, fz);
   $('force').textContent = `${magnitude.toFixed(3)}\u00a0N (${fx.toFixed(2)}, ${fy.toFixed(2)}, ` +
@@ -227,7 +251,8 @@ function onForce(m) {
 
 function onStatus(m) {
   state.status = m;
-  const error = m.error_percent, target = m.error_target_percent;
+  const error = Number.isFinite(m.error_percent) ? m.error_percent : -1;
+  const target = Number.isFinite(m.error_target_percent) ? m.error_target_percent : 0;
   $('error').textContent = error < 0 ? 'no error map loaded'
       : `${error.toFixed(2)}\u00a0% (target ${target.toFixed(1)}\u00a0%, JND\u00a0${JND_PERCENT}\u00a0%)`;
   const full = Math.max(2 * JND_PERCENT, target * 1.2, error * 1.1);
@@ -237,13 +262,17 @@ function onStatus(m) {
   bar.querySelector('.target').style.left = `${target / full * 100}%`;
   bar.querySelector('.jnd').style.left = `${JND_PERCENT / full * 100}%`;
   $('configuration').textContent = `primary ±${m.primary_size} nodes, secondary ` +
-      `${m.secondary_lod}× coarser at ${m.secondary_rate_hz.toFixed(0)} Hz` +
+      `${m.secondary_lod}× coarser at ${shown(m.secondary_rate_hz, 0)}\u00a0Hz` +
       (m.asleep ? ', asleep' : '') + (m.fault_latched ? ', FAULT LATCHED' : '');
   $('regions').textContent = m.regions.map((r) =>
-      `${r.name} ${r.rate_hz.toFixed(0)} Hz, ${r.nodes} nodes, ${r.deadline_misses} periods late`).join('; ');
+      `${r.name} ${shown(r.rate_hz, 0)}\u00a0Hz, ${r.nodes} nodes, ${r.deadline_misses} periods late`).join('; ');
 }
 
-function onTool(m) { state.toolPosition = m.position_m; state.lastTool = performance.now(); }
+function onTool(m) {
+  if (!m.position_m.every(Number.isFinite)) return;
+  state.toolPosition = m.position_m;
+  state.lastTool = performance.now();
+}
 
 // The tool tip: the device's position when the device speaks LCM; when it speaks shared memory
 // only (its input is not on the bus), the touched node while in contact.
@@ -285,8 +314,10 @@ function connect() {
 connect();
 
 // ---- drawing -------------------------------------------------------------------------------------
+let toolShown = true;
+
 function render() {
-  const tip = toolTip();
+  const tip = toolShown ? toolTip() : null;
   tool.visible = tip !== null;
   if (tip) tool.position.copy(tip);
   const f = state.force;
@@ -312,6 +343,25 @@ window.hapticsimView = {
     if (!tip) return null;
     const p = tip.clone().project(camera);
     return { x: (p.x + 1) / 2 * window.innerWidth, y: (1 - p.y) / 2 * window.innerHeight };
+  },
+  // Hides or shows the tool and the arrow (the test looks at the surface alone).
+  showTool(visible) { toolShown = visible; },
+  // The primary region's extent the page draws, in lattice indices: {lo: [3], hi: [3]}.
+  primaryExtent() { return object.primary ?? null; },
+  // Where the surface mesh (the triangles drawn, not the lattice lines) has the touched node: the
+  // vertices of its squares, each as [x, y, z] in m.
+  surfaceAtTouchedNode() {
+    if (!object.surface || object.contactIndex < 0) return [];
+    const p = object.surface.geometry.attributes.position.array, out = [];
+    for (let q = 0; q < object.quads.length; q += 4) {
+      QUAD_TRIANGLES.forEach((corner, v) => {
+        if (object.quads[q + corner] === object.contactIndex) {
+          const i = 3 * ((q / 4) * 6 + v);
+          out.push([p[i], p[i + 1], p[i + 2]]);
+        }
+      });
+    }
+    return out;
   },
   // The touched node where the page draws it now (object frame, m), or null.
   touchedNodeDrawn() {
