@@ -32,8 +32,9 @@ std::string MulticastSourceOffLoopback(const std::string& url) {
   const bool routed = connect(probe, reinterpret_cast<sockaddr*>(&to), sizeof to) == 0 &&
                       getsockname(probe, reinterpret_cast<sockaddr*>(&from), &length) == 0;
   close(probe);
-  // 0.0.0.0: no source chosen yet (a route on lo without one; the kernel picks 127.0.0.1 when
-  // sending), so nothing to say.
+  // 0.0.0.0: a route on lo without `src`: lo's address is host-scoped, so the packets leave with
+  // source 0.0.0.0. Not off loopback; under the systemd unit LCM's self test then fails, and
+  // LcmStartProblem says so with the route to use.
   const std::uint32_t source = ntohl(from.sin_addr.s_addr);
   if (!routed || source == INADDR_ANY || (source >> 24) == 127) return "";
   char text[INET_ADDRSTRLEN] = "";

@@ -25,7 +25,10 @@ inline std::string LcmStartProblem(lcm::LCM& lcm, const std::string& url) {
            " (for udpm:// the interface needs a multicast route: " + kLcmLoopbackRoute +
            "; or set another LCM URL)";
   }
-  if (lcm.getFileno() < 0) {
+  // The receive side only udpm:// sets up on first use (and "" is udpm's default); tcpq://
+  // connects when it can and reconnects by itself, memq:// and file:// always have a descriptor.
+  const bool udpm = url.empty() || url.rfind("udpm://", 0) == 0 || url.rfind("mpudpm://", 0) == 0;
+  if (udpm && lcm.getFileno() < 0) {
     return "LCM on " + url +
            " cannot receive: its self test's message did not come back (multicast dropped on the "
            "way: under the systemd unit, route the group through loopback with source "

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The Debian package on a clean Debian 12 with systemd running: a minimal bookworm made by
-# debootstrap, booted with systemd as PID 1 in namespaces of its own (PID, mount, UTS, IPC and
-# network: only its own loopback, so the daemon's LCM never reaches the host's network). In it:
+# debootstrap, booted with systemd as PID 1 in namespaces of its own (PID, mount, UTS, IPC,
+# cgroup under a cgroup of its own, and network: only its own loopback, so the daemon's LCM never
+# reaches the host's network), told it is a container, with /proc/sys read-only and a /dev of
+# its own, so it changes nothing of the host's. In it:
 # `dpkg -i hapticsim_*.deb` with the machine's network cut (its dependencies fetched
 # beforehand from Debian's archive), then the service must be active, answer a simulated device's
 # press over LCM, and stop when the package is removed. A long-form check (a few minutes, ~150 MB
@@ -9,22 +11,39 @@
 # Usage (root): scripts/check-deb-on-clean-debian.sh [BUILD_DIR] [WORK_DIR]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-$root/build}"
-work="${2:-/var/tmp/hapticsim-clean-debian}"
+build="$(realpath "${1:-$root/build}")"
+work="$(realpath -m "${2:-/var/tmp/hapticsim-clean-debian}")"
 [ "$(id -u)" -eq 0 ] || { echo "check-deb: run as root (debootstrap, chroot, namespaces)"; exit 2; }
-command -v debootstrap >/dev/null || apt-get install -y -qq --no-install-recommends debootstrap >/dev/null
+command -v debootstrap >/dev/null ||
+  { echo "check-deb: needs debootstrap: apt-get install debootstrap"; exit 2; }
 fail() { echo "check-deb: FAIL: $*"; exit 1; }
 step() { echo "check-deb: $*"; }
+marker=".hapticsim-clean-debian"
 
-system_pid=""
+unshare_pid="" cgroups="" system_pid=""
 cleanup() {
-  # PID 1 of the namespace gone, the namespace and everything in it go too.
-  [ -n "$system_pid" ] && [ -z "${HAPTICSIM_KEEP_MACHINE:-}" ] && kill -9 "$system_pid" 2>/dev/null || true
+  [ -n "${HAPTICSIM_KEEP_MACHINE:-}" ] && return
+  # unshare --kill-child: its end takes the machine's PID 1, and with it the whole machine.
+  if [ -n "$unshare_pid" ]; then
+    kill -9 "$unshare_pid" 2>/dev/null || true
+    wait "$unshare_pid" 2>/dev/null || true
+  fi
+  if [ -n "$cgroups" ] && mountpoint -q "$cgroups"; then
+    sleep 0.5
+    find "$cgroups/hapticsim-check" -depth -type d -exec rmdir {} + 2>/dev/null || true
+    umount "$cgroups"
+  fi
 }
 trap cleanup EXIT
 
-rm -rf "$work"
+# The work folder is deleted whole: only one this script made, with nothing mounted in it.
+if [ -e "$work" ]; then
+  [ -f "$work/$marker" ] || fail "$work exists and is not this script's (no $marker): choose another"
+  ! findmnt -R -n -o TARGET | grep -q "^$work/" || fail "something is still mounted under $work"
+  rm -rf --one-file-system "$work"
+fi
 mkdir -p "$work/deb"
+touch "$work/$marker"
 step "cpack -G DEB from $build"
 (cd "$work/deb" && cpack --config "$build/CPackConfig.cmake" -G DEB -B "$work/deb" >cpack.log 2>&1) ||
   { cat "$work/deb/cpack.log"; fail "cpack"; }
@@ -38,23 +57,38 @@ cp "$deb" "$machine/root/"
 package="/root/$(basename "$deb")"
 
 step "the package's dependencies, fetched while the machine still has the archive"
-chroot "$machine" sh -c "mount -t proc proc /proc && apt-get update -qq &&
-  apt-get install -y -qq --download-only $package >/dev/null; status=\$?; umount /proc; exit \$status" ||
+# In a mount namespace of its own: its /proc goes with it, whatever happens.
+unshare --mount chroot "$machine" sh -c "mount -t proc proc /proc && apt-get clean &&
+  apt-get update -qq && apt-get install -y -qq --download-only $package >/dev/null" ||
   fail "apt-get --download-only"
 
 step "booting it: systemd as PID 1, no network but its own loopback"
 # pivot_root rather than chroot: the machine's root must be a mount of its own for the service's
 # sandboxing (ProtectSystem= and the other mount namespacing of the unit).
-unshare --fork --pid --mount --uts --ipc --net /bin/sh -c \
-  'mount --make-rprivate / && mount --bind "$1" "$1" && cd "$1" && mkdir -p .oldroot &&
-   pivot_root . .oldroot &&
-   exec /bin/sh -c "mount -t proc proc /proc && umount -l /.oldroot && rmdir /.oldroot &&
-     mount -t sysfs sys /sys && mount -t tmpfs tmpfs /run && mount -t tmpfs tmpfs /tmp &&
-     mount -t cgroup2 cgroup2 /sys/fs/cgroup && exec /lib/systemd/systemd --system"' \
+# Its cgroups under one of its own (a cgroup namespace rooted there), removed at the end.
+cgroups="$work/cgroups"
+mkdir -p "$cgroups"
+mount -t cgroup2 none "$cgroups"
+mkdir "$cgroups/hapticsim-check"
+# /dev: a tmpfs with the host's few harmless nodes and its own devpts and shm, not the host's
+# devtmpfs; /proc/sys read-only; container= so systemd knows it is not the host's init.
+sh -c 'echo $$ > "$1/hapticsim-check/cgroup.procs" && shift && exec "$@"' sh "$cgroups" \
+  unshare --kill-child --fork --pid --mount --uts --ipc --net --cgroup /bin/sh -c \
+  'mount --make-rprivate / && mount --bind "$1" "$1" && cd "$1" &&
+   mount -t tmpfs -o mode=755,nosuid dev dev &&
+   for d in null zero full random urandom tty; do touch dev/$d && mount --bind /dev/$d dev/$d; done &&
+   mkdir -p dev/pts dev/shm && mount -t devpts -o newinstance,ptmxmode=666 devpts dev/pts &&
+   ln -s pts/ptmx dev/ptmx && mount -t tmpfs -o mode=1777,nosuid,nodev shm dev/shm &&
+   mkdir -p .oldroot && pivot_root . .oldroot &&
+   exec /bin/sh -c "mount -t proc proc /proc && mount --bind /proc/sys /proc/sys &&
+     mount -o remount,bind,ro /proc/sys && umount -l /.oldroot && rmdir /.oldroot &&
+     mount -t sysfs -o ro sys /sys && mount -t tmpfs tmpfs /run && mount -t tmpfs tmpfs /tmp &&
+     mount -t cgroup2 cgroup2 /sys/fs/cgroup &&
+     exec env container=hapticsim-check /lib/systemd/systemd --system"' \
   sh "$machine" >"$work/boot.log" 2>&1 &
 unshare_pid=$!
 for _ in $(seq 1 50); do
-  # unshare's child: after two execs, the machine's systemd (never another machine's).
+  # unshare's child (sh above became unshare): after two execs, the machine's systemd.
   candidate=$(pgrep -P "$unshare_pid" || true)
   [ -n "$candidate" ] && [ "$(cat "/proc/$candidate/comm" 2>/dev/null)" = systemd ] && system_pid=$candidate
   [ -n "$system_pid" ] && break
@@ -69,7 +103,7 @@ for _ in $(seq 1 30); do
   case "$state" in running | degraded) break ;; esac
   sleep 1
 done
-step "systemd is $state (starting: a unit of the bare machine still waits, e.g. a serial getty)"
+step "systemd is $state"
 
 step "dpkg -i $package with its dependencies, offline"
 inside sh -c "dpkg -i /var/cache/apt/archives/*.deb $package" >"$work/install.log" 2>&1 ||
@@ -101,5 +135,7 @@ inside journalctl -u hapticsimd --no-pager -n 6 -o cat | sed 's/^/  journal: /' 
 
 step "dpkg --remove hapticsim: the service stops"
 inside dpkg --remove hapticsim >"$work/remove.log" 2>&1 || { cat "$work/remove.log"; fail "dpkg --remove"; }
-inside systemctl is-active -q hapticsimd && fail "hapticsimd still active after removal"
+kill -0 "$system_pid" 2>/dev/null || fail "the machine is gone"
+state=$(inside systemctl is-active hapticsimd 2>/dev/null || true)
+case "$state" in inactive | unknown) ;; *) fail "hapticsimd is '$state' after removal" ;; esac
 step "PASS: installed, started, answered, removed and stopped on a clean Debian 12"

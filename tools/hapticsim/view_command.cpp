@@ -82,9 +82,9 @@ int Run(const ViewOptions& o) {
   std::optional<view::ViewFeed> feed;
   view::ViewServer server(settings);
   const std::string url = "http://127.0.0.1:" + std::to_string(server.port()) + "/";
+  feed.emplace(o.lcm_url, channels);
   const bool desktop = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
   if (o.open == "yes" || (o.open == "auto" && desktop)) OpenBrowser(url);
-  feed.emplace(o.lcm_url, channels);
   std::cout << "hapticsim view: serving " << url << " (listening to " << o.lcm_url
             << "); Ctrl-C stops" << std::endl;
   std::jthread waiting([&feed = *feed, &o] {

@@ -142,7 +142,13 @@ ViewFeed::~ViewFeed() {
 
 void ViewFeed::Run() {
   while (!stop_) {
-    // -1: LCM failed (a tcpq:// server gone); wait rather than spin.
+    // No descriptor: a tcpq:// server gone. liblcm's handleTimeout would select() on -1; wait,
+    // then handle(), which is what reconnects.
+    if (lcm_->getFileno() < 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      if (lcm_->getFileno() >= 0) lcm_->handleTimeout(0);
+      continue;
+    }
     if (lcm_->handleTimeout(100) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
 }

@@ -314,7 +314,7 @@ function connect() {
 connect();
 
 // ---- drawing -------------------------------------------------------------------------------------
-let toolShown = true;
+let toolShown = true, framesDrawn = 0;
 
 function render() {
   const tip = toolShown ? toolTip() : null;
@@ -326,6 +326,7 @@ function render() {
   if (arrow.visible) pointArrow(tip, new THREE.Vector3(...f.force_n), arrowMetresPerNewton, object.edge / 250);
   controls.update();
   renderer.render(scene, camera);
+  framesDrawn += 1;
 }
 renderer.setAnimationLoop(render);
 
@@ -346,6 +347,8 @@ window.hapticsimView = {
   },
   // Hides or shows the tool and the arrow (the test looks at the surface alone).
   showTool(visible) { toolShown = visible; },
+  // Frames drawn since the page loaded: a test waits for the next ones after a change.
+  framesDrawn() { return framesDrawn; },
   // The primary region's extent the page draws, in lattice indices: {lo: [3], hi: [3]}.
   primaryExtent() { return object.primary ?? null; },
   // Where the surface mesh (the triangles drawn, not the lattice lines) has the touched node: the
