@@ -13,7 +13,7 @@ Checks, as the issue asks:
     the tool's depth (the touched node is held there);
   - the primary region drawn is the one the daemon's hybrid mesh makes: the coarse cells that
     overlap the contact node ± primary_size (core/hybrid_mesh.cpp, CellOverlaps, written again
-    here);
+    here), holding as many independent nodes as the daemon's status reports for its primary;
   - the server answers only itself: other paths 404, another Host or Origin 403;
   - Ctrl-C stops it cleanly, every message decoded.
 
@@ -142,9 +142,13 @@ try:
         if shown < 0.05:
             fail(f"the screenshot does not show the object ({100 * shown:.1f} % not background)")
 
-        # The primary region the page draws against the daemon's rule, from the frame it drew.
-        d = browser.execute_script("return window.hapticsimView.state.deformation")
-        extent = browser.execute_script("return window.hapticsimView.primaryExtent()")
+        # The primary region the page draws against the daemon's rule, from the frame it drew,
+        # and against the daemon's own count of the primary's nodes (status_t).
+        wait_for("the daemon's status on the page",
+                 lambda: browser.execute_script("return window.hapticsimView.state.status !== null"), 10)
+        d, extent, status = browser.execute_script(
+            "const v = window.hapticsimView;"
+            "return [v.state.deformation, v.primaryExtent(), v.state.status];")
         n, k, r = d["nodes_per_axis"], max(1, d["secondary_lod"]), d["primary_size"]
         expected = {"lo": [], "hi": []}
         for c in d["contact_node"]:
@@ -155,6 +159,21 @@ try:
         print(f"primary region drawn over lattice {extent}, the hybrid mesh's {expected}")
         if extent != expected:
             fail("the page draws another primary region than the daemon's")
+        # Its independent nodes: every lattice node in the extent but those hanging on a face it
+        # shares with the coarser secondary (there only the coarse lattice's nodes are its own).
+        def independent(i, j, l):
+            point = (i, j, l)
+            on_interface = any(point[a] in (extent["lo"][a], extent["hi"][a]) and
+                               point[a] not in (0, n - 1) for a in range(3))
+            return not on_interface or all(v % k == 0 for v in point)
+        counted = sum(independent(i, j, l)
+                      for i in range(extent["lo"][0], extent["hi"][0] + 1)
+                      for j in range(extent["lo"][1], extent["hi"][1] + 1)
+                      for l in range(extent["lo"][2], extent["hi"][2] + 1))
+        reported = next(r["nodes"] for r in status["regions"] if r["name"] == "primary")
+        print(f"the primary drawn holds {counted} independent nodes; the daemon reports {reported}")
+        if counted != reported:
+            fail("the primary region drawn is not the daemon's")
 
         # 10 mm presses at the front face's centre, 8 s each, above 8 mm for 2.3 s of each: the
         # screenshots are taken in one of them; on a loaded machine that misses, in the next.

@@ -88,6 +88,13 @@ class Deadline {
 
 constexpr std::chrono::seconds kReadLimit{10}, kWriteLimit{5};
 
+// The page went away (closed, reloaded): its FIN or reset, seen without reading. A page that
+// goes while nothing is sent would otherwise keep its connection's slot.
+bool PeerClosed(int fd) {
+  pollfd p{fd, POLLRDHUP, 0};
+  return ::poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0;
+}
+
 // Sends the hello, then the newest of each kind of message whenever the feed has a newer one, at
 // most frame_rate_hz times a second: a page that draws slower gets fewer, newer frames.
 void StreamFeed(websocket::stream<tcp::socket&>& ws, const ViewFeed& feed,
@@ -103,7 +110,7 @@ void StreamFeed(websocket::stream<tcp::socket&>& ws, const ViewFeed& feed,
   }
   FeedSnapshot seen;
   auto next = Clock::now();
-  while (!ec && !stopping) {
+  while (!ec && !stopping && !PeerClosed(ws.next_layer().native_handle())) {
     const FeedSnapshot now = feed.WaitNewer(seen.version, std::chrono::milliseconds(200));
     const auto send = [&](const FeedSnapshot::Text& text, uint64_t version, uint64_t seen_version) {
       if (!ec && version > seen_version && text) {
