@@ -73,19 +73,22 @@ def request(port, path, headers):
     return r.status
 
 
+def outside_panel(size, panel, step=1):
+    """The pixels (x, y) of a screenshot of `size` that the panel does not cover (its text
+    changes with every message), every step-th along each axis."""
+    w, h = size
+    for y in range(0, h, step):
+        for x in range(0, w, step):
+            if not (panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]):
+                yield x, y
+
+
 def changed_fraction(image, background, panel):
     """The share of pixels outside the panel that are not the page's background colour."""
     px = image.convert("RGB").load()
-    w, h = image.size
-    changed = total = 0
-    for y in range(0, h, 2):
-        for x in range(0, w, 2):
-            if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
-                continue
-            total += 1
-            if sum(abs(a - b) for a, b in zip(px[x, y], background)) > 30:
-                changed += 1
-    return changed / total
+    pixels = list(outside_panel(image.size, panel, step=2))
+    changed = sum(sum(abs(a - b) for a, b in zip(px[x, y], background)) > 30 for x, y in pixels)
+    return changed / len(pixels)
 
 
 try:
@@ -228,27 +231,22 @@ try:
         tx, ty = s["tool"]["x"] * scale, s["tool"]["y"] * scale
 
         def change_near_tool(after_path, radius_px):
-            """Mean change within radius of the tool and elsewhere outside the panel (its text
-            changes too), the share of pixels that changed by more than 5 of 255 there and
+            """Mean change within radius of the tool and elsewhere outside the panel, the share of pixels that changed by more than 5 of 255 there and
             elsewhere, and how far from the tool the change is centred, in px."""
             diff = ImageChops.difference(before.convert("L"), Image.open(after_path).convert("L"))
             r = radius_px * scale
             box = (tx - r, ty - r, tx + r, ty + r)
             px = diff.load()
-            w, h = diff.size
             near_sum = near_n = far_sum = far_n = near_changed = far_changed = 0
             sx = sy = weight = 0.0
-            for y in range(h):
-                for x in range(w):
-                    if panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]:
-                        continue
-                    v = px[x, y]
-                    if box[0] <= x < box[2] and box[1] <= y < box[3]:
-                        near_sum, near_n, near_changed = near_sum + v, near_n + 1, near_changed + (v > 5)
-                    else:
-                        far_sum, far_n, far_changed = far_sum + v, far_n + 1, far_changed + (v > 5)
-                    if v > 20:
-                        sx, sy, weight = sx + x * v, sy + y * v, weight + v
+            for x, y in outside_panel(diff.size, panel):
+                v = px[x, y]
+                if box[0] <= x < box[2] and box[1] <= y < box[3]:
+                    near_sum, near_n, near_changed = near_sum + v, near_n + 1, near_changed + (v > 5)
+                else:
+                    far_sum, far_n, far_changed = far_sum + v, far_n + 1, far_changed + (v > 5)
+                if v > 20:
+                    sx, sy, weight = sx + x * v, sy + y * v, weight + v
             offset = math.hypot(sx / weight - tx, sy / weight - ty) / scale if weight else math.inf
             return (near_sum / near_n, far_sum / far_n, near_changed / near_n,
                     far_changed / far_n, offset)
