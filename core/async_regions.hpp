@@ -270,6 +270,16 @@ class AsyncRegions {
     /** What the primary leaves to the shells by design (kPrimaryReserve of its energy): the
      *  backlog above it is what EnergyAboveBound counts. */
     double primary_reserve_j = 0;
+    /** Σ of the regions' StateEnergy at their last steps: what the state holds, J. */
+    double state_energy_j = 0;
+    /**
+     * What the energy balance lets the object hold now, J: the state energy at the balance's
+     * start + the contact's work − the damping (the secondaries' less the kDampingCredit the
+     * interfaces may spend) + the primary's reserve. Not the backlog: that is what the
+     * controllers have yet to take out, and a backlog that outgrows everything the contact put
+     * in is the controllers losing (Runaway).
+     */
+    double allowed_j = 0;
   };
   /**
    * What the interface observers hold (EnergyAccount::pending_excess_j, each link's positive
@@ -279,6 +289,38 @@ class AsyncRegions {
    * to the lag between the regions. With the controllers off (kOff) the energies are not published.
    */
   PublishedBalanceView PublishedBalance() const noexcept;
+
+  /**
+   * The runaway watch: the state holds more than kRunawayFactor × what the energy balance allows
+   * (and more than that factor × the port floor, so that rest is not measured in round-off). The
+   * interface controllers and the port limits hold the regions' *discrete* energies to the
+   * balance; this is the one thing they cannot see — a region whose discrete energy is no longer
+   * a norm of its state (one element deep between the contact and a Γ whose motion aliases a
+   * faster neighbour's; docs/regions.md, "The runaway watch"). The daemon then moves the regions
+   * to equal rates, which are monolithic central difference and stable by each region's own limit.
+   * Any thread (reads what PublishedBalance reads).
+   */
+  bool Runaway(const PublishedBalanceView& view) const noexcept {
+    return view.state_energy_j > kRunawayFactor * std::max(view.allowed_j, port_floor_j_);
+  }
+  /**
+   * Above what a stable region's state can hold against its discrete energy: for a mode of
+   * frequency ω stepped at h, ½(m v² + k u²) ≤ (discrete energy) / (1 − hω/2), and substeps keep
+   * hω/2 ≤ kSubstepSafety, so a factor of 1 / (1 − 0.95) = 20 at the most, in a state that is
+   * all the stiffest mode. Measured: 0.90–0.93 on the paper's 48 configurations under the 1 cm
+   * press, up to 2.1 from a random state.
+   */
+  static constexpr double kRunawayFactor = 32;
+  /**
+   * Whether Runaway applies to these regions: the interface controllers on (kPassive), more than
+   * one region, and the production margin (each step within kSubstepSafety of its own limit; the
+   * stress test's near-limit cases step closer, where the factor above no longer bounds a stable
+   * state).
+   */
+  bool watches_runaway() const noexcept {
+    return control_ == InterfaceControl::kPassive && num_regions() > 1 &&
+           substep_safety_ <= kSubstepSafety;
+  }
 
   /** Positive-definite energy of the coupled state (all regions), J. */
   double Energy() noexcept;
@@ -330,8 +372,7 @@ class AsyncRegions {
   /** Reset, then every region's copy of the state set to displacements `u` and velocities `v`
    *  (u⁻ = u − v·h with its own substep h), the boundaries published from it. */
   void StartFrom(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
-  TrialResult RunTrialFromCurrentState(const InputSettings& input,
-                                       const TrialFrames& frames = {});
+  TrialResult RunTrialFromCurrentState(const InputSettings& input, const TrialFrames& frames = {});
   void PublishInward(RegionIndex region) noexcept;
   void PublishOutward(RegionIndex region) noexcept;
   /** After a step: the boundaries for the neighbours, and the surface if a reader asked. */
@@ -340,6 +381,8 @@ class AsyncRegions {
   void BuildSurface();
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction) noexcept;
+  void ControlInterfaces(RegionIndex region, double* asked_inward, double* asked_outward,
+                         PortWorkLimits* limits) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
   double InwardPortLimit(RegionIndex region, double energy, bool lockstep) noexcept;
   bool InLockStep(RegionIndex region) const noexcept;
@@ -375,6 +418,8 @@ class AsyncRegions {
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};
   double port_floor_j_ = 0;
+  double state_energy_at_reset_j_ = 0;
+  double substep_safety_ = kSubstepSafety;  // Σ StateEnergy when the energy balance last started
 
   // The surface (core/region_surface.cpp): each of its values (3 per point) is a sum of terms
   // [term_start[v], term_start[v + 1]), each a weight times a region's published surface value.

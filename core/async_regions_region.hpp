@@ -45,10 +45,12 @@ struct AsyncRegions::Region {
 
   // The energy balance (docs/regions.md, "Passive interfaces"), J since Reset. Written by
   // this region's thread; the *_published copies for the neighbours' threads to read.
-  double input_work = 0;                    // the contact's work (primary)
-  double damping_dissipated = 0;            // material damping
-  double port_refused = 0;                  // work the port limits kept out (PortWorkLimits)
-  std::atomic<double> energy_published{0};  // its discrete energy at its last step's start
+  double input_work = 0;                          // the contact's work (primary)
+  double damping_dissipated = 0;                  // material damping
+  double port_refused = 0;                        // work the port limits kept out (PortWorkLimits)
+  std::atomic<double> energy_published{0};        // its discrete energy at its last step's start
+  std::atomic<double> state_energy_published{0};  // its StateEnergy then (the runaway watch)
+  std::atomic<double> input_work_published{0}, damping_published{0};  // … and those sums
   // The largest port allowance each side has used and energy it has had since Reset, for the
   // bound the port limits guarantee (EnergyAccount::backlog_bound_j).
   double inward_allowance_peak = 0, outward_allowance_peak = 0, energy_peak = 0;

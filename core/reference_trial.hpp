@@ -30,6 +30,9 @@ struct ForceSample {
 
 struct TrialResult {
   TrialOutcome outcome = TrialOutcome::kCompleted;
+  /** kDivergedEnergy by the runaway watch (AsyncRegions::Runaway): the state outgrew what the
+   *  energy balance allows, long before it outgrew the passivity budget. */
+  bool runaway = false;
   StabilityEstimate stability;
   std::vector<ForceSample> samples;  ///< t = 0, dt, …, duration (fewer if it diverged)
   long steps = 0;                    ///< periods of solver.dt simulated (= samples)

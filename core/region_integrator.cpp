@@ -182,17 +182,26 @@ double RegionIntegrator::DampControlled(double dissipate_j, double plus, double*
   return swept * (scale * scale - 1.0);
 }
 
-double RegionIntegrator::DiscreteEnergy() noexcept {
+double RegionIntegrator::DiscreteEnergy() noexcept { return BothEnergies().discrete_j; }
+
+double RegionIntegrator::StateEnergy() noexcept { return BothEnergies().state_j; }
+
+RegionIntegrator::Energies RegionIntegrator::BothEnergies() noexcept {
   const Eigen::VectorXd& ku = Forces();
   const Eigen::VectorXd& u = *u_;
   const Eigen::VectorXd& up = *u_previous_;
-  double kinetic = 0, strain = 0;
+  double kinetic = 0, discrete_strain = 0, strain = 0;
   for (int i : owned_) {
     kinetic += mass_[i] * (u[i] - up[i]) * (u[i] - up[i]);
-    strain += up[i] * ku[i];
+    discrete_strain += up[i] * ku[i];
+    strain += u[i] * ku[i];
   }
-  for (int i : prescribed_) strain += up[i] * ku[i];
-  return 0.5 * kinetic / (h_ * h_) + 0.5 * strain;
+  for (int i : prescribed_) {
+    discrete_strain += up[i] * ku[i];
+    strain += u[i] * ku[i];
+  }
+  kinetic *= 0.5 / (h_ * h_);
+  return {kinetic + 0.5 * discrete_strain, kinetic + 0.5 * strain};
 }
 
 void RegionIntegrator::SetState(const Eigen::VectorXd& u, const Eigen::VectorXd& u_previous) {

@@ -103,6 +103,20 @@ class RegionIntegrator {
    * damping and load (positive while the step is within the region's own limit).
    */
   double DiscreteEnergy() noexcept;
+  /**
+   * ½ Σ_owned m ((u − u⁻)/h)² + ½ uᵀ K u over every DOF its elements touch, J: what the state
+   * holds, positive whatever the step (K of its elements is positive semi-definite). Where the
+   * region's step is well inside its limit and its prescribed DOFs move smoothly it is close to
+   * DiscreteEnergy; where they do not (a region one element deep between the contact and Γ), the
+   * discrete energy can be small or negative while this one is not (AsyncRegions::Runaway).
+   */
+  double StateEnergy() noexcept;
+  struct Energies {
+    double discrete_j = 0;  ///< DiscreteEnergy
+    double state_j = 0;     ///< StateEnergy
+  };
+  /** Both in one pass over the DOFs (the real-time steps take both). */
+  Energies BothEnergies() noexcept;
 
   /**
    * Residual of the equation of motion at prescribed DOF index `k` at the start of the last

@@ -75,6 +75,13 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
       result.outcome = TrialOutcome::kDivergedEnergy;
       break;
     }
+    // What the daemon watches for, with the same numbers: a trial it would have taken off these
+    // regions is not a sample of them.
+    if (watches_runaway() && Runaway(PublishedBalance())) {
+      result.outcome = TrialOutcome::kDivergedEnergy;
+      result.runaway = true;
+      break;
+    }
     ForceSample sample;
     sample.t_s = t;
     sample.contact_displacement_m = trajectory.DisplacementAt(t);

@@ -232,6 +232,7 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
       return;
   }
   balance_peak_stored_j_ = 0;  // the balance starts afresh with the new regions
+  runaway_seen_ = false;
 }
 
 void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
@@ -302,6 +303,12 @@ void HapticLoop::WatchEnergyBalance() noexcept {
   // Above the reserve the primary leaves to the shells by design, as EnergyAboveBound counts.
   if (balance.backlog_j - balance.primary_reserve_j > kBacklogTolerance * scale) {
     balance_violations_.fetch_add(1, std::memory_order_relaxed);
+  }
+  // Once per set of regions: the supervisor takes them off this configuration (release: the
+  // regions it reads with the count are the ones that ran away).
+  if (!runaway_seen_ && regions_->watches_runaway() && regions_->Runaway(balance)) {
+    runaway_seen_ = true;
+    runaways_.fetch_add(1, std::memory_order_release);
   }
 }
 

@@ -256,6 +256,12 @@ class HapticLoop {
   std::int64_t energy_balance_violations() const {
     return balance_violations_.load(std::memory_order_relaxed);
   }
+  /**
+   * Sets of regions whose state outgrew what the energy balance allows (AsyncRegions::Runaway,
+   * watched every primary period; counted once per set of regions): the supervisor moves the
+   * regions off that configuration to equal rates. Any thread.
+   */
+  std::int64_t runaways() const { return runaways_.load(std::memory_order_acquire); }
   /** The stress test's tolerance for a controlled exchange (StressOutcome::kGrowingBacklog). */
   static constexpr double kBacklogTolerance = StressOutcome::kGrowingBacklog;
   /**
@@ -362,6 +368,8 @@ class HapticLoop {
   std::atomic<double> interface_backlog_j_{0}, interface_backlog_max_j_{0};
   std::atomic<std::int64_t> balance_violations_{0};
   double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
+  bool runaway_seen_ = false;         // primary thread: these regions' runaway is counted
+  std::atomic<std::int64_t> runaways_{0};
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;

@@ -66,6 +66,7 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
     // Nothing steps any region now: rest exactly, at time 0 of a schedule that starts on waking.
     regions_->Reset();
     balance_peak_stored_j_ = 0;  // they start again from rest
+    runaway_seen_ = false;
     interface_backlog_j_.store(0, std::memory_order_relaxed);
     sleep_state_ = kAsleep;
     asleep_.store(true, std::memory_order_relaxed);

@@ -332,7 +332,7 @@ int Serve(const Arguments& args) {
   match_miss_loggers(HapticLoop::NowNs());
   const std::int64_t start_ns = HapticLoop::NowNs();
   std::int64_t next_status_ns = start_ns, next_watchdog_ns = start_ns;
-  std::int64_t faults_seen = 0, rearms_seen = 0, last_rejection_line_ns = 0;
+  std::int64_t faults_seen = 0, rearms_seen = 0, runaways_seen = 0, last_rejection_line_ns = 0;
   std::int64_t regions_since_ns = start_ns, health_reconfigurations = 0;
   bool health_asleep = false;
   StallReport stall_report;  // the stalled threads, as last logged and told to systemd
@@ -724,6 +724,10 @@ int Serve(const Arguments& args) {
       }
       if (request && mover.may_ask(*request)) mover.Ask(*request, now);
     }
+    if (loop.runaways() > runaways_seen) {  // off a configuration whose state outgrew its balance
+      runaways_seen = loop.runaways();
+      mover.OnRunaway(now);  // the Poll below moves them
+    }
     try {
       if (const std::optional<RegionsMover::Outcome> moved = mover.Poll(now)) {
         apply_move(*moved, now);
@@ -750,25 +754,19 @@ int Serve(const Arguments& args) {
       const std::string name = loop.regions().partition().RegionName(region);
       const bool nothing_cheaper = decision.cost_us_per_ms == cheapest_cost_us_per_ms;
       if (decision.have_map && !pinned && !chooser.busy() && !nothing_cheaper) {
-        spdlog::error(
-            "{} thread missed {} of its {} periods in the last second, and more than 5 % in "
-            "each of the 3 before: choosing a configuration cheaper than {} µs per simulated "
-            "ms (deadlines before accuracy)",
-            name, overload.last_misses(), rates_hz[region], decision.cost_us_per_ms);
+        spdlog::error("{}", ChoosingCheaperLine(name, overload.last_misses(), rates_hz[region],
+                                                decision.cost_us_per_ms));
         cost_ceiling = decision.cost_us_per_ms;
         choice_for_overload = true;
         start_choice(std::nullopt);
       } else if (now - last_overload_line_ns > 60'000'000'000) {
         last_overload_line_ns = now;
-        spdlog::error(
-            "{} thread keeps missing deadlines ({} in the last second) and the "
-            "supervisor cannot choose a cheaper configuration ({}): give it a CPU of "
-            "its own (realtime.cpus, realtime.fifo_priority) or pin a cheaper one",
-            name, overload.last_misses(),
-            pinned              ? "a configuration is pinned"
-            : nothing_cheaper   ? "the map has nothing cheaper"
-            : decision.have_map ? "a choice is being made"
-                                : "no error map");
+        spdlog::error("{}",
+                      CannotChooseCheaperLine(name, overload.last_misses(),
+                                              pinned              ? "a configuration is pinned"
+                                              : nothing_cheaper   ? "the map has nothing cheaper"
+                                              : decision.have_map ? "a choice is being made"
+                                                                  : "no error map"));
       }
     }
     if (loop.force_faults() > faults_seen) {

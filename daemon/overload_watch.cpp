@@ -1,5 +1,7 @@
 #include "daemon/overload_watch.hpp"
 
+#include <fmt/format.h>
+
 #include <cstddef>
 
 namespace hapticsim {
@@ -33,6 +35,24 @@ int OverloadWatch::Check(std::int64_t now_ns, const std::vector<double>& rates_h
   }
   if (overloaded >= 0) over_.assign(over_.size(), 0);
   return overloaded;
+}
+
+std::string ChoosingCheaperLine(const std::string& region, std::int64_t misses, double rate_hz,
+                                double cost_us_per_ms) {
+  return fmt::format(
+      "{} thread missed {} of its {} periods in the last second, and more than 5 % in each of "
+      "the 3 before: choosing a configuration cheaper than {} µs per simulated ms (deadlines "
+      "before accuracy)",
+      region, misses, rate_hz, cost_us_per_ms);
+}
+
+std::string CannotChooseCheaperLine(const std::string& region, std::int64_t misses,
+                                    const char* why) {
+  return fmt::format(
+      "{} thread keeps missing deadlines ({} in the last second) and the supervisor cannot "
+      "choose a cheaper configuration ({}): give it a CPU of its own (realtime.cpus, "
+      "realtime.fifo_priority) or pin a cheaper one",
+      region, misses, why);
 }
 
 }  // namespace hapticsim

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace hapticsim {
@@ -37,5 +38,13 @@ class OverloadWatch {
   std::vector<int> over_;             // consecutive windows over the share, per region
   std::int64_t last_misses_ = 0;
 };
+
+/** The log line when a region overloaded second after second and the supervisor chooses a
+ *  configuration cheaper than `cost_us_per_ms`. */
+std::string ChoosingCheaperLine(const std::string& region, std::int64_t misses, double rate_hz,
+                                double cost_us_per_ms);
+/** … and when it cannot (`why`): what the user can do about it. */
+std::string CannotChooseCheaperLine(const std::string& region, std::int64_t misses,
+                                    const char* why);
 
 }  // namespace hapticsim

@@ -30,7 +30,15 @@ std::string RegionsMover::Outcome::Describe() const {
            << DescribeContactNode(request.node) << " verified " << elapsed_s
            << " s after the touch asked for the regions there: ";
       text.precision(5);
-      if (kind == Kind::kConfirmed) {
+      if (runaway) {
+        text.str("");
+        text << "the state of " << DescribeConfiguration(request.configuration) << " around "
+             << DescribeContactNode(request.node)
+             << " outgrew what the energy balance allows (runaway watch); ";
+        text << (to.centred.configuration == request.configuration
+                     ? "already at equal rates: restarting them from rest"
+                     : "secondaries at the primary rate there, from rest");
+      } else if (kind == Kind::kConfirmed) {
         text << "stable, spectral radius " << to.centred.spectral_radius;
       } else {
         text << "UNSTABLE; secondaries at the primary rate there";
@@ -122,6 +130,22 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
     out.kind = out.to.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
   }
   return out;
+}
+
+void RegionsMover::OnRunaway(std::int64_t now_ns) {
+  const Request ran{placed_.centred.configuration, placed_.node};
+  refused_.insert(KeyOf(ran));
+  verdicts_.erase(KeyOf(ran));
+  refusal_.clear();
+  CentredConfiguration equal{ran.configuration, -1, true};
+  equal.configuration.secondary_rate_hz = PrimaryRateHz(scene_);
+  // Whatever was asked is given up (a verification running is dropped by the next Submit):
+  // the regions leave this configuration at the next Poll.
+  asked_ = ran;
+  asked_ns_ = now_ns;
+  behind_ = false;
+  ready_ = Outcome{Outcome::Kind::kDemote, ran, {equal, ran.node}, 0, ""};
+  ready_->runaway = true;
 }
 
 void RegionsMover::Applied(const Outcome& outcome) {

@@ -58,6 +58,7 @@ class RegionsMover {
     Placement to;           ///< where the regions go (or stay, kConfirmed)
     double elapsed_ms = 0;  ///< from the request to this outcome
     std::string why_not;    ///< kMoveBack: why the node was refused
+    bool runaway = false;   ///< kDemote for the runaway watch (OnRunaway), not a verdict
     bool moves() const { return kind != Kind::kConfirmed; }
     /**
      * Whether the new regions start from the object's motion (HapticLoop::Handover::
@@ -108,6 +109,15 @@ class RegionsMover {
    *         refused; the regions stay where they are.
    */
   std::optional<Outcome> Poll(std::int64_t now_ns);
+  /**
+   * The loop's runaway watch fired on the regions as placed (HapticLoop::runaways): their state
+   * outgrew what the energy balance allows, which the interface controllers cannot see. Returns
+   * the move to the secondaries at the primary rate there (kDemote, from rest with the touch
+   * ramped in) and refuses that configuration around that node from then on. Already at equal
+   * rates (monolithic central difference, stable by each region's own limit), the same regions
+   * start again from rest. Gives up whatever the mover was doing; the next Poll returns the move.
+   */
+  void OnRunaway(std::int64_t now_ns);
   /**
    * The caller moved the regions as `outcome` said (or, kConfirmed, left them): placement()
    * follows. An outcome that fails to apply (HapticLoop::Reconfigure threw) is given back with
