@@ -118,6 +118,43 @@ TEST(RegionsMover, ATouchMovesAtOnceAndItsVerdictFollowsThenTheNodeIsKnown) {
   EXPECT_EQ(home->kind, Kind::kMoveVerified);
 }
 
+// The loop's runaway watch fired (AsyncRegions::Runaway): at the next Poll the regions go to
+// equal rates where they are, from rest, whatever the mover was doing, and that configuration is
+// not asked for around that node again.
+TEST(RegionsMover, ARunawayDemotesTheRegionsToEqualRatesThereAndRefusesTheConfiguration) {
+  const Scene scene;
+  RegionsMover mover(scene, AtStart(scene), RefusingAt(kElsewhere));
+  const RegionConfiguration configuration{2, 2, 600};
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  ASSERT_TRUE(PollAndApply(mover));  // moved unverified; its verdict is behind it
+  mover.OnRunaway(Now());
+  const std::optional<RegionsMover::Outcome> off = PollAndApply(mover);
+  ASSERT_TRUE(off);
+  EXPECT_EQ(off->kind, Kind::kDemote);
+  EXPECT_TRUE(off->runaway);
+  EXPECT_TRUE(off->moves());
+  EXPECT_EQ(off->request.configuration, configuration);
+  EXPECT_EQ(off->to.node, kOffCentre);
+  EXPECT_EQ(off->to.centred.configuration.primary_size, 2);
+  EXPECT_EQ(off->to.centred.configuration.secondary_lod, 2);
+  EXPECT_EQ(off->to.centred.configuration.secondary_rate_hz, PrimaryRateHz(scene));
+  EXPECT_FALSE(off->CarriesMotionFrom(kOffCentre)) << "a state that ran away is not carried";
+  EXPECT_NE(off->Describe().find("runaway watch"), std::string::npos) << off->Describe();
+  EXPECT_EQ(mover.placement().centred.configuration, off->to.centred.configuration);
+  EXPECT_FALSE(mover.may_ask(Touch(configuration, kOffCentre)));
+  EXPECT_TRUE(mover.may_ask(Touch(configuration, AtStart(scene).node)));
+  // The verdict the touch started is given up: nothing more comes from the mover.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_FALSE(PollAndApply(mover));
+  EXPECT_FALSE(mover.busy());
+  // Already at equal rates: the same regions again, from rest.
+  mover.OnRunaway(Now());
+  const std::optional<RegionsMover::Outcome> again = PollAndApply(mover);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->to.centred.configuration, again->request.configuration);
+  EXPECT_NE(again->Describe().find("already at equal rates"), std::string::npos);
+}
+
 TEST(RegionsMover, ATouchWhereTheConfigurationIsUnstableIsDemotedToEqualRates) {
   Scene scene;
   scene.material.poisson_ratio = 0.49;  // k 1 r 2 700 Hz: 1.47 per common period, bare
