@@ -308,7 +308,7 @@ class AsyncRegions {
    * frequency ω stepped at h, ½(m v² + k u²) ≤ (discrete energy) / (1 − hω/2), and substeps keep
    * hω/2 ≤ kSubstepSafety, so a factor of 1 / (1 − 0.95) = 20 at the most, in a state that is
    * all the stiffest mode. Measured: 0.90–0.93 on the paper's 48 configurations under the 1 cm
-   * press, up to 2.1 from a random state.
+   * press, up to 2.3 from a random state.
    */
   static constexpr double kRunawayFactor = 32;
   /**
@@ -418,8 +418,8 @@ class AsyncRegions {
   std::int64_t ticks_per_second_ = 0, common_period_ticks_ = 0;
   std::atomic<double> primary_boundary_age_s_{0};
   double port_floor_j_ = 0;
-  double state_energy_at_reset_j_ = 0;
-  double substep_safety_ = kSubstepSafety;  // Σ StateEnergy when the energy balance last started
+  double state_energy_at_reset_j_ = 0;  // Σ StateEnergy when the energy balance last started
+  double substep_safety_ = kSubstepSafety;
 
   // The surface (core/region_surface.cpp): each of its values (3 per point) is a sum of terms
   // [term_start[v], term_start[v + 1]), each a weight times a region's published surface value.

@@ -12,6 +12,15 @@ std::string RegionsMover::Outcome::Describe() const {
   text.precision(3);
   text << std::fixed;
   const double elapsed_s = elapsed_ms * 1e-3;
+  if (runaway) {
+    text << "the state of " << DescribeConfiguration(request.configuration) << " around "
+         << DescribeContactNode(request.node)
+         << " outgrew what the energy balance allows (runaway watch); "
+         << (to.centred.configuration == request.configuration
+                 ? "already at equal rates: restarting them from rest"
+                 : "secondaries at the primary rate there, from rest");
+    return text.str();
+  }
   switch (kind) {
     case Kind::kMoveUnverified:
     case Kind::kMoveVerified:
@@ -30,15 +39,7 @@ std::string RegionsMover::Outcome::Describe() const {
            << DescribeContactNode(request.node) << " verified " << elapsed_s
            << " s after the touch asked for the regions there: ";
       text.precision(5);
-      if (runaway) {
-        text.str("");
-        text << "the state of " << DescribeConfiguration(request.configuration) << " around "
-             << DescribeContactNode(request.node)
-             << " outgrew what the energy balance allows (runaway watch); ";
-        text << (to.centred.configuration == request.configuration
-                     ? "already at equal rates: restarting them from rest"
-                     : "secondaries at the primary rate there, from rest");
-      } else if (kind == Kind::kConfirmed) {
+      if (kind == Kind::kConfirmed) {
         text << "stable, spectral radius " << to.centred.spectral_radius;
       } else {
         text << "UNSTABLE; secondaries at the primary rate there";
