@@ -376,9 +376,8 @@ int Serve(const Arguments& args) {
     start_choice(pin);
   };
   // The regions run mover.placement(): the decision's configuration, or its equal-rate fallback
-  // where the decision's is unstable around the node they are centred on.
-  RegionsMover mover(config.scene, {{decision.configuration, decision.spectral_radius, false},
-                                    loop.centre_node()});
+  // where the decision's ran away around the node they are centred on.
+  RegionsMover mover(config.scene, {{decision.configuration, true, false}, loop.centre_node()});
   auto active = [&mover]() -> const RegionConfiguration& {
     return mover.placement().centred.configuration;
   };
@@ -441,8 +440,8 @@ int Serve(const Arguments& args) {
   std::int64_t hover_since_ns = 0;
   constexpr double kHoverBeforeRecentre_s = 0.2;      // not every node a passing tool crosses
   constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
-  // The regions where the mover says: moved now (verified before, or to be verified behind
-  // them), demoted to equal rates or moved back where the verdict finds them unstable.
+  // The regions where the mover says: moved now (checked before, or to be checked behind them),
+  // demoted to equal rates where they ran away, or moved back where they cannot run.
   auto apply_move = [&](const RegionsMover::Outcome& moved, std::int64_t now) {
     using Kind = RegionsMover::Outcome::Kind;
     spdlog::log(moved.kind == Kind::kMoveBack ? spdlog::level::err
@@ -684,7 +683,7 @@ int Serve(const Arguments& args) {
           pending.reset();
         } else {
           spdlog::info(
-              "{} configuration: {}; switching once it is verified around the contact "
+              "{} configuration: {}; switching once it is checked around the contact "
               "node, carrying the object's motion over",
               pinned ? "pinned" : "better", chosen.reason);
           pending = chosen;
@@ -700,12 +699,12 @@ int Serve(const Arguments& args) {
       choose_for_centre_if_missed();  // the regions may have moved while it was being made
     }
     // Moving the regions — to the pending configuration, or onto the node the tool touches or
-    // hovers over. A new configuration around the same node switches as soon as it is verified,
+    // hovers over. A new configuration around the same node switches as soon as it is checked,
     // in contact too: the object's motion carries over and the force is held meanwhile
     // (Handover::kCarryMotion). Onto a hovered node only after the object has settled, as the
     // regions restart from rest there. A touch on another node moves them at once (zero force,
-    // flagged, for the few periods until they are there; their coupling verified behind them),
-    // then ramps its force in; it may give up a verification still running.
+    // flagged, for the few periods until they are there; checked behind them), then ramps its
+    // force in; it may give up a check still running.
     const bool settled = (now - loop.last_contact_ns()) * 1e-9 >= kSettleBeforeReconfigure_s;
     const std::optional<LatticeIndex> wanted = loop.wanted_contact_node();
     if (wanted != hover_node) hover_node = wanted, hover_since_ns = now;
@@ -798,7 +797,6 @@ int Serve(const Arguments& args) {
       if (bridge) {
         SupervisorDecision shown = decision;
         shown.configuration = active();
-        shown.spectral_radius = mover.placement().centred.spectral_radius;
         shown.error_percent = reported_error;  // for the node the regions are centred on
         shown.target_met = reported_target_met;
         status_t status =

@@ -27,23 +27,17 @@ std::string RegionsMover::Outcome::Describe() const {
       text << "regions centred on " << DescribeContactNode(to.node) << " " << elapsed_s
            << " s after it was asked for";
       if (kind == Kind::kMoveUnverified) {
-        text << "; their coupling is being verified behind them";
+        text << "; they are being checked behind them";
       } else if (to.centred.fell_back) {
-        text << "; the chosen configuration is unstable around it: secondaries at the primary "
-                "rate there";
+        text << "; the chosen configuration ran away around it before: secondaries at the "
+                "primary rate there";
       }
       break;
     case Kind::kConfirmed:
-    case Kind::kDemote:
-      text << "coupling of " << DescribeConfiguration(request.configuration) << " around "
-           << DescribeContactNode(request.node) << " verified " << elapsed_s
-           << " s after the touch asked for the regions there: ";
-      text.precision(5);
-      if (kind == Kind::kConfirmed) {
-        text << "stable, spectral radius " << to.centred.spectral_radius;
-      } else {
-        text << "UNSTABLE; secondaries at the primary rate there";
-      }
+    case Kind::kDemote:  // only ever the runaway watch's, described above
+      text << DescribeConfiguration(request.configuration) << " around "
+           << DescribeContactNode(request.node) << " checked " << elapsed_s
+           << " s after the touch asked for the regions there: it runs there";
       break;
     case Kind::kMoveBack:
       text << why_not << "; the regions go back to " << DescribeContactNode(to.node) << " ("
@@ -55,7 +49,7 @@ std::string RegionsMover::Outcome::Describe() const {
 
 RegionsMover::RegionsMover(const Scene& scene, const Placement& at, Verifier verify)
     : scene_(scene), placed_(at), last_verified_(at), verify_(std::move(verify)) {
-  if (at.centred.spectral_radius >= 0) {  // the start is verified: a touch back there need not be
+  if (at.centred.verified) {  // the start is verified: a touch back there need not be
     verdicts_[KeyOf({at.centred.configuration, at.node})] = at.centred;
   }
 }
@@ -89,7 +83,7 @@ void RegionsMover::Ask(const Request& request, std::int64_t now_ns) {
   behind_ = true;
   ready_ = Outcome{Outcome::Kind::kMoveUnverified,
                    request,
-                   {CentredConfiguration{request.configuration, -1, false}, request.node},
+                   {CentredConfiguration{request.configuration, false, false}, request.node},
                    0,
                    ""};
 }
@@ -127,9 +121,7 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
   verdicts_[KeyOf(request)] = *verdict->result;
   Outcome out{
       Outcome::Kind::kMoveVerified, request, {*verdict->result, request.node}, elapsed_ms, ""};
-  if (behind) {
-    out.kind = out.to.centred.fell_back ? Outcome::Kind::kDemote : Outcome::Kind::kConfirmed;
-  }
+  if (behind) out.kind = Outcome::Kind::kConfirmed;
   return out;
 }
 
@@ -138,7 +130,7 @@ void RegionsMover::OnRunaway(std::int64_t now_ns) {
   refused_.insert(KeyOf(ran));
   verdicts_.erase(KeyOf(ran));
   refusal_.clear();
-  CentredConfiguration equal{ran.configuration, -1, true};
+  CentredConfiguration equal{ran.configuration, false, true};
   equal.configuration.secondary_rate_hz = PrimaryRateHz(scene_);
   // Whatever was asked is given up (a verification running is dropped by the next Submit):
   // the regions leave this configuration at the next Poll.
@@ -157,7 +149,8 @@ void RegionsMover::Applied(const Outcome& outcome) {
 void RegionsMover::NotApplied(const Outcome& outcome) {
   using Kind = Outcome::Kind;
   if (outcome.kind == Kind::kDemote || outcome.kind == Kind::kMoveBack) {
-    asked_ = outcome.request;  // the regions still run what was found unstable: again next Poll
+    asked_ =
+        outcome.request;  // the regions still run what ran away or was refused: again next Poll
     ready_ = outcome;
     behind_ = false;
   } else if (outcome.kind == Kind::kMoveUnverified) {

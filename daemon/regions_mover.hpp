@@ -20,17 +20,17 @@ namespace hapticsim {
  * with what Poll returns.
  *
  * A touch does not wait. The regions move onto a touched node at once, with their interface
- * controllers and port limits on (docs/regions.md), and the coupled stability of the bare
- * exchange around the node is verified behind them (VerifyCentredOn, a fraction of a second on
- * the paper's cube) on a background thread of its own, made once, so the supervisor's tick never
- * waits and no request makes a thread. Should the verdict be that the configuration is unstable
- * around the node, Poll says to demote the regions there to their secondaries at the primary
- * rate, or — unstable even so — to move them back to where they were last verified; the port
- * guard bounds what reaches the hand meanwhile. A configuration change (asked out of contact,
- * with nobody waiting) and a hovering tool's move are still verified before they move. Verdicts
- * are kept per configuration and node, so a node touched before moves straight to its verified
- * configuration. A touch elsewhere may give up a verification still running (the regions leave
- * that node anyway).
+ * controllers, port limits and runaway watch on (docs/regions.md), and what a move needs — the
+ * node is one the tool may touch, the regions can be built around it (VerifyCentredOn) — is
+ * checked behind them on a background thread of its own, made once, so the supervisor's tick
+ * never waits and no request makes a thread. No stability estimate is made: should the regions'
+ * state outgrow what the energy balance allows, the loop's runaway watch says so (OnRunaway) and
+ * the regions go to equal rates there. Should the check refuse the node, Poll says to move them
+ * back to where they were last checked; the port guard bounds what reaches the hand meanwhile. A
+ * configuration change (asked out of contact, with nobody waiting) and a hovering tool's move
+ * are checked before they move. Checks are kept per configuration and node, so a node touched
+ * before moves straight there. A touch elsewhere may give up a check still running (the regions
+ * leave that node anyway).
  */
 class RegionsMover {
  public:
@@ -42,29 +42,29 @@ class RegionsMover {
   };
   /** Where the regions run: a configuration, centred on a node. */
   struct Placement {
-    CentredConfiguration centred;  ///< spectral_radius −1 while unverified
+    CentredConfiguration centred;  ///< verified false while the check behind a move runs
     LatticeIndex node{};
   };
   struct Outcome {
     enum class Kind {
-      kMoveUnverified,  ///< move now; its coupling is being verified behind it
-      kMoveVerified,    ///< move now; verified (before, or by an earlier touch on the node)
-      kConfirmed,       ///< the regions moved unverified are stable there: nothing to move
-      kDemote,          ///< they are not: move them to the secondaries at equal rates there
-      kMoveBack,        ///< not even at equal rates: back to where they were last verified
+      kMoveUnverified,  ///< move now; checked behind it
+      kMoveVerified,    ///< move now; checked (before, or by an earlier touch on the node)
+      kConfirmed,       ///< the regions moved unchecked can run there: nothing to move
+      kDemote,          ///< they ran away (OnRunaway): the secondaries at equal rates there
+      kMoveBack,        ///< they cannot run there: back to where they were last checked
     };
     Kind kind = Kind::kMoveVerified;
     Request request;
     Placement to;           ///< where the regions go (or stay, kConfirmed)
     double elapsed_ms = 0;  ///< from the request to this outcome
     std::string why_not;    ///< kMoveBack: why the node was refused
-    bool runaway = false;   ///< kDemote for the runaway watch (OnRunaway), not a verdict
+    bool runaway = false;   ///< kDemote for the runaway watch (OnRunaway)
     bool moves() const { return kind != Kind::kConfirmed; }
     /**
      * Whether the new regions start from the object's motion (HapticLoop::Handover::
      * kCarryMotion, a switch in contact): a verified configuration on the node they are centred
-     * on now. Onto another node, or demoted or moved back from a configuration found unstable
-     * (whose motion is not to be kept), they start from rest, a touch ramped in.
+     * on now. Onto another node, or demoted or moved back from a configuration that ran away or
+     * cannot run (whose motion is not to be kept), they start from rest, a touch ramped in.
      */
     bool CarriesMotionFrom(const LatticeIndex& centre) const {
       return kind == Kind::kMoveVerified && to.node == centre;
@@ -94,7 +94,7 @@ class RegionsMover {
   bool may_interrupt() const { return busy() && !ready_; }
   /** When its verification running now started (CLOCK_MONOTONIC ns), 0 when none runs. */
   std::int64_t running_since_ns() const { return verifier_.running_since_ns(); }
-  /** False for a configuration and node found unstable (or invalid) before: not asked again. */
+  /** False for a configuration and node that ran away (or were refused) before: not asked again. */
   bool may_ask(const Request& request) const { return !refused_.count(KeyOf(request)); }
   /**
    * Starts a move: one a touch waits for at once (the next Poll returns it), any other once
@@ -105,7 +105,7 @@ class RegionsMover {
    * The next outcome, once there is one; placement() follows it.
    * @throws Error when a move is refused before anything moved: the node cannot be touched (off
    *         the surface, a support) or the regions cannot be built around it (both at once), or a
-   *         configuration change is unstable around it even at equal rates. Remembered as
+   *         configuration change cannot run around it. Remembered as
    *         refused; the regions stay where they are.
    */
   std::optional<Outcome> Poll(std::int64_t now_ns);

@@ -10,7 +10,7 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
   s.primary_size = decision.configuration.primary_size;
   s.secondary_lod = decision.configuration.secondary_lod;
   s.secondary_rate_hz = decision.configuration.secondary_rate_hz;
-  s.spectral_radius = decision.spectral_radius;
+  s.spectral_radius = -1;  // not estimated: the runaway watch guards the coupling (`runaways`)
   s.error_target_percent = target;
   s.error_percent = decision.error_percent;
   s.target_met = decision.target_met;
@@ -37,6 +37,7 @@ status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>&
   s.interface_backlog_j = loop.interface_backlog_j();
   s.interface_backlog_max_j = loop.interface_backlog_max_j();
   s.energy_balance_violations = loop.energy_balance_violations();
+  s.runaways = loop.runaways();
   s.stale_periods = loop.stale_periods();
   for (int c = 0; c < 3; ++c) s.contact_node[c] = loop.centre_node()[c];
   s.reconfigurations = loop.reconfigurations();

@@ -16,19 +16,15 @@ constexpr int kLod = static_cast<int>(MapAxis::kSecondaryLod);
 constexpr int kSize = static_cast<int>(MapAxis::kPrimarySize);
 constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
 
-// Coupled stability of a configuration on this scene; nullopt when the configuration is invalid.
-// Estimated for the bare lagged exchange, without the interface controllers: they hold most of
-// what it refuses (docs/regions.md, "Passive interfaces"), but not yet all — the stress test
-// finds small stiff scenes with regions near their own limits where a mode outgrows them — so
-// the daemon runs only what is stable without them, and the controllers are its second line.
-std::optional<double> CoupledRadius(const Scene& scene, const RegionConfiguration& c) {
+// Why regions cannot be built on `scene` as the daemon builds them, or "". Built, each region
+// steps within kSubstepSafety of its own limit: nothing more is asked of a configuration
+// (ChooseConfiguration says why).
+std::string BuildProblem(const Scene& scene) {
   try {
-    AsyncRegions regions(SceneWith(scene, c), AsyncRegions::kSubstepSafety,
-                         AsyncRegions::InterfaceControl::kOff);
-    const CoupledStability stability = regions.EstimateCoupledStability();
-    return stability.stable ? std::optional<double>(stability.spectral_radius) : std::nullopt;
-  } catch (const Error&) {
-    return std::nullopt;
+    const AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
   }
 }
 
@@ -97,16 +93,11 @@ CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfigurati
                                      const LatticeIndex& node) {
   const Scene centred = SceneWith(scene, configuration, node);
   ValidateScene(centred);  // a node off the surface or on a support is refused with its reason
-  if (const std::optional<double> radius = CoupledRadius(centred, configuration)) {
-    return {configuration, *radius, false};
+  if (const std::string problem = BuildProblem(centred); !problem.empty()) {
+    throw Error(DescribeConfiguration(configuration) + " cannot run around " +
+                DescribeContactNode(node) + ": " + problem);
   }
-  RegionConfiguration equal = configuration;
-  equal.secondary_rate_hz = PrimaryRateHz(scene);
-  if (const std::optional<double> radius = CoupledRadius(centred, equal)) {
-    return {equal, *radius, true};
-  }
-  throw Error(DescribeConfiguration(configuration) + " is not stable around " +
-              DescribeContactNode(node) + ", not even at equal rates");
+  return {configuration, true, false};
 }
 
 std::string MapProblem(const Scene& scene, const ErrorMap& map) {
@@ -175,7 +166,7 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     }
   }
   if (candidates.empty() && capped) {
-    throw Error("no configuration in the error map is stable and cheaper than " +
+    throw Error("no configuration in the error map ran and is cheaper than " +
                 std::to_string(below_cost_us_per_ms) + " µs per simulated ms");
   }
   if (candidates.empty()) {  // no map, or nothing usable in it: the scene's own configuration
@@ -183,11 +174,6 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
         RegionConfiguration{scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
                             scene.adaptivity.secondary_rate_hz});
     candidates.push_back({own, -1, 0, false});
-    if (!pinned) {
-      RegionConfiguration equal = own;
-      equal.secondary_rate_hz = PrimaryRateHz(scene);
-      if (!(equal == own)) candidates.push_back({equal, -1, 0, false});
-    }
   }
   const bool have_map = candidates.front().error >= 0;
   // Cheapest first among those meeting the target; then the most accurate of the rest.
@@ -201,33 +187,33 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
                    });
   SupervisorDecision decision;
   decision.have_map = have_map;
+  std::string problem;
   for (const Candidate& candidate : candidates) {
-    ++decision.stability_checks;
-    const std::optional<double> radius = CoupledRadius(scene, candidate.configuration);
-    if (!radius) continue;
+    ++decision.candidates_built;
+    problem = BuildProblem(SceneWith(scene, candidate.configuration));
+    if (!problem.empty()) continue;
     decision.configuration = candidate.configuration;
     decision.error_percent = candidate.error;
     decision.cost_us_per_ms = candidate.cost;
     decision.clamped = candidate.clamped;
-    decision.spectral_radius = *radius;
     decision.target_met = have_map && candidate.error <= target_percent;
     std::ostringstream reason;
-    reason << DescribeConfiguration(candidate.configuration) << ": coupled spectral radius "
-           << *radius;
+    reason << DescribeConfiguration(candidate.configuration);
     if (have_map) {
-      reason << ", looked-up error " << candidate.error << " % against the target "
+      reason << ": looked-up error " << candidate.error << " % against the target "
              << target_percent << " %" << (decision.target_met ? "" : " (TARGET EXCEEDED)")
              << (candidate.clamped ? " (the scene is outside the map: clamped)" : "");
     } else {
-      reason << ", no error map: the error is unknown";
+      reason << ": no error map, the error is unknown";
     }
     decision.reason = reason.str();
     return decision;
   }
   throw Error(pinned ? "the pinned configuration " + DescribeConfiguration(*pinned) +
-                           " is not stable on this scene"
-                     : "no stable configuration for this scene (checked " +
-                           std::to_string(decision.stability_checks) + ")");
+                           " cannot run on this scene: " + problem
+                     : "no configuration can run on this scene (" +
+                           std::to_string(decision.candidates_built) +
+                           " tried; the last: " + problem + ")");
 }
 
 }  // namespace hapticsim

@@ -33,26 +33,29 @@ struct SupervisorDecision {
   bool have_map = false;
   double error_percent = -1;  ///< looked-up worst magnitude error, % (-1 without a map)
   bool target_met = false;
-  bool clamped = false;        ///< the scene is outside the map on some axis
-  double spectral_radius = 0;  ///< coupled, verified before choosing
-  double cost_us_per_ms = 0;   ///< mean measured cost in the map (0 without a map)
-  int stability_checks = 0;    ///< candidates whose stability was estimated
-  std::string reason;          ///< one line for the log
+  bool clamped = false;       ///< the scene is outside the map on some axis
+  double cost_us_per_ms = 0;  ///< mean measured cost in the map (0 without a map)
+  int candidates_built = 0;   ///< candidates whose regions were built to check them
+  std::string reason;         ///< one line for the log
 };
 
 /**
- * Stability first: picks the cheapest configuration (by the map's measured cost) whose
- * looked-up error meets `target_percent` and whose coupled regions are stable (estimated here,
- * not only trusted from the map); when none meets the target, the stable one with the least
- * error, target_met = false. The error is looked up for the scene's material and contact node
- * (the daemon passes the node its regions are centred on; stability is estimated around it too)
- * with the input frequency and amplitude unknown (their worst case over the map). Without a map:
- * the scene's own configuration if stable, else equal rates (always stable when the primary rate
- * is); a map with a MapProblem counts as none. `pinned`: only that configuration (refused — an
- * Error — if it is unstable).
+ * Picks the cheapest configuration (by the map's measured cost) whose looked-up error meets
+ * `target_percent`; when none does, the one with the least error, target_met = false. A
+ * configuration the map measured unstable or diverged is never chosen. The error is looked up
+ * for the scene's material and contact node (the daemon passes the node its regions are centred
+ * on) with the input frequency and amplitude unknown (their worst case over the map). Without a
+ * map: the scene's own configuration. A map with a MapProblem counts as none. `pinned`: only
+ * that configuration.
+ *
+ * Stability is not estimated (docs/regions.md, "Stable by construction"): every region steps
+ * within its own limit (its substeps see to it), the interface controllers hold the coupling's
+ * energy, the runaway watch takes the regions to equal rates should their state outgrow what the
+ * energy balance allows, and the port guard bounds the force meanwhile. A candidate is only
+ * refused when its regions cannot be built on the scene (a primary region covering the object).
  * `below_cost_us_per_ms`: only configurations the map measured cheaper than this (deadlines
  * before accuracy, when the running one keeps missing them).
- * @throws Error when no stable configuration exists at all (or none cheaper, with a ceiling).
+ * @throws Error when no candidate's regions can be built (or none is cheaper, with a ceiling).
  */
 /**
  * Why the daemon cannot use a grid map with its scene, or "" when it can: the lookup must take
@@ -89,19 +92,18 @@ Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration);
 Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration,
                 const LatticeIndex& node);
 
-/** A configuration verified stable around one contact node. */
+/** A configuration checked around one contact node. */
 struct CentredConfiguration {
   RegionConfiguration configuration;  ///< the one asked for, or its equal-rate fallback
-  double spectral_radius = 0;         ///< coupled, around the node
-  bool fell_back = false;             ///< the one asked for is unstable around the node
+  bool verified = false;              ///< checked around the node (false: moved there unchecked)
+  bool fell_back = false;             ///< at equal rates: the one asked for ran away there
 };
 
 /**
- * Stability first, wherever the tool touches: verifies `configuration` with its regions centred
- * on `node` (the regions' shapes, and so their coupling, change near the object's edges and
- * corners). When it is unstable there, the same regions with the secondaries at the primary rate
- * instead (stable whenever the primary rate is).
- * @throws Error when neither is stable around the node.
+ * Checks that `configuration` can run with its regions centred on `node`: the node is a surface
+ * node the tool may touch (not a support) and the regions can be built around it (their shapes
+ * change near the object's edges and corners). No stability estimate: see ChooseConfiguration.
+ * @throws Error naming what is wrong.
  */
 CentredConfiguration VerifyCentredOn(const Scene& scene, const RegionConfiguration& configuration,
                                      const LatticeIndex& node);

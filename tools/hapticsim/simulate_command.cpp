@@ -197,15 +197,16 @@ int Run(const SimulateOptions& options) {
     WriteForcePlot(options.plot_path, result, scene);
   }
 
-  double peak_time = 0;
+  // When the largest force of the samples shown came (the trial's own peak may fall between them).
+  double peak_time = 0, largest_shown = -1;
   for (const ForceSample& s : result.samples) {
     const double magnitude =
         std::hypot(s.feedback_force_n[0], s.feedback_force_n[1], s.feedback_force_n[2]);
-    if (magnitude == result.peak_force_n) peak_time = s.t_s;
+    if (magnitude > largest_shown) largest_shown = magnitude, peak_time = s.t_s;
   }
   const double simulated_ms = result.steps * scene.solver.dt_s * 1e3;
   const double cost_us_per_ms = simulated_ms > 0 ? result.wall_time_s * 1e6 / simulated_ms : 0;
-  // Adaptive: the bare exchange stable, as the daemon verifies before it runs a configuration.
+  // Adaptive: the bare exchange stable (an analysis: the daemon no longer estimates it).
   const bool predicted_stable =
       adaptive ? report.coupled.stable : result.stability.IsStable(scene.solver.dt_s);
 
@@ -294,8 +295,8 @@ int Run(const SimulateOptions& options) {
                 << Quantity(report.coupled.spectral_radius, "") << "per common period of "
                 << Duration(report.coupled.common_period_s) << ": "
                 << (report.coupled.stable ? "stable"
-                                          : "UNSTABLE (hapticsimd does not run it; here the "
-                                            "interface controllers hold it)")
+                                          : "UNSTABLE bare (the interface controllers hold it "
+                                            "as run; the runaway watch ends what they cannot)")
                 << "\n  energy: the exchange between the regions created "
                 << Quantity(e.interface_created_j, "J") << " and the interface controllers took "
                 << "out " << Quantity(e.interface_dissipated_j, "J") << "; the port limits kept "
@@ -313,7 +314,11 @@ int Run(const SimulateOptions& options) {
     } else {
       if (result.diverged()) {
         std::cout << "  DIVERGED at t = " << Duration(result.stopped_at_s) << " ("
-                  << TrialOutcomeName(result.outcome) << "); forces after that are not shown\n";
+                  << (result.runaway ? "the runaway watch: the state outgrew what the energy "
+                                       "balance allows; hapticsimd takes these regions to equal "
+                                       "rates"
+                                     : TrialOutcomeName(result.outcome))
+                  << "); forces after that are not shown\n";
       }
       std::cout << "  peak force on the user: " << Quantity(result.peak_force_n, "N")
                 << " at t = " << Duration(peak_time) << "\n";

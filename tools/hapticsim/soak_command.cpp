@@ -109,16 +109,17 @@ std::string DefaultDaemon() {
 // namespace of our own (loopback only, a multicast route on it), as the tests do.
 [[noreturn]] void ReexecInPrivateNetns(int argc, char** argv) {
   setenv(kInNetnsVariable, "1", 1);
-  std::vector<std::string> args{"unshare",
-                                "--user",
-                                "--map-root-user",
-                                "--net",
-                                "sh",
-                                "-c",
-                                "ip link set lo up && ip route add 224.0.0.0/4 dev lo src 127.0.0.1 && "
-                                "exec \"$@\"",
-                                "sh",
-                                SelfPath().string()};
+  std::vector<std::string> args{
+      "unshare",
+      "--user",
+      "--map-root-user",
+      "--net",
+      "sh",
+      "-c",
+      "ip link set lo up && ip route add 224.0.0.0/4 dev lo src 127.0.0.1 && "
+      "exec \"$@\"",
+      "sh",
+      SelfPath().string()};
   for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
   std::vector<char*> raw;
   for (std::string& a : args) raw.push_back(a.data());
@@ -428,6 +429,7 @@ int RunSoak(const SoakOptions& o) {
       {"port_energy_dissipated_j", last_status.port_energy_dissipated_j},
       {"port_guard_off", last_status.port_guard_off},
       {"energy_balance_violations", last_status.energy_balance_violations},
+      {"runaways", last_status.runaways},
       {"interface_backlog_max_j", last_status.interface_backlog_max_j},
       {"switch_every_s", o.switch_every_s},
       {"configuration_pins_ok", switcher.ok.load()},
@@ -469,9 +471,11 @@ int RunSoak(const SoakOptions& o) {
         last_status.port_energy_dissipated_j);
     std::printf(
         "  coupling                   %lld period(s) with the interface backlog beyond the "
-        "primary's reserve above %.3g %% of the regions' energy; largest backlog %.3g J%s\n",
+        "primary's reserve above %.3g %% of the regions' energy; largest backlog %.3g J; "
+        "%lld runaway(s) taken to equal rates%s\n",
         static_cast<long long>(last_status.energy_balance_violations),
         100 * StressOutcome::kGrowingBacklog, last_status.interface_backlog_max_j,
+        static_cast<long long>(last_status.runaways),
         last_status.port_guard_off ? " (port guard OFF)" : "");
     if (o.switch_every_s > 0) {
       std::printf(

@@ -1,10 +1,14 @@
 // hapticsim stress: the numerical-stability stress test. Random scenes and configurations are
 // predicted and then run (core/stability_stress.hpp); the supervisor is asked to choose for each
-// scene, also from an error map that calls every configuration fine, and what it chose is
-// verified again on its own.
+// scene, also from an error map that calls every configuration fine, and what it chose is run
+// as the daemon runs it.
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -17,6 +21,7 @@
 #include "core/async_regions.hpp"
 #include "core/error.hpp"
 #include "core/error_map.hpp"
+#include "core/scene_toml.hpp"
 #include "core/stability_stress.hpp"
 #include "daemon/supervisor.hpp"
 #include "tools/hapticsim/command.hpp"
@@ -32,6 +37,7 @@ struct StressOptions {
   std::uint64_t seed = 1;
   int jobs = 0;
   int only_case = -1;
+  std::string scene_out;
   int supervisor_every = 1;
   StressRanges ranges;
   bool faults = false;
@@ -41,30 +47,57 @@ struct StressOptions {
 
 // What the supervisor did for one case's scene.
 struct SupervisorCheck {
-  int choices = 0;                // decisions made (without a map, from a lying map, pinned)
-  int chose_unstable = 0;         // a chosen configuration that is not predicted stable on its own
-  int stable_pinned_refused = 0;  // a stable pinned configuration it refused
+  int choices = 0;         // decisions made (without a map, from a lying map, pinned)
+  int chose_unstable = 0;  // a chosen configuration that, run as the daemon runs it, broke the
+                           // energy balance without the runaway watch ending it
+  int stable_pinned_refused = 0;  // a pinned configuration refused though its regions build
+  int runaways = 0;               // chosen runs the runaway watch ended (the daemon demotes them)
   std::string problem;
   double seconds = 0;  // wall time of the checks
 };
 
-// Not the supervisor's estimate: one fixed iteration of 3 × its base length (1800 + 900 common
-// periods), no early stop, from another random start — a slowly growing mode the supervisor's
-// estimate took for decaying shows here as a failure. (The same orbit norm: the Euclidean one
-// swings by up to ±0.004 per period and would accuse stable configurations.) Both estimate the
-// bare exchange, as the supervisor does.
-bool IndependentlyStable(const Scene& scene) {
-  try {
-    AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
-    return regions.EstimateCoupledStability(1800, 900, 1, /*seed=*/11).stable;
-  } catch (const Error&) {
-    return false;
+// The supervisor no longer estimates stability (docs/regions.md, "Stable by construction"), so
+// what it chose is run here as the daemon runs it: production substeps, interface controllers and
+// runaway watch on, from the case's random start under its input for 2 s. It must end within the
+// energy balance the controllers guarantee (the same check as the case's own run), or be ended by
+// the runaway watch — which the daemon answers by taking the regions to equal rates. Diverging
+// any other way, or keeping more energy than the balance allows, is a failure ("" when none).
+struct GuardedRun {
+  bool runaway = false;
+  std::string problem;
+};
+GuardedRun RunAsTheDaemonRunsIt(const Scene& scene, unsigned state_seed) {
+  GuardedRun out;
+  AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
+  InputSettings input = scene.input;
+  input.periods = 2.0 * input.frequency_hz;
+  regions.SetRandomState(state_seed);
+  const double start_energy = regions.Energies().stored_j;
+  const TrialResult trial = regions.RunTrialFromRandomState(input, state_seed);
+  if (trial.runaway) {
+    out.runaway = true;
+    return out;
   }
+  StressOutcome as_run;  // its energy_balance_violated() is the case's own check
+  as_run.controlled_run = true;
+  as_run.passive_expected = scene.adaptivity.displacement_coupling;
+  const EnergyAccount e = regions.Energies();
+  as_run.energy_gain_j = EnergyAboveBound(e, start_energy);
+  as_run.energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
+  as_run.backlog_bound_j = e.backlog_bound_j;
+  if (trial.diverged()) {
+    out.problem = "diverged without the runaway watch ending it";
+  } else if (as_run.energy_balance_violated()) {
+    out.problem = "ended " + std::to_string(as_run.energy_gain_j) +
+                  " J above the interface controllers' energy bound";
+  }
+  return out;
 }
 
 // An error map for this scene's material and input that calls four configurations fine (two
-// primary sizes × two secondary rates at the scene's spacing factor): the supervisor must still
-// verify stability itself. Four, not the paper's 60, keeps a case's checks to a few estimates.
+// primary sizes × two secondary rates at the scene's spacing factor): what the supervisor chooses
+// from it is run as the daemon runs it. Four, not the paper's 60, keeps a case's checks to a few
+// runs.
 ErrorMap LyingMap(const Scene& scene, std::mt19937_64& rng) {
   std::array<std::vector<double>, kNumMapAxes> axes;
   const MapPoint at = PointOfScene(scene);
@@ -95,28 +128,31 @@ SupervisorCheck CheckSupervisor(const StressOutcome& outcome) {
   const Scene& scene = outcome.stress_case.scene;
   std::mt19937_64 rng(outcome.stress_case.state_seed);
   const ErrorMap lying = LyingMap(scene, rng);
-  // Independent verdicts, each estimated once per configuration.
-  std::map<std::tuple<int, int, double>, bool> verdicts;
-  auto stable = [&](const RegionConfiguration& c) {
+  // Each chosen configuration run once.
+  std::map<std::tuple<int, int, double>, GuardedRun> runs;
+  auto run = [&](const RegionConfiguration& c) -> const GuardedRun& {
     const auto key = std::make_tuple(c.primary_size, c.secondary_lod, c.secondary_rate_hz);
-    const auto found = verdicts.find(key);
-    if (found != verdicts.end()) return found->second;
-    return verdicts[key] = IndependentlyStable(SceneWith(scene, c));
+    const auto found = runs.find(key);
+    if (found != runs.end()) return found->second;
+    GuardedRun& ran = runs[key] =
+        RunAsTheDaemonRunsIt(SceneWith(scene, c), outcome.stress_case.state_seed);
+    if (ran.runaway) ++check.runaways;
+    return ran;
   };
   auto verify = [&](const char* how, const ErrorMap* map,
                     const std::optional<RegionConfiguration>& pinned) {
     ++check.choices;
     try {
       const SupervisorDecision decision = ChooseConfiguration(scene, map, 5.0, pinned);
-      if (!stable(decision.configuration)) {
+      if (const GuardedRun& ran = run(decision.configuration); !ran.problem.empty()) {
         ++check.chose_unstable;
-        check.problem = std::string(how) + " chose an unstable configuration: " + decision.reason;
+        check.problem = std::string(how) + " chose " + decision.reason + ", which " + ran.problem;
       }
-    } catch (const Error&) {
-      // Refusing when nothing is stable is a correct answer; refusing a stable pinned one is not.
-      if (pinned && stable(*pinned)) {
+    } catch (const Error& e) {
+      // Regions that cannot be built are the only refusal; the scene's own always build.
+      if (pinned) {
         ++check.stable_pinned_refused;
-        check.problem = std::string(how) + " refused a stable pinned configuration";
+        check.problem = std::string(how) + " refused: " + e.what();
       }
     }
   };
@@ -146,7 +182,28 @@ Json CaseJson(const StressOutcome& o) {
       {"diverged_region", o.diverged_region}};
 }
 
+// --scene-out: case I's scene as a scene file, to run it in the daemon or `simulate`.
+int WriteCaseScene(const StressOptions& o) {
+  HAPTICSIM_THROW_UNLESS(o.only_case >= 0, "--scene-out needs --case I: the case to write");
+  const StressCase c = DrawStressCase(o.seed, o.only_case, o.ranges);
+  std::ofstream out(o.scene_out);
+  out << "# hapticsim stress --seed " << o.seed << " --min-nodes " << o.ranges.min_nodes
+      << " --max-nodes " << o.ranges.max_nodes << " --case " << o.only_case << "\n# "
+      << DescribeStressCase(c) << "\n"
+      << FormatSceneToml(c.scene);
+  out.close();
+  HAPTICSIM_THROW_UNLESS(out, "cannot write " + o.scene_out + ": " + std::strerror(errno));
+  std::cerr << "case " << o.only_case << "'s scene written to " << o.scene_out
+            << (c.substep_safety > AsyncRegions::kSubstepSafety
+                    ? " (the case steps one region near its own limit; hapticsimd and simulate "
+                      "build it with production substeps)"
+                    : "")
+            << "\n";
+  return 0;
+}
+
 int Run(const StressOptions& o) {
+  if (!o.scene_out.empty()) return WriteCaseScene(o);
   HAPTICSIM_THROW_UNLESS(o.count >= 1, "--count must be at least 1");
   HAPTICSIM_THROW_UNLESS(o.ranges.min_nodes >= 3 && o.ranges.max_nodes >= o.ranges.min_nodes,
                          "--nodes MIN MAX: need 3 <= MIN <= MAX");
@@ -200,7 +257,7 @@ int Run(const StressOptions& o) {
 
   long predicted_stable = 0, stable_diverged = 0, past_limit = 0, coupling_only = 0, unstable = 0,
        detected = 0, undetected = 0, marginal = 0, marginal_detected = 0, region_is_past_limit = 0,
-       past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0,
+       past_limit_diverged = 0, choices = 0, chose_unstable = 0, pinned_refused = 0, runaways = 0,
        energy_violations = 0, passive = 0, passive_refused_today = 0, passive_diverged = 0,
        other_controlled = 0, other_controlled_diverged = 0;
   double worst_energy_gain = -INFINITY;  // relative to the case's energy scale
@@ -222,6 +279,7 @@ int Run(const StressOptions& o) {
     choices += check.choices;
     chose_unstable += check.chose_unstable;
     pinned_refused += check.stable_pinned_refused;
+    runaways += check.runaways;
     if (out.energy_balance_violated()) ++energy_violations;
     const FaultOutcome& fault = fault_outcomes[i];
     if (fault.ran) {
@@ -329,6 +387,7 @@ int Run(const StressOptions& o) {
                 {"supervisor_choices", choices},
                 {"supervisor_chose_unstable", chose_unstable},
                 {"supervisor_refused_stable_pinned", pinned_refused},
+                {"supervisor_runaways", runaways},
                 {"seconds", seconds},
                 {"slowest_case_s", slowest_case_s},
                 {"prediction_and_run_s", cases_s},
@@ -394,8 +453,12 @@ int Run(const StressOptions& o) {
         << ")\n"
         << "    region reported is past its limit: " << region_is_past_limit << " of "
         << past_limit_diverged << "\n"
-        << "  supervisor decisions        " << choices << ", unstable chosen " << chose_unstable
-        << ", stable pinned refused " << pinned_refused << "\n";
+        << "  supervisor decisions        " << choices
+        << ", run as the daemon runs them: " << chose_unstable
+        << " broke the energy balance unguarded, " << runaways
+        << " ended by the runaway watch (the daemon takes those to equal rates); pinned "
+           "refused "
+        << pinned_refused << "\n";
     if (o.faults) {
       std::cout << "  under timing faults         " << fault_runs << " runs of " << o.fault_run_s
                 << " s on real threads (" << injected.secondary_lags << " secondary lags, "
@@ -423,7 +486,9 @@ Command AddStressCommand(CLI::App& parent) {
       "paper's ranges, meshes, primary sizes, spacing factors, rates, coupling, steps around each "
       "region's own limit, extreme inputs) predicted, then run from a random state; checks that "
       "every predicted-stable one stays bounded, every unstable one is detected within its "
-      "predicted bound, and the supervisor never chooses an unstable one. Exit 4 when a check "
+      "predicted bound, and what the supervisor chooses keeps the energy balance as the daemon "
+      "runs "
+      "it, or is caught by the runaway watch. Exit 4 when a check "
       "fails.");
   app->add_option("--count", options->count, "Number of random cases")->capture_default_str();
   app->add_option("--seed", options->seed, "Seed of the draw (case i is the same for any --jobs)")
@@ -432,6 +497,9 @@ Command AddStressCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--case", options->only_case,
                   "Run only case I of the seed and describe it (to reproduce a failure)");
+  app->add_option("--scene-out", options->scene_out,
+                  "With --case I: write case I's scene to this TOML file and exit (to run it in "
+                  "hapticsimd or `hapticsim simulate`)");
   app->add_option("--min-nodes", options->ranges.min_nodes, "Smallest mesh, nodes per axis")
       ->capture_default_str();
   app->add_option("--max-nodes", options->ranges.max_nodes, "Largest mesh, nodes per axis")
@@ -443,8 +511,8 @@ Command AddStressCommand(CLI::App& parent) {
                   "Longest simulated time of a predicted-unstable run, s")
       ->capture_default_str();
   app->add_option("--supervisor-every", options->supervisor_every,
-                  "Ask the supervisor to choose for every Nth case only (its checks cost several "
-                  "stability estimates each)")
+                  "Ask the supervisor to choose for every Nth case only (each choice is run as "
+                  "the daemon runs it, 2 s of simulated time)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app->add_flag("--faults", options->faults,
