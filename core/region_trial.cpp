@@ -65,8 +65,12 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
           reaction_along * (depth_next - trajectory.DepthAt(t + (q - 2) * h)) / 2.0;
       if (increment > 0) work += increment;
     }
-    // The kinetic part alone is bounded by the same passivity budget and needs no extra K·u.
-    const double energy = KineticEnergy();
+    // The state's energy is bounded by the same passivity budget. With the controllers on, each
+    // region published it before its last step (their pass computes it anyway: 4 % of a
+    // sweep's CPU went to a second pass); with them off, the kinetic part alone, no extra K·u.
+    const PublishedBalanceView balance = PublishedBalance();
+    const double energy =
+        control_ != InterfaceControl::kOff ? balance.state_energy_j : KineticEnergy();
     if (!std::isfinite(energy) || !std::isfinite(r[0] + r[1] + r[2])) {
       result.outcome = TrialOutcome::kDivergedNonFinite;
       break;
@@ -77,7 +81,7 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
     }
     // What the daemon watches for, with the same numbers: a trial it would have taken off these
     // regions is not a sample of them.
-    if (watches_runaway() && Runaway(PublishedBalance())) {
+    if (watches_runaway() && Runaway(balance)) {
       result.outcome = TrialOutcome::kDivergedEnergy;
       result.runaway = true;
       break;
