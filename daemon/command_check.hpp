@@ -13,15 +13,16 @@ struct CheckedCommand {
   enum class Kind { kSetErrorTarget, kPinConfiguration, kReleaseConfiguration, kReset, kRefused };
   Kind kind = Kind::kRefused;
   double error_target_percent = 0;  ///< kSetErrorTarget: in (0, 100] %
-  RegionConfiguration pin;          ///< kPinConfiguration: fields in range (stability is the
-                                    ///< supervisor's to verify before it runs)
+  RegionConfiguration pin;          ///< kPinConfiguration: fields in range (the supervisor
+                                    ///< checks its regions can be built before it runs)
   std::string refusal;              ///< kRefused: what was wrong, for the log
 };
 
 /**
  * Checks a decoded command like every other input: a known command with fields in range, else
- * refused with the reason. Never throws. The command channel cannot push the simulation into an
- * unstable configuration: a pin that passes here is still verified by the supervisor.
+ * refused with the reason. Never throws. A pin that passes here still goes through the supervisor:
+ * its regions are built (each within its own step limit) before it runs, and like any
+ * configuration it runs under the interface controllers, the runaway watch and the port guard.
  */
 CheckedCommand CheckCommand(const command_t& command, double primary_rate_hz);
 

@@ -233,6 +233,7 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
   }
   balance_peak_stored_j_ = 0;  // the balance starts afresh with the new regions
   runaway_seen_ = false;
+  runaway_periods_ = 0;
 }
 
 void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
@@ -306,8 +307,14 @@ void HapticLoop::WatchEnergyBalance() noexcept {
   }
   // Once per set of regions: the supervisor takes them off this configuration (release: the
   // regions it reads with the count are the ones that ran away).
-  if (!runaway_seen_ && regions_->watches_runaway() && regions_->Runaway(balance)) {
+  const bool above = !runaway_seen_ && regions_->watches_runaway() && regions_->Runaway(balance);
+  runaway_periods_ = above ? runaway_periods_ + 1 : 0;
+  if (runaway_periods_ >= AsyncRegions::kRunawayPeriods) {
     runaway_seen_ = true;
+    runaway_periods_ = 0;
+    runaway_state_j_.store(balance.state_energy_j, std::memory_order_relaxed);
+    runaway_allowed_j_.store(std::max(balance.allowed_j, regions_->port_floor_j()),
+                             std::memory_order_relaxed);
     runaways_.fetch_add(1, std::memory_order_release);
   }
 }

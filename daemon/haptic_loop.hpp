@@ -262,6 +262,12 @@ class HapticLoop {
    * regions off that configuration to equal rates. Any thread.
    */
   std::int64_t runaways() const { return runaways_.load(std::memory_order_acquire); }
+  /** The last runaway's state energy and what the balance allowed then, J (read after runaways()
+   *  rose: stored before its count is released). */
+  RunawayEnergies last_runaway() const {
+    return {runaway_state_j_.load(std::memory_order_relaxed),
+            runaway_allowed_j_.load(std::memory_order_relaxed)};
+  }
   /** The stress test's tolerance for a controlled exchange (StressOutcome::kGrowingBacklog). */
   static constexpr double kBacklogTolerance = StressOutcome::kGrowingBacklog;
   /**
@@ -369,7 +375,9 @@ class HapticLoop {
   std::atomic<std::int64_t> balance_violations_{0};
   double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
   bool runaway_seen_ = false;         // primary thread: these regions' runaway is counted
+  int runaway_periods_ = 0;           // primary thread: periods in a row above the watch's line
   std::atomic<std::int64_t> runaways_{0};
+  std::atomic<double> runaway_state_j_{0}, runaway_allowed_j_{0};
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;

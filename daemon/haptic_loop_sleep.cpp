@@ -67,6 +67,7 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
     regions_->Reset();
     balance_peak_stored_j_ = 0;  // they start again from rest
     runaway_seen_ = false;
+    runaway_periods_ = 0;
     interface_backlog_j_.store(0, std::memory_order_relaxed);
     sleep_state_ = kAsleep;
     asleep_.store(true, std::memory_order_relaxed);

@@ -1,6 +1,6 @@
 // hapticsimd: the haptic force daemon. Device input in (LCM), force plus its looked-up error out
-// at the primary rate (1 kHz), on real-time threads; a supervisor that chooses a stable
-// configuration meeting the error target; systemd notify and watchdog.
+// at 1 kHz on real-time threads; a supervisor that chooses a configuration meeting the error
+// target and moves regions that run away to equal rates; systemd notify and watchdog.
 //
 //   hapticsimd [--config /etc/hapticsim/hapticsimd.toml] [--check-config] [--print-config]
 //
@@ -343,14 +343,14 @@ int Serve(const Arguments& args) {
   BlackBox black_box(kBlackBoxCycles);
   std::int64_t last_fault_dump_ns = -1;  // none yet (CLOCK_MONOTONIC starts at boot)
   OverrunBurst overrun(HapticLoop::NowNs());
-  // New choices are made on one background thread (stability estimates take seconds): the tick
-  // never waits, and no command makes a thread.
+  // New choices are made on one background thread (building regions takes milliseconds): the
+  // tick never waits, and no command makes a thread.
   BackgroundWorker<SupervisorDecision> chooser("hsim-choose");
   std::optional<RegionConfiguration> choice_pin;  // the pin the newest choice was asked with
   std::optional<SupervisorDecision> pending;      // chosen, waiting for the tool to be away
   bool choice_for_overload = false;               // the running choice is for deadlines
   // The scene as the regions run it: centred on the node the tool last touched. A choice is made
-  // for that node — its error looked up there, its stability estimated around it.
+  // for that node — its error looked up there, its regions built around it.
   auto scene_at_centre = [&] {
     Scene scene = config.scene;
     scene.input.contact_node = loop.centre_node();
@@ -725,7 +725,7 @@ int Serve(const Arguments& args) {
     }
     if (loop.runaways() > runaways_seen) {  // off a configuration whose state outgrew its balance
       runaways_seen = loop.runaways();
-      mover.OnRunaway(now);  // the Poll below moves them
+      mover.OnRunaway(now, loop.last_runaway());  // the Poll below moves them
     }
     try {
       if (const std::optional<RegionsMover::Outcome> moved = mover.Poll(now)) {

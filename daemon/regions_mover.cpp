@@ -15,7 +15,9 @@ std::string RegionsMover::Outcome::Describe() const {
   if (runaway) {
     text << "the state of " << DescribeConfiguration(request.configuration) << " around "
          << DescribeContactNode(request.node)
-         << " outgrew what the energy balance allows (runaway watch); "
+         << " outgrew what the energy balance allows (runaway watch: " << std::scientific
+         << runaway_energies.state_j << " J against " << runaway_energies.allowed_j
+         << " J allowed); " << std::fixed
          << (to.centred.configuration == request.configuration
                  ? "already at equal rates: restarting them from rest"
                  : "secondaries at the primary rate there, from rest");
@@ -34,7 +36,7 @@ std::string RegionsMover::Outcome::Describe() const {
       }
       break;
     case Kind::kConfirmed:
-    case Kind::kDemote:  // only ever the runaway watch's, described above
+    case Kind::kDemote:  // only ever the runaway watch's, described above (runaway is set)
       text << DescribeConfiguration(request.configuration) << " around "
            << DescribeContactNode(request.node) << " checked " << elapsed_s
            << " s after the touch asked for the regions there: it runs there";
@@ -125,13 +127,13 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
   return out;
 }
 
-void RegionsMover::OnRunaway(std::int64_t now_ns) {
+void RegionsMover::OnRunaway(std::int64_t now_ns, const RunawayEnergies& measured) {
   const Request ran{placed_.centred.configuration, placed_.node};
-  refused_.insert(KeyOf(ran));
-  verdicts_.erase(KeyOf(ran));
   refusal_.clear();
-  CentredConfiguration equal{ran.configuration, false, true};
+  CentredConfiguration equal{ran.configuration, true, true};
   equal.configuration.secondary_rate_hz = PrimaryRateHz(scene_);
+  // From now on, a touch there asking for this configuration moves straight to equal rates.
+  verdicts_[KeyOf(ran)] = equal;
   // Whatever was asked is given up (a verification running is dropped by the next Submit):
   // the regions leave this configuration at the next Poll.
   asked_ = ran;
@@ -139,6 +141,7 @@ void RegionsMover::OnRunaway(std::int64_t now_ns) {
   behind_ = false;
   ready_ = Outcome{Outcome::Kind::kDemote, ran, {equal, ran.node}, 0, ""};
   ready_->runaway = true;
+  ready_->runaway_energies = measured;
 }
 
 void RegionsMover::Applied(const Outcome& outcome) {

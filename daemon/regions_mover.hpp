@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "core/async_regions.hpp"
 #include "daemon/background_worker.hpp"
 #include "daemon/supervisor.hpp"
 
@@ -55,10 +56,11 @@ class RegionsMover {
     };
     Kind kind = Kind::kMoveVerified;
     Request request;
-    Placement to;           ///< where the regions go (or stay, kConfirmed)
-    double elapsed_ms = 0;  ///< from the request to this outcome
-    std::string why_not;    ///< kMoveBack: why the node was refused
-    bool runaway = false;   ///< kDemote for the runaway watch (OnRunaway)
+    Placement to;                      ///< where the regions go (or stay, kConfirmed)
+    double elapsed_ms = 0;             ///< from the request to this outcome
+    std::string why_not;               ///< kMoveBack: why the node was refused
+    bool runaway = false;              ///< kDemote for the runaway watch (OnRunaway)
+    RunawayEnergies runaway_energies;  ///< what the watch measured, for the log
     bool moves() const { return kind != Kind::kConfirmed; }
     /**
      * Whether the new regions start from the object's motion (HapticLoop::Handover::
@@ -113,11 +115,12 @@ class RegionsMover {
    * The loop's runaway watch fired on the regions as placed (HapticLoop::runaways): their state
    * outgrew what the energy balance allows, which the interface controllers cannot see. Returns
    * the move to the secondaries at the primary rate there (kDemote, from rest with the touch
-   * ramped in) and refuses that configuration around that node from then on. Already at equal
-   * rates (monolithic central difference, stable by each region's own limit), the same regions
-   * start again from rest. Gives up whatever the mover was doing; the next Poll returns the move.
+   * ramped in); from then on a request for that configuration around that node moves straight
+   * to equal rates there. Already at equal rates (monolithic central difference, stable by each
+   * region's own limit), the same regions start again from rest. Gives up whatever the mover was
+   * doing; the next Poll returns the move. `measured`: what the watch saw, for the log line.
    */
-  void OnRunaway(std::int64_t now_ns);
+  void OnRunaway(std::int64_t now_ns, const RunawayEnergies& measured = {});
   /**
    * The caller moved the regions as `outcome` said (or, kConfirmed, left them): placement()
    * follows. An outcome that fails to apply (HapticLoop::Reconfigure threw) is given back with

@@ -12,7 +12,7 @@
 namespace hapticsim {
 
 /**
- * The status message of the running daemon: the active configuration and its verdicts, the input
+ * The status message of the running daemon: the active configuration and its error, the input
  * counters, and each region's schedule and deadline statistics (`snapshots`, one per region).
  */
 status_t MakeStatus(const HapticLoop& loop, const std::vector<DeadlineSnapshot>& snapshots,

@@ -139,11 +139,25 @@ TEST(RegionsMover, ARunawayDemotesTheRegionsToEqualRatesThereAndRefusesTheConfig
   EXPECT_FALSE(off->CarriesMotionFrom(kOffCentre)) << "a state that ran away is not carried";
   EXPECT_NE(off->Describe().find("runaway watch"), std::string::npos) << off->Describe();
   EXPECT_EQ(mover.placement().centred.configuration, off->to.centred.configuration);
-  EXPECT_FALSE(mover.may_ask(Touch(configuration, kOffCentre)));
+  EXPECT_TRUE(mover.placement().centred.verified);
   EXPECT_TRUE(mover.may_ask(Touch(configuration, AtStart(scene).node)));
   // The verdict the touch started is given up: nothing more comes from the mover.
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_FALSE(PollAndApply(mover));
+  EXPECT_FALSE(mover.busy());
+  // Away and back: a touch there asking for the configuration that ran away gets equal rates
+  // straight away (not zero force while nothing is asked).
+  mover.Ask(Touch(configuration, AtStart(scene).node), Now());
+  ASSERT_TRUE(PollAndApply(mover));
+  ASSERT_TRUE(mover.may_ask(Touch(configuration, kOffCentre)));
+  mover.Ask(Touch(configuration, kOffCentre), Now());
+  const std::optional<RegionsMover::Outcome> back = PollAndApply(mover);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->kind, Kind::kMoveVerified);
+  EXPECT_TRUE(back->to.centred.fell_back);
+  EXPECT_EQ(back->to.centred.configuration, off->to.centred.configuration);
+  EXPECT_NE(back->Describe().find("ran away around it before"), std::string::npos)
+      << back->Describe();
   EXPECT_FALSE(mover.busy());
   // Already at equal rates: the same regions again, from rest.
   mover.OnRunaway(Now());

@@ -92,7 +92,7 @@ Command AddCtlCommand(CLI::App& parent) {
       "Send a command to the running hapticsimd over its control socket (root, the daemon's "
       "user and control.group only) and print its answer. Requests:\n"
       "  set-error-target PERCENT                     the worst force error allowed, %\n"
-      "  pin PRIMARY_SIZE SECONDARY_LOD SECONDARY_HZ  hold this configuration (verified first)\n"
+      "  pin PRIMARY_SIZE SECONDARY_LOD SECONDARY_HZ  hold this configuration (checked first)\n"
       "  release                                      choose freely again\n"
       "  reset                                        restart the simulation from rest\n"
       "With --lcm --key-file FILE the command goes on LCM instead, signed with the key the "

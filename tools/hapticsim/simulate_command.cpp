@@ -86,7 +86,7 @@ struct RegionReport {
 
 struct AdaptiveReport {
   std::vector<RegionReport> regions;
-  CoupledStability coupled;  // the bare exchange's, as the daemon verifies it
+  CoupledStability coupled;  // the bare exchange's (an analysis; the daemon no longer estimates)
   EnergyAccount energy;      // the run's energy balance (AsyncRegions::Energies)
   std::vector<std::optional<DeadlineStats>> deadlines;  // per region, with --threads
   std::optional<ForceError> threaded_vs_virtual;
@@ -111,7 +111,7 @@ nlohmann::json ErrorJson(const ForceError& e) {
 
 // Nothing refused: each region takes the substeps its own limit asks for and the interface
 // controllers keep the exchange from adding energy (docs/regions.md). The bare exchange's
-// estimate is reported: the daemon runs only what is stable without the controllers.
+// estimate is reported as an analysis; the runaway watch ends what the controllers cannot hold.
 TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report, VtkOutput* vtk) {
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
   report->coupled = regions.EstimateCoupledStability();

@@ -64,7 +64,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene, bool estimate) 
   if (!coupled) {
     std::cout << "  coupled: the interface controllers take out what the exchange creates "
                  "(docs/regions.md); not estimated — add --estimate for the spectral radius of "
-                 "the bare exchange, which hapticsimd still verifies before it switches\n";
+                 "the bare exchange (an analysis: hapticsimd no longer estimates it)\n";
     return kExitOk;
   }
   std::cout << "  coupled: spectral radius of the " << Duration(coupled->common_period_s)
@@ -72,7 +72,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene, bool estimate) 
             << " periods of power iteration, "
             << (coupled->orbit_norm ? "orbit norm"
                                     : "Euclidean norm: the orbit energy is indefinite")
-            << "): " << (coupled->stable ? "stable" : "UNSTABLE — the daemon refuses it")
+            << "): " << (coupled->stable ? "stable" : "UNSTABLE")
             << " (bare exchange)\n"
             << "  as run, with the interface controllers: "
             << Quantity(controlled->spectral_radius, "")
@@ -189,8 +189,8 @@ Command AddStabilityCommand(CLI::App& parent) {
   AddSceneOptions(app, options.get());
   app->add_flag("--estimate", *estimate,
                 "With adaptivity set: estimate the coupled spectral radius per common period by "
-                "power iteration, of the bare exchange (what hapticsimd verifies before it "
-                "switches) and as run with the interface controllers; seconds to minutes");
+                "power iteration, of the bare exchange and as run with the interface controllers "
+                "(an analysis: hapticsimd no longer estimates it); seconds to minutes");
   app->add_flag(
       "--all-configurations", *all_configurations,
       "The bare exchange's coupled spectral radius (as --estimate) for every adaptive "

@@ -50,7 +50,7 @@ struct SupervisorCheck {
   int choices = 0;         // decisions made (without a map, from a lying map, pinned)
   int chose_unstable = 0;  // a chosen configuration that, run as the daemon runs it, broke the
                            // energy balance without the runaway watch ending it
-  int stable_pinned_refused = 0;  // a pinned configuration refused though its regions build
+  int stable_pinned_refused = 0;  // the scene's own configuration refused (pinned or no map)
   int runaways = 0;               // chosen runs the runaway watch ended (the daemon demotes them)
   std::string problem;
   double seconds = 0;  // wall time of the checks
@@ -136,24 +136,36 @@ SupervisorCheck CheckSupervisor(const StressOutcome& outcome) {
     if (found != runs.end()) return found->second;
     GuardedRun& ran = runs[key] =
         RunAsTheDaemonRunsIt(SceneWith(scene, c), outcome.stress_case.state_seed);
-    if (ran.runaway) ++check.runaways;
+    if (ran.runaway) {
+      // The daemon then runs the secondaries at the primary rate there: that must hold.
+      ++check.runaways;
+      RegionConfiguration equal = c;
+      equal.secondary_rate_hz = PrimaryRateHz(scene);
+      const GuardedRun then =
+          RunAsTheDaemonRunsIt(SceneWith(scene, equal), outcome.stress_case.state_seed);
+      if (then.runaway) ran.problem = "ran away, and again at equal rates";
+      if (!then.problem.empty()) ran.problem = "ran away; at equal rates it " + then.problem;
+    }
     return ran;
   };
   auto verify = [&](const char* how, const ErrorMap* map,
                     const std::optional<RegionConfiguration>& pinned) {
     ++check.choices;
+    std::optional<SupervisorDecision> decision;
     try {
-      const SupervisorDecision decision = ChooseConfiguration(scene, map, 5.0, pinned);
-      if (const GuardedRun& ran = run(decision.configuration); !ran.problem.empty()) {
-        ++check.chose_unstable;
-        check.problem = std::string(how) + " chose " + decision.reason + ", which " + ran.problem;
-      }
+      decision = ChooseConfiguration(scene, map, 5.0, pinned);
     } catch (const Error& e) {
-      // Regions that cannot be built are the only refusal; the scene's own always build.
-      if (pinned) {
+      // Regions that cannot be built are the only refusal, and the scene's own always build (a
+      // lying map's four may all fail to on a small mesh: that refusal is right).
+      if (map == nullptr) {
         ++check.stable_pinned_refused;
         check.problem = std::string(how) + " refused: " + e.what();
       }
+      return;
+    }
+    if (const GuardedRun& ran = run(decision->configuration); !ran.problem.empty()) {
+      ++check.chose_unstable;
+      check.problem = std::string(how) + " chose " + decision->reason + ", which " + ran.problem;
     }
   };
   const RegionConfiguration own{scene.adaptivity.primary_size, scene.adaptivity.secondary_lod,
