@@ -18,7 +18,6 @@
 
 namespace hapticsim {
 
-/** The spectral radius of the map that advances the coupled state by one common period. */
 /** What the runaway watch measured when it fired (AsyncRegions::Runaway): the state's energy and
  *  what the energy balance allowed (at least the port floor), J. */
 struct RunawayEnergies {
@@ -26,6 +25,7 @@ struct RunawayEnergies {
   double allowed_j = 0;
 };
 
+/** The spectral radius of the map that advances the coupled state by one common period. */
 struct CoupledStability {
   double spectral_radius = 0;  ///< per common period; < 1 decays, > 1 grows
   double common_period_s = 0;  ///< the shortest time after which every region's schedule repeats
@@ -309,6 +309,15 @@ class AsyncRegions {
    */
   bool Runaway(const PublishedBalanceView& view) const noexcept {
     return view.state_energy_j > kRunawayFactor * std::max(view.allowed_j, port_floor_j_);
+  }
+  /**
+   * The watch as the trials and the daemon run it, once per primary period: true once Runaway
+   * has held for kRunawayPeriods periods in a row where it applies (watches_runaway).
+   * `periods_in_a_row` is the caller's count, kept between calls (0 for new regions).
+   */
+  bool RunawayHeld(const PublishedBalanceView& view, int* periods_in_a_row) const noexcept {
+    *periods_in_a_row = watches_runaway() && Runaway(view) ? *periods_in_a_row + 1 : 0;
+    return *periods_in_a_row >= kRunawayPeriods;
   }
   /**
    * Above what a stable region's state can hold against its discrete energy: for a mode of

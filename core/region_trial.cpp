@@ -83,8 +83,7 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
     }
     // What the daemon watches for, with the same numbers: a trial it would have taken off these
     // regions is not a sample of them.
-    runaway_periods = watches_runaway() && Runaway(balance) ? runaway_periods + 1 : 0;
-    if (runaway_periods >= kRunawayPeriods) {
+    if (RunawayHeld(balance, &runaway_periods)) {
       result.outcome = TrialOutcome::kDivergedEnergy;
       result.runaway = true;
       break;

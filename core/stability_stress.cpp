@@ -135,6 +135,19 @@ long DetectionBoundPeriods(double spectral_radius, double common_period_s, doubl
   return bound > 1e12 ? static_cast<long>(1e12) : static_cast<long>(std::ceil(bound));
 }
 
+TrialResult RunAsTheDaemonRuns(AsyncRegions& regions, const InputSettings& input, unsigned seed,
+                               StressOutcome* out) {
+  regions.SetRandomState(seed);
+  const double start_energy = regions.Energies().stored_j;
+  TrialResult trial = regions.RunTrialFromRandomState(input, seed);
+  const EnergyAccount e = regions.Energies();
+  out->controlled_run = true;
+  out->energy_gain_j = EnergyAboveBound(e, start_energy);
+  out->energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
+  out->backlog_bound_j = e.backlog_bound_j;
+  return trial;
+}
+
 StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& ranges) {
   const auto start = std::chrono::steady_clock::now();
   StressOutcome out;
@@ -180,14 +193,7 @@ StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& r
     // As the daemon runs it, interface controllers on: bounded too, and the object may hold no
     // more than the controllers guarantee (the tolerance is the one step the observer lags).
     bare.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
-    bare.SetRandomState(stress_case.state_seed);
-    const double start_energy = bare.Energies().stored_j;
-    const TrialResult as_run = bare.RunTrialFromRandomState(input, stress_case.state_seed);
-    out.controlled_outcome = as_run.outcome;
-    const EnergyAccount e = bare.Energies();
-    out.energy_gain_j = EnergyAboveBound(e, start_energy);
-    out.energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
-    out.backlog_bound_j = e.backlog_bound_j;
+    out.controlled_outcome = RunAsTheDaemonRuns(bare, input, stress_case.state_seed, &out).outcome;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -136,6 +136,13 @@ struct StressOutcome {
  */
 long DetectionBoundPeriods(double spectral_radius, double common_period_s, double primary_dt_s);
 
+/**
+ * Runs `regions` (controllers as set) from the random state `seed` under `input`, and records in
+ * `out` what StressOutcome::energy_balance_violated checks of a run as the daemon runs it
+ * (controlled_run, the energy above the controllers' bound, its scale, the port limits' bound).
+ */
+TrialResult RunAsTheDaemonRuns(AsyncRegions& regions, const InputSettings& input, unsigned seed,
+                               StressOutcome* out);
 /** Predicts and runs one case. */
 StressOutcome RunStressCase(const StressCase& stress_case, const StressRanges& ranges);
 

@@ -307,11 +307,8 @@ void HapticLoop::WatchEnergyBalance() noexcept {
   }
   // Once per set of regions: the supervisor takes them off this configuration (release: the
   // regions it reads with the count are the ones that ran away).
-  const bool above = !runaway_seen_ && regions_->watches_runaway() && regions_->Runaway(balance);
-  runaway_periods_ = above ? runaway_periods_ + 1 : 0;
-  if (runaway_periods_ >= AsyncRegions::kRunawayPeriods) {
+  if (!runaway_seen_ && regions_->RunawayHeld(balance, &runaway_periods_)) {
     runaway_seen_ = true;
-    runaway_periods_ = 0;
     runaway_state_j_.store(balance.state_energy_j, std::memory_order_relaxed);
     runaway_allowed_j_.store(std::max(balance.allowed_j, regions_->port_floor_j()),
                              std::memory_order_relaxed);

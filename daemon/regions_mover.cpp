@@ -152,8 +152,7 @@ void RegionsMover::Applied(const Outcome& outcome) {
 void RegionsMover::NotApplied(const Outcome& outcome) {
   using Kind = Outcome::Kind;
   if (outcome.kind == Kind::kDemote || outcome.kind == Kind::kMoveBack) {
-    asked_ =
-        outcome.request;  // the regions still run what ran away or was refused: again next Poll
+    asked_ = outcome.request;  // the regions still run it: asked again at the next Poll
     ready_ = outcome;
     behind_ = false;
   } else if (outcome.kind == Kind::kMoveUnverified) {

@@ -166,7 +166,7 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     }
   }
   if (candidates.empty() && capped) {
-    throw Error("no configuration in the error map ran and is cheaper than " +
+    throw Error("no usable configuration in the error map is cheaper than " +
                 std::to_string(below_cost_us_per_ms) + " µs per simulated ms");
   }
   if (candidates.empty()) {  // no map, or nothing usable in it: the scene's own configuration

@@ -71,20 +71,13 @@ GuardedRun RunAsTheDaemonRunsIt(const Scene& scene, unsigned state_seed) {
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
   InputSettings input = scene.input;
   input.periods = 2.0 * input.frequency_hz;
-  regions.SetRandomState(state_seed);
-  const double start_energy = regions.Energies().stored_j;
-  const TrialResult trial = regions.RunTrialFromRandomState(input, state_seed);
+  StressOutcome as_run;  // its energy_balance_violated() is the case's own check
+  as_run.passive_expected = scene.adaptivity.displacement_coupling;
+  const TrialResult trial = RunAsTheDaemonRuns(regions, input, state_seed, &as_run);
   if (trial.runaway) {
     out.runaway = true;
     return out;
   }
-  StressOutcome as_run;  // its energy_balance_violated() is the case's own check
-  as_run.controlled_run = true;
-  as_run.passive_expected = scene.adaptivity.displacement_coupling;
-  const EnergyAccount e = regions.Energies();
-  as_run.energy_gain_j = EnergyAboveBound(e, start_energy);
-  as_run.energy_scale_j = std::max({start_energy, e.input_work_j, e.stored_j});
-  as_run.backlog_bound_j = e.backlog_bound_j;
   if (trial.diverged()) {
     out.problem = "diverged without the runaway watch ending it";
   } else if (as_run.energy_balance_violated()) {
