@@ -199,7 +199,6 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
       },
       15))
       << daemon_->Log();
-  EXPECT_NE(daemon_->Log().find("reconfigured: primary_size 3"), std::string::npos);
   for (std::int64_t seq = 1; seq <= 100; ++seq) {  // from above the surface into the object
     client.Send(seq, kEdge / 2, kEdge / 2, seq <= 20 ? -0.002 : 0.001);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -249,8 +248,6 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   // It relaxes from the press's overshoot towards the static 0.7–0.75 N; a force dropped and
   // ramped in again (a switch from rest) would pass near zero.
   EXPECT_LT(weakest, -0.5) << "the force was dropped across the switch\n" << daemon_->Log();
-  EXPECT_NE(daemon_->Log().find("reconfigured: primary_size 1"), std::string::npos)
-      << daemon_->Log();
 }
 
 // Contact anywhere: a touch on another surface node moves the regions there at once (their
@@ -280,7 +277,6 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
   EXPECT_NE(daemon_->Log().find("around contact node (2, 3, 0) checked"), std::string::npos)
       << "the check behind the move\n"
       << daemon_->Log();
-  EXPECT_EQ(daemon_->Log().find("runaway watch"), std::string::npos) << daemon_->Log();
   int waited = 0, pushing_back = 0, near_late = 0;
   std::int64_t touch_down_us = -1, first_force_us = -1;  // seq 51 is the first input inside
   double previous = 0, largest_jump = 0;
@@ -443,7 +439,6 @@ TEST(HapticsimdContactNodes, WhereTheConfigurationMissesTheTargetTheSupervisorCh
                               "1, secondary_lod 3, secondary_rate 1000 Hz is"),
             std::string::npos)
       << daemon.Log();
-  EXPECT_NE(daemon.Log().find("reconfigured: primary_size"), std::string::npos);
   // While size 1 ran around (2, 6, 0) its forces said the target was exceeded; once the better
   // configuration took over in contact (no stability estimate to wait for), they no longer do.
   const std::vector<force_feedback_t> forces = client.Forces();
