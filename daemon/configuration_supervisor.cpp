@@ -6,9 +6,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "core/error_sweep.hpp"
 #include "daemon/command_check.hpp"
-#include "daemon/input_guard.hpp"
 
 namespace hapticsim {
 
