@@ -9,9 +9,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/cpu_dispatch.hpp"
+#include "core/fem/cpu_dispatch.hpp"
 #include "core/error.hpp"
-#include "core/error_sweep.hpp"
+#include "core/errormap/error_sweep.hpp"
 #include "daemon/error_map_loading.hpp"
 #include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"

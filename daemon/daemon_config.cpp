@@ -15,7 +15,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
-#include "core/scene_toml.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {

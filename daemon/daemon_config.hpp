@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 #include "daemon/port_guard.hpp"
 
 namespace hapticsim {

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <cstdint>
 
-#include "daemon/spsc_ring.hpp"
+#include "rt/spsc_ring.hpp"
 
 namespace hapticsim {
 

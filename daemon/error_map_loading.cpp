@@ -3,7 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/error.hpp"
-#include "core/error_map_file.hpp"
+#include "core/errormap/error_map_file.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {

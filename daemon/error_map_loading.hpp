@@ -3,8 +3,8 @@
 #include <memory>
 #include <string>
 
-#include "core/error_map.hpp"
-#include "core/scene.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "core/monotonic_clock.hpp"
-#include "daemon/futex.hpp"
+#include "rt/monotonic_clock.hpp"
+#include "rt/futex.hpp"
 
 namespace hapticsim {
 namespace {

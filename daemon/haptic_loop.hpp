@@ -10,14 +10,14 @@
 #include <thread>
 #include <vector>
 
-#include "core/async_regions.hpp"
-#include "core/seqlock_slot.hpp"
-#include "core/stability_stress.hpp"
+#include "core/regions/async_regions.hpp"
+#include "rt/seqlock_slot.hpp"
+#include "core/regions/stability_stress.hpp"
 #include "daemon/contact_tracker.hpp"
 #include "daemon/deadline_monitor.hpp"
 #include "daemon/input_resampler.hpp"
 #include "daemon/port_guard.hpp"
-#include "daemon/spsc_ring.hpp"
+#include "rt/spsc_ring.hpp"
 
 namespace hapticsim {
 

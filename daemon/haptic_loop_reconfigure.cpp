@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "core/error.hpp"
-#include "core/monotonic_clock.hpp"
-#include "daemon/futex.hpp"
+#include "rt/monotonic_clock.hpp"
+#include "rt/futex.hpp"
 #include "daemon/haptic_loop.hpp"
 
 namespace hapticsim {

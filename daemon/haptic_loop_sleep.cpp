@@ -1,6 +1,6 @@
 // Sleeping at rest (see HapticLoop's class comment): out of contact, once every region is within
 // kRestTolerance_m of rest, the secondary threads park and the regions stop stepping until a touch.
-#include "daemon/futex.hpp"
+#include "rt/futex.hpp"
 #include "daemon/haptic_loop.hpp"
 
 namespace hapticsim {

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 

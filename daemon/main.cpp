@@ -18,7 +18,7 @@
 #include <iostream>
 
 #include "core/error.hpp"
-#include "core/error_sweep.hpp"
+#include "core/errormap/error_sweep.hpp"
 #include "daemon/background_worker.hpp"
 #include "daemon/daemon.hpp"
 

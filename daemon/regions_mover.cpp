@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "core/error.hpp"
-#include "core/region_partition.hpp"
+#include "core/regions/region_partition.hpp"
 
 namespace hapticsim {
 std::string RegionsMover::Outcome::Describe() const {

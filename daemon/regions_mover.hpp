@@ -9,7 +9,7 @@
 #include <tuple>
 #include <utility>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "daemon/background_worker.hpp"
 #include "daemon/supervisor.hpp"
 

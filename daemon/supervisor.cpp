@@ -5,9 +5,9 @@
 #include <map>
 #include <sstream>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/error_lookup.hpp"
+#include "core/errormap/error_lookup.hpp"
 
 namespace hapticsim {
 namespace {

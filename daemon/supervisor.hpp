@@ -4,8 +4,8 @@
 #include <optional>
 #include <string>
 
-#include "core/error_map.hpp"
-#include "core/scene.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 

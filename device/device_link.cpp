@@ -6,7 +6,7 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "core/monotonic_clock.hpp"
+#include "rt/monotonic_clock.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "ipc/lcm_start.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/monotonic_clock.hpp"
+#include "rt/monotonic_clock.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 
 namespace hapticsim::device {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "core/error_lookup.hpp"
-#include "core/error_map_file.hpp"
+#include "core/errormap/error_lookup.hpp"
+#include "core/errormap/error_map_file.hpp"
 
 namespace {
 

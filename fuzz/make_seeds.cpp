@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error_map.hpp"
-#include "core/error_map_file.hpp"
-#include "core/scene_toml.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "daemon/daemon_config.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"

@@ -24,7 +24,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "core/seqlock_slot.hpp"
+#include "rt/seqlock_slot.hpp"
 
 namespace hapticsim::shm {
 

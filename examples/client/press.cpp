@@ -12,7 +12,7 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 #include "ipc/shm_device_client.hpp"
 
 namespace {

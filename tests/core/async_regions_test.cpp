@@ -1,12 +1,12 @@
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <utility>
 
-#include "core/cube_scene.hpp"
-#include "core/force_error.hpp"
+#include "core/scene/cube_scene.hpp"
+#include "core/trial/force_error.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
 namespace hapticsim {

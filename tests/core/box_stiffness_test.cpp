@@ -1,15 +1,15 @@
 // K·u by node stencils on the bounding box against the element-by-element product it replaces:
 // the same numbers on the same DOFs, for every primary region, every secondary region of fine
 // elements (a box with a hole) and arbitrary sets of fine elements.
-#include "core/box_stiffness.hpp"
+#include "core/regions/box_stiffness.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "core/error.hpp"
-#include "core/region_partition.hpp"
-#include "core/scene.hpp"
+#include "core/regions/region_partition.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 namespace {

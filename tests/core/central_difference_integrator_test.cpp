@@ -1,12 +1,12 @@
-#include "core/central_difference_integrator.hpp"
+#include "core/fem/central_difference_integrator.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/contact_trajectory.hpp"
-#include "core/cube_scene.hpp"
-#include "core/reference_trial.hpp"
-#include "core/stability_estimate.hpp"
-#include "core/static_solver.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/scene/cube_scene.hpp"
+#include "core/trial/reference_trial.hpp"
+#include "core/fem/stability_estimate.hpp"
+#include "core/fem/static_solver.hpp"
 #include "tests/support/random_field.hpp"
 
 namespace hapticsim {

@@ -5,10 +5,10 @@
 
 #include <cmath>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/force_error.hpp"
-#include "core/reference_trial.hpp"
+#include "core/trial/force_error.hpp"
+#include "core/trial/reference_trial.hpp"
 
 namespace hapticsim {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/error_lookup.hpp"
+#include "core/errormap/error_lookup.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "core/error_map_file.hpp"
+#include "core/errormap/error_map_file.hpp"
 
 #include <gtest/gtest.h>
 

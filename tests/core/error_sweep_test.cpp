@@ -1,4 +1,4 @@
-#include "core/error_sweep.hpp"
+#include "core/errormap/error_sweep.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/error_lookup.hpp"
-#include "core/error_map_file.hpp"
+#include "core/errormap/error_lookup.hpp"
+#include "core/errormap/error_map_file.hpp"
 
 namespace hapticsim {
 namespace {

@@ -9,8 +9,8 @@
 #include <cstring>
 #include <string>
 
-#include "core/error_map.hpp"
-#include "core/error_map_file.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/errormap/error_map_file.hpp"
 
 namespace hapticsim {
 namespace {

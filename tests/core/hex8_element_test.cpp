@@ -1,4 +1,4 @@
-#include "core/hex8_element.hpp"
+#include "core/fem/hex8_element.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-#include "core/hybrid_mesh.hpp"
+#include "core/regions/hybrid_mesh.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/element_set_stiffness.hpp"
+#include "core/regions/element_set_stiffness.hpp"
 #include "core/error.hpp"
-#include "core/stencil_stiffness.hpp"
+#include "core/fem/stencil_stiffness.hpp"
 #include "tests/support/random_field.hpp"
 
 namespace hapticsim {

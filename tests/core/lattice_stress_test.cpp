@@ -1,6 +1,6 @@
 // The von Mises stress `hapticsim simulate --vtk` writes per cell (VonMisesPerCell), against
 // closed forms of linear elasticity: uniaxial strain, simple shear and a rigid rotation.
-#include "core/lattice_stress.hpp"
+#include "core/fem/lattice_stress.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Table I's partial correlations against a case with a known answer: the error is a linear
 // function of two parameters plus independent noise, the parameters drawn independently.
-#include "core/map_statistics.hpp"
+#include "core/errormap/map_statistics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The Pareto front of a cost/error trade-off, against the definition checked pair by pair.
-#include "core/pareto_front.hpp"
+#include "core/errormap/pareto_front.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,10 +9,10 @@
 #include <string>
 #include <utility>
 
-#include "core/async_regions.hpp"
-#include "core/contact_trajectory.hpp"
-#include "core/force_error.hpp"
-#include "core/stability_stress.hpp"
+#include "core/regions/async_regions.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/trial/force_error.hpp"
+#include "core/regions/stability_stress.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
 namespace hapticsim {

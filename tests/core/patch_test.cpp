@@ -3,8 +3,8 @@
 // affine values prescribed on the boundary returns the affine values inside.
 #include <gtest/gtest.h>
 
-#include "core/elastic_model.hpp"
-#include "core/static_solver.hpp"
+#include "core/fem/elastic_model.hpp"
+#include "core/fem/static_solver.hpp"
 #include "tests/support/random_field.hpp"
 
 namespace hapticsim {

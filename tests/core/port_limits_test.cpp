@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "core/region_integrator.hpp"
-#include "core/region_partition.hpp"
+#include "core/regions/region_integrator.hpp"
+#include "core/regions/region_partition.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
 namespace hapticsim {

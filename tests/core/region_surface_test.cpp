@@ -9,8 +9,8 @@
 #include <cmath>
 #include <vector>
 
-#include "core/async_regions.hpp"
-#include "core/contact_trajectory.hpp"
+#include "core/regions/async_regions.hpp"
+#include "core/scene/contact_trajectory.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
 namespace hapticsim {

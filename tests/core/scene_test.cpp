@@ -1,4 +1,4 @@
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
-#include "core/scene_toml.hpp"
+#include "core/scene/scene_toml.hpp"
 
 namespace hapticsim {
 namespace {

@@ -1,11 +1,11 @@
-#include "core/stability_estimate.hpp"
+#include "core/fem/stability_estimate.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 
-#include "core/assembled_stiffness.hpp"
-#include "core/cube_scene.hpp"
+#include "core/fem/assembled_stiffness.hpp"
+#include "core/scene/cube_scene.hpp"
 
 namespace hapticsim {
 namespace {

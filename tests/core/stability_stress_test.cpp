@@ -1,13 +1,13 @@
 // The stability stress test's own parts: deterministic draws, steps placed around a region's limit,
 // and the detection bound. The 1,000-case run itself is the Stress.* CTest (label stress).
-#include "core/stability_stress.hpp"
+#include "core/regions/stability_stress.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 
 namespace hapticsim {
 namespace {

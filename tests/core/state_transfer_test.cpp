@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
 #include "tests/support/adaptive_scene.hpp"
 

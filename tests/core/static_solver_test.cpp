@@ -1,8 +1,8 @@
-#include "core/static_solver.hpp"
+#include "core/fem/static_solver.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/cube_scene.hpp"
+#include "core/scene/cube_scene.hpp"
 
 namespace hapticsim {
 namespace {

@@ -1,8 +1,8 @@
-#include "core/stencil_stiffness.hpp"
+#include "core/fem/stencil_stiffness.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/assembled_stiffness.hpp"
+#include "core/fem/assembled_stiffness.hpp"
 #include "tests/support/random_field.hpp"
 
 namespace hapticsim {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <tuple>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
 #include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"

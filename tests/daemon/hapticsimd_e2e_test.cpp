@@ -28,10 +28,10 @@
 #include <set>
 #include <thread>
 
-#include "core/error_map.hpp"
-#include "core/error_map_file.hpp"
-#include "core/map_axes.hpp"
-#include "core/scene.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/errormap/map_axes.hpp"
+#include "core/scene/scene.hpp"
 #include "hapticsim/command_t.hpp"
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
@@ -806,7 +806,7 @@ TEST(HapticsimdSharedMemory, ADriverThatDiesMidWriteExpiresTheInputAndARestarted
   EXPECT_LT(pressed.force_n[2], -0.5);
 
   // It dies between the two sequence stores of its next write, before publishing it. (The slot's
-  // sequence is its first word, core/seqlock_slot.hpp: this store leaves it exactly as such a
+  // sequence is its first word, rt/seqlock_slot.hpp: this store leaves it exactly as such a
   // death does.)
   shm::ShmSegment& view = first->segment();
   const std::int64_t next = view.newest_input.load() + 1;

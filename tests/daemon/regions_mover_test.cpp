@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 namespace {

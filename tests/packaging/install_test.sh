@@ -17,8 +17,10 @@ echo "== cmake --install --prefix $prefix"
 cmake --install "$build" --prefix "$prefix" > "$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 for f in bin/hapticsimd bin/hapticsim bin/hapticsim-shm-client \
          lib/libhapticsim_client.so include/hapticsim_client.h \
-         lib/libhapticsim_core.a lib/libhapticsim_ipc.a \
-         include/hapticsim/ipc/shm_device_client.hpp include/hapticsim/core/scene.hpp \
+         lib/libhapticsim_fem.a lib/libhapticsim_scene.a lib/libhapticsim_trial.a \
+         lib/libhapticsim_regions.a lib/libhapticsim_errormap.a lib/libhapticsim_ipc.a \
+         include/hapticsim/ipc/shm_device_client.hpp include/hapticsim/core/scene/scene.hpp \
+         include/hapticsim/rt/seqlock_slot.hpp include/hapticsim/core/error.hpp \
          include/hapticsim/force_feedback_t.hpp \
          lib/cmake/hapticsim/hapticsimConfig.cmake lib/cmake/hapticsim/hapticsimConfigVersion.cmake \
          lib/pkgconfig/hapticsim-client.pc lib/cmake/hapticsim/hapticsimCoreTargets.cmake \
@@ -40,7 +42,8 @@ assert hapticsim.force_feedback_t.decode(f.encode()).seq == 7" || fail "the inst
 if [ -e "$build/lcmtypes/hapticsim-lcmtypes.jar" ]; then  # built when a JDK was found
   [ -e "$prefix/share/java/hapticsim-lcmtypes.jar" ] || fail "the lcm-spy jar is not installed"
 fi
-for f in include/hapticsim/ipc/control_client.hpp include/hapticsim/core/error_sweep.hpp; do
+for f in include/hapticsim/ipc/control_client.hpp include/hapticsim/core/errormap/error_sweep.hpp \
+         include/hapticsim/core/scene/scene_toml.hpp; do
   [ ! -e "$prefix/$f" ] || fail "$f is installed, but its library is not"
 done
 # An install never overwrites the administrator's config: the defaults go beside it.

@@ -5,9 +5,9 @@
 #include <memory>
 #include <vector>
 
-#include "core/central_difference_integrator.hpp"
-#include "core/contact_trajectory.hpp"
-#include "core/cube_scene.hpp"
+#include "core/fem/central_difference_integrator.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/scene/cube_scene.hpp"
 #include "tests/support/allocation_counter.hpp"
 
 namespace hapticsim {
@@ -38,7 +38,7 @@ TEST(TimeStep, NeverAllocates) {
 }  // namespace
 }  // namespace hapticsim
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 
 namespace hapticsim {
 namespace {
@@ -93,8 +93,8 @@ TEST(RegionSteps, NeverAllocateWhileThePortLimitsAct) {
 }  // namespace
 }  // namespace hapticsim
 
-#include "core/error_lookup.hpp"
-#include "core/sweep_grid.hpp"
+#include "core/errormap/error_lookup.hpp"
+#include "core/errormap/sweep_grid.hpp"
 
 namespace hapticsim {
 namespace {

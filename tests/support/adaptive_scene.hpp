@@ -1,6 +1,6 @@
 #pragma once
 
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim::testing {
 

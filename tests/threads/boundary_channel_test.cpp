@@ -1,4 +1,4 @@
-#include "core/boundary_channel.hpp"
+#include "core/regions/boundary_channel.hpp"
 
 #include <gtest/gtest.h>
 

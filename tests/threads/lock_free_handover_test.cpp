@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <thread>
 
-#include "core/seqlock_slot.hpp"
-#include "daemon/spsc_ring.hpp"
+#include "rt/seqlock_slot.hpp"
+#include "rt/spsc_ring.hpp"
 
 namespace hapticsim {
 namespace {
@@ -52,7 +52,7 @@ TEST(SeqlockSlot, ReadersNeverSeeATornValue) {
 TEST(SeqlockSlot, AWriterThatDiedMidWriteLeavesNothingReadableAndTheNextWriterIsRead) {
   SeqlockSlot<Checked> slot;
   slot.Write({1, 2, 3});
-  // The sequence is the slot's first member (core/seqlock_slot.hpp): a death mid-write leaves it
+  // The sequence is the slot's first member (rt/seqlock_slot.hpp): a death mid-write leaves it
   // odd, exactly as this store does.
   auto& sequence = *reinterpret_cast<std::atomic<std::uint64_t>*>(&slot);
   ASSERT_EQ(sequence.load() % 2, 0u);

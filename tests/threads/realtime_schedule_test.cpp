@@ -1,8 +1,8 @@
-#include "core/realtime_schedule.hpp"
+#include "core/regions/realtime_schedule.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/force_error.hpp"
+#include "core/trial/force_error.hpp"
 
 namespace hapticsim {
 namespace {

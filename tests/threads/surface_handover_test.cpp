@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/seqlock_array.hpp"
+#include "rt/seqlock_array.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/supervisor.hpp"
 #include "ipc/shm_segment.hpp"

@@ -12,7 +12,7 @@ Checks, as the issue asks:
     the dent alone still changes the picture there; the surface mesh drawn under the tool is at
     the tool's depth (the touched node is held there);
   - the primary region drawn is the one the daemon's hybrid mesh makes: the coarse cells that
-    overlap the contact node ± primary_size (core/hybrid_mesh.cpp, CellOverlaps, written again
+    overlap the contact node ± primary_size (core/regions/hybrid_mesh.cpp, CellOverlaps, written again
     here), holding as many independent nodes as the daemon's status reports for its primary;
   - the server answers only itself: other paths 404, another Host or Origin 403;
   - Ctrl-C stops it cleanly, every message decoded.

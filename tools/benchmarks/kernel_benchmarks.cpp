@@ -9,14 +9,14 @@
 // since it stores the zero couplings the stencil drops).
 #include <benchmark/benchmark.h>
 
-#include "core/assembled_stiffness.hpp"
-#include "core/box_stiffness.hpp"
-#include "core/central_difference_integrator.hpp"
-#include "core/cube_scene.hpp"
-#include "core/element_set_stiffness.hpp"
-#include "core/hybrid_mesh.hpp"
-#include "core/region_partition.hpp"
-#include "core/stencil_stiffness.hpp"
+#include "core/fem/assembled_stiffness.hpp"
+#include "core/regions/box_stiffness.hpp"
+#include "core/fem/central_difference_integrator.hpp"
+#include "core/scene/cube_scene.hpp"
+#include "core/regions/element_set_stiffness.hpp"
+#include "core/regions/hybrid_mesh.hpp"
+#include "core/regions/region_partition.hpp"
+#include "core/fem/stencil_stiffness.hpp"
 
 namespace hapticsim {
 namespace {

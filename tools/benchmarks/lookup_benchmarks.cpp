@@ -5,9 +5,9 @@
 
 #include <filesystem>
 
-#include "core/error_lookup.hpp"
-#include "core/error_map_file.hpp"
-#include "core/sweep_grid.hpp"
+#include "core/errormap/error_lookup.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/errormap/sweep_grid.hpp"
 
 namespace hapticsim {
 namespace {

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
-#include "core/error_map_file.hpp"
-#include "core/map_statistics.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/errormap/map_statistics.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 

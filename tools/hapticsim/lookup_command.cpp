@@ -2,9 +2,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
-#include "core/error_lookup.hpp"
-#include "core/error_map_file.hpp"
-#include "core/scene_toml.hpp"
+#include "core/errormap/error_lookup.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "core/error_sweep.hpp"
+#include "core/errormap/error_sweep.hpp"
 #include "tools/hapticsim/command.hpp"
 
 int main(int argc, char** argv) {

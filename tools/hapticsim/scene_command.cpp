@@ -1,7 +1,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/scene_toml.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/scene_options.hpp"
 

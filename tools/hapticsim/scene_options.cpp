@@ -1,6 +1,6 @@
 #include "tools/hapticsim/scene_options.hpp"
 
-#include "core/scene_toml.hpp"
+#include "core/scene/scene_toml.hpp"
 
 namespace hapticsim::cli {
 

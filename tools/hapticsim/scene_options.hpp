@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim::cli {
 

@@ -6,11 +6,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/force_error.hpp"
-#include "core/realtime_schedule.hpp"
-#include "core/reference_trial.hpp"
+#include "core/trial/force_error.hpp"
+#include "core/regions/realtime_schedule.hpp"
+#include "core/trial/reference_trial.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/scene_options.hpp"

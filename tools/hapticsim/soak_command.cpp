@@ -20,7 +20,7 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "core/stability_stress.hpp"
+#include "core/regions/stability_stress.hpp"
 #include "daemon/sandbox_check.hpp"
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"

@@ -3,10 +3,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "core/async_regions.hpp"
-#include "core/cube_scene.hpp"
+#include "core/regions/async_regions.hpp"
+#include "core/scene/cube_scene.hpp"
 #include "core/error.hpp"
-#include "core/stability_estimate.hpp"
+#include "core/fem/stability_estimate.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/scene_options.hpp"

@@ -1,8 +1,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/cube_scene.hpp"
-#include "core/static_solver.hpp"
+#include "core/scene/cube_scene.hpp"
+#include "core/fem/static_solver.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/scene_options.hpp"

@@ -1,5 +1,5 @@
 // hapticsim stress: the numerical-stability stress test. Random scenes and configurations are
-// predicted and then run (core/stability_stress.hpp); the supervisor is asked to choose for each
+// predicted and then run (core/regions/stability_stress.hpp); the supervisor is asked to choose for each
 // scene, also from an error map that calls every configuration fine, and what it chose is run
 // as the daemon runs it.
 #include <algorithm>
@@ -18,11 +18,11 @@
 #include <thread>
 #include <tuple>
 
-#include "core/async_regions.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/error_map.hpp"
-#include "core/scene_toml.hpp"
-#include "core/stability_stress.hpp"
+#include "core/errormap/error_map.hpp"
+#include "core/scene/scene_toml.hpp"
+#include "core/regions/stability_stress.hpp"
 #include "daemon/supervisor.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/progress_line.hpp"

@@ -2,8 +2,8 @@
 
 #include <string>
 
-#include "core/reference_trial.hpp"
-#include "core/scene.hpp"
+#include "core/trial/reference_trial.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim::cli {
 

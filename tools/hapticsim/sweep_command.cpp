@@ -5,9 +5,9 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "core/error_map_file.hpp"
-#include "core/error_sweep.hpp"
-#include "core/sweep_grid_file.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/errormap/error_sweep.hpp"
+#include "core/errormap/sweep_grid_file.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/progress_line.hpp"

@@ -5,7 +5,7 @@
 #include <system_error>
 
 #include "core/error.hpp"
-#include "core/lattice_stress.hpp"
+#include "core/fem/lattice_stress.hpp"
 
 namespace hapticsim::cli {
 namespace fs = std::filesystem;

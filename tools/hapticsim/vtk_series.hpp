@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/hybrid_mesh.hpp"
-#include "core/object_state.hpp"
-#include "core/scene.hpp"
+#include "core/regions/hybrid_mesh.hpp"
+#include "core/fem/object_state.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim::cli {
 

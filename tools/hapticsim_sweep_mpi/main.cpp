@@ -13,9 +13,9 @@
 #include <iostream>
 
 #include "core/error.hpp"
-#include "core/error_map_file.hpp"
-#include "core/error_sweep.hpp"
-#include "core/sweep_grid_file.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/errormap/error_sweep.hpp"
+#include "core/errormap/sweep_grid_file.hpp"
 #include "tools/hapticsim/scene_options.hpp"
 
 namespace {

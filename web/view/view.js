@@ -135,8 +135,8 @@ function buildObject(m) {
 }
 
 // The primary region: the coarse cells (secondary_lod fine cells a side) that overlap the box of
-// the contact node ± primary_size, clipped to the object — core/region_partition.cpp makes the
-// box, core/hybrid_mesh.cpp's CellOverlaps takes the cells. Its extent in lattice indices.
+// the contact node ± primary_size, clipped to the object — core/regions/region_partition.cpp makes the
+// box, core/regions/hybrid_mesh.cpp's CellOverlaps takes the cells. Its extent in lattice indices.
 function primaryExtent(m, n) {
   const k = Math.max(1, m.secondary_lod), last = n - 1, r = m.primary_size;
   const lo = [], hi = [];

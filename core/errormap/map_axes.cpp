@@ -1,0 +1,72 @@
+#include "core/errormap/map_axes.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr std::array<MapAxisInfo, kNumMapAxes> kAxes{{
+    {"material.poisson_ratio", "poisson_ratio", "", "ν", false, true},
+    {"material.density", "density", "kg/m^3", "ρ", false, true},
+    {"material.damping", "damping", "1/s", "d", false, true},
+    {"material.youngs_modulus", "youngs_modulus", "Pa", "E", false, true},
+    {"input.amplitude", "amplitude", "m", "amplitude", false, false},
+    {"input.frequency", "frequency", "Hz", "frequency", false, false},
+    {"adaptivity.secondary_lod", "secondary_lod", "", "lod", true, false},
+    {"adaptivity.primary_size", "primary_size", "", "primary size", true, false},
+    {"adaptivity.secondary_rate", "secondary_rate", "Hz", "secondary rate", false, false},
+    // Whole lattice indices in a sweep; a lookup interpolates between mapped nodes.
+    {"input.contact_node.x", "contact_node_x", "node", "contact x", true, false, 0},
+    {"input.contact_node.y", "contact_node_y", "node", "contact y", true, false, 1},
+    {"input.contact_node.z", "contact_node_z", "node", "contact z", true, false, 2},
+}};
+
+}  // namespace
+
+const MapAxisInfo& AxisInfo(int axis) { return kAxes.at(static_cast<size_t>(axis)); }
+
+MapPoint PointOfScene(const Scene& scene) {
+  MapPoint point{};
+  const LatticeIndex node = ContactNode(scene);
+  for (int a = 0; a < kNumMapAxes; ++a) {
+    const MapAxisInfo& info = AxisInfo(a);
+    point[a] = info.node_component >= 0 ? node[info.node_component]
+                                        : std::stod(GetSceneValue(scene, info.scene_key));
+  }
+  return point;
+}
+
+Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
+  Scene scene = base;
+  // "ix,iy,iz" (the node axes come in component order), set through the scene key so that it is
+  // checked as any other value.
+  std::string node;
+  for (int a = 0; a < kNumMapAxes; ++a) {
+    const MapAxisInfo& info = AxisInfo(a);
+    if (info.integer) {
+      HAPTICSIM_THROW_UNLESS(
+          point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
+          std::string(info.scene_key) + " = " + FormatReal(point[a]) + " is not a whole number");
+      if (info.node_component >= 0) {
+        node += (node.empty() ? "" : ",") + std::to_string(static_cast<long>(point[a]));
+        continue;
+      }
+      SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));
+    } else {
+      SetSceneValue(&scene, info.scene_key, FormatReal(point[a]));
+    }
+  }
+  SetSceneValue(&scene, "input.contact_node", node);
+  return scene;
+}
+
+int FindAxis(std::string_view name) {
+  for (int a = 0; a < kNumMapAxes; ++a) {
+    if (kAxes[a].name == name || kAxes[a].scene_key == name) return a;
+  }
+  return -1;
+}
+
+}  // namespace hapticsim

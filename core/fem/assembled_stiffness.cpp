@@ -1,0 +1,38 @@
+#include "core/fem/assembled_stiffness.hpp"
+
+#include <vector>
+
+#include "core/fem/hex8_element.hpp"
+
+namespace hapticsim {
+
+AssembledStiffness::AssembledStiffness(const HexGrid& grid, const Material& material)
+    : StiffnessOperator(grid.num_dofs()), matrix_(grid.num_dofs(), grid.num_dofs()) {
+  const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(grid.spacing(), material);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(grid.num_elements()) * 24 * 24);
+  for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
+    for (int ey = 0; ey + 1 < grid.ny(); ++ey) {
+      for (int ex = 0; ex + 1 < grid.nx(); ++ex) {
+        const auto nodes = grid.ElementNodes(ex, ey, ez);
+        for (int i = 0; i < 24; ++i) {
+          const int row = grid.Dof(nodes[i / 3], i % 3);
+          for (int j = 0; j < 24; ++j) {
+            triplets.emplace_back(row, grid.Dof(nodes[j / 3], j % 3), ke(i, j));
+          }
+        }
+      }
+    }
+  }
+  matrix_.setFromTriplets(triplets.begin(), triplets.end());
+  matrix_.makeCompressed();
+}
+
+void AssembledStiffness::Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
+                               Eigen::Ref<Eigen::VectorXd> ku) const {
+  ku.noalias() = matrix_ * u;
+}
+
+Eigen::VectorXd AssembledStiffness::Diagonal() const { return matrix_.diagonal(); }
+
+}  // namespace hapticsim

@@ -1,0 +1,132 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstring>
+#include <vector>
+
+#include "core/fem/cpu_dispatch.hpp"
+#include "core/fem/hex8_element.hpp"
+
+namespace hapticsim {
+
+/**
+ * One coupling of a stencil: ku_a[i] += coefficient · u[i + offset], where offset already includes
+ * the component block of the source (b·N) and the neighbour's node stride.
+ */
+struct StencilTerm {
+  std::ptrdiff_t offset;
+  double coefficient;
+};
+
+/** A node's stencil on a structured grid, split by output component a. */
+using NodeStencil = std::array<std::vector<StencilTerm>, 3>;
+
+/**
+ * The stencil of a node from the cells around it that are present: bit c of `cell_mask` stands
+ * for the cell on the node's low side along every axis j whose bit j of c is set (high side
+ * where clear). The sum of those cells' element-matrix blocks, couplings below 10⁻¹³ of the
+ * largest entry dropped; on a grid of n nodes with node strides sy (y) and sz (z),
+ * component-blocked.
+ */
+NodeStencil MakeNodeStencil(const Hex8Element::Matrix24& ke, unsigned cell_mask, std::ptrdiff_t n,
+                            std::ptrdiff_t sy, std::ptrdiff_t sz);
+
+namespace stencil_detail {
+
+// Four doubles in one SIMD register (GCC/Clang vector extension: one AVX register in a kernel
+// compiled for AVX2 or AVX-512, two SSE halves in the baseline's). Loads go through memcpy because
+// neighbour rows are not aligned. A Vec4 is never passed or returned by value: without AVX that
+// is an ABI change GCC warns of and clang refuses.
+using Vec4 = double __attribute__((vector_size(32)));
+
+// sum += c · p[0 … 4)
+HAPTICSIM_KERNEL_INLINE void AddScaled4(Vec4& sum, double c, const double* p) {
+  Vec4 v;
+  std::memcpy(&v, p, sizeof v);
+  sum += c * v;
+}
+
+// ku_a[i … i+W) for one output component over all its couplings. W/4 vectors, each summed in
+// two interleaved partial accumulators (even and odd terms): an FMA takes several cycles, so
+// one dependency chain per vector would leave the FMA units idle.
+template <int W>
+HAPTICSIM_KERNEL_INLINE void AccumulateChunk(const std::vector<StencilTerm>& terms, const double* u,
+                                             double* out) {
+  constexpr int kVectors = W / 4;
+  Vec4 even[kVectors] = {}, odd[kVectors] = {};
+  const size_t count = terms.size();
+  size_t t = 0;
+  for (; t + 1 < count; t += 2) {
+    const double* src_even = u + terms[t].offset;
+    const double* src_odd = u + terms[t + 1].offset;
+    const double c_even = terms[t].coefficient, c_odd = terms[t + 1].coefficient;
+    for (int v = 0; v < kVectors; ++v) {
+      AddScaled4(even[v], c_even, src_even + 4 * v);
+      AddScaled4(odd[v], c_odd, src_odd + 4 * v);
+    }
+  }
+  if (t < count) {
+    const double* src = u + terms[t].offset;
+    for (int v = 0; v < kVectors; ++v) AddScaled4(even[v], terms[t].coefficient, src + 4 * v);
+  }
+  for (int v = 0; v < kVectors; ++v) {
+    const Vec4 sum = even[v] + odd[v];
+    std::memcpy(out + 4 * v, &sum, sizeof sum);
+  }
+}
+
+// ku at W consecutive nodes from node i, all three components.
+template <int W>
+HAPTICSIM_KERNEL_INLINE void AccumulateNodes(const NodeStencil& stencil, const double* u,
+                                             double* ku, std::ptrdiff_t i, std::ptrdiff_t n) {
+  for (int a = 0; a < 3; ++a) AccumulateChunk<W>(stencil[a], u + i, ku + a * n + i);
+}
+
+}  // namespace stencil_detail
+
+/**
+ * ku at node i (all three components) by its stencil; n nodes per component block. Four partial
+ * sums, for the same reason as in AccumulateChunk.
+ */
+HAPTICSIM_KERNEL_INLINE void ApplyStencilAt(const NodeStencil& stencil, const double* u, double* ku,
+                                            std::ptrdiff_t i, std::ptrdiff_t n) {
+  for (int a = 0; a < 3; ++a) {
+    const auto& terms = stencil[a];
+    double acc[4] = {};
+    size_t t = 0;
+    for (; t + 3 < terms.size(); t += 4) {
+      for (int k = 0; k < 4; ++k) acc[k] += terms[t + k].coefficient * u[i + terms[t + k].offset];
+    }
+    for (; t < terms.size(); ++t) acc[0] += terms[t].coefficient * u[i + terms[t].offset];
+    ku[a * n + i] = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+  }
+}
+
+/**
+ * ku at the `length` consecutive nodes (along x) from node `first` that share one stencil: in
+ * vectors of 16, 8 and 4 nodes, a tail of fewer than 4 as the run's last 4 again (the overlap
+ * writes the same values, cheaper than scalar nodes), single nodes only in runs shorter than 4.
+ */
+HAPTICSIM_KERNEL_INLINE void ApplyStencilRun(const NodeStencil& stencil, const double* u,
+                                             double* ku, std::ptrdiff_t first, int length,
+                                             std::ptrdiff_t n) {
+  using stencil_detail::AccumulateNodes;
+  if (length < 4) {
+    for (int k = 0; k < length; ++k) ApplyStencilAt(stencil, u, ku, first + k, n);
+    return;
+  }
+  int k = 0;
+  for (; k + 16 <= length; k += 16) AccumulateNodes<16>(stencil, u, ku, first + k, n);
+  if (k + 8 <= length) {
+    AccumulateNodes<8>(stencil, u, ku, first + k, n);
+    k += 8;
+  }
+  if (k + 4 <= length) {
+    AccumulateNodes<4>(stencil, u, ku, first + k, n);
+    k += 4;
+  }
+  if (k < length) AccumulateNodes<4>(stencil, u, ku, first + length - 4, n);
+}
+
+}  // namespace hapticsim

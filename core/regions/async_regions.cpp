@@ -1,0 +1,504 @@
+#include "core/regions/async_regions.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "core/regions/async_regions_region.hpp"
+#include "core/error.hpp"
+
+namespace hapticsim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Value at time t on the line through two snapshots (the newer one alone if they coincide).
+// Callers clamp t from above: a late writer must never be extrapolated far. A reader that has
+// fallen behind both snapshots (its thread was late by more than the ring holds) gets the older
+// one: extrapolating backwards multiplies the difference between the snapshots by the lag, and
+// fed back through the coupling that diverges within a few late periods.
+inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
+                     int i, double t) {
+  const double span = newer.time_s - older.time_s;
+  if (!(span > 0)) return newer.values[i];
+  t = std::max(t, older.time_s);
+  return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
+}
+
+}  // namespace
+
+const RegionSchedule& AsyncRegions::schedule(RegionIndex region) const {
+  return regions_[region]->schedule;
+}
+std::int64_t AsyncRegions::period_ticks(RegionIndex region) const {
+  return regions_[region]->period_ticks;
+}
+std::int64_t AsyncRegions::state_ticks(RegionIndex region) const {
+  return regions_[region]->state_ticks;
+}
+double AsyncRegions::compute_seconds(RegionIndex region) const {
+  return regions_[region]->compute_s;
+}
+
+AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceControl control)
+    : partition_(scene),
+      coupling_(scene.adaptivity.displacement_coupling ? Coupling::kDisplacement
+                                                       : Coupling::kForce),
+      control_(control) {
+  if (!(substep_safety > 0)) throw Error("substep safety must be positive");
+  substep_safety_ = substep_safety;
+  const RegionPartition& p = partition_;
+  port_floor_j_ = PortFloorJ(scene.material, p.dof_mass().sum() / 3.0);
+  const int n = p.mesh().num_dofs();
+  const int count = p.num_regions();
+  // Each region's elements next to its outer Γ: what the region outwards evaluates on its Γ.
+  std::vector<std::unique_ptr<ElementSetStiffness>> bands(static_cast<size_t>(count));
+  for (int a = 0; a + 1 < count; ++a) {
+    bands[a] =
+        std::make_unique<ElementSetStiffness>(p.mesh(), scene.material, p.outer_band_elements(a));
+  }
+  const std::vector<RegionSchedule> schedules =
+      ScheduleRegions(p, scene, bands, coupling_ == Coupling::kDisplacement, substep_safety);
+  std::vector<std::int64_t> rates;
+  ticks_per_second_ = 1;
+  for (const RegionSchedule& schedule : schedules) {
+    rates.push_back(static_cast<std::int64_t>(schedule.rate_hz));
+    ticks_per_second_ = std::lcm(ticks_per_second_, rates.back() * schedule.substeps);
+  }
+  common_period_ticks_ = 1;
+
+  for (int a = 0; a < count; ++a) {
+    auto region = std::make_unique<Region>();
+    const RegionDofs& dofs = p.dofs(a);
+    region->dofs = &dofs;
+    region->schedule = schedules[a];
+    region->period_ticks = ticks_per_second_ / (rates[a] * schedules[a].substeps);
+    // The schedule repeats once every region has completed whole nominal periods.
+    common_period_ticks_ = std::lcm(common_period_ticks_, ticks_per_second_ / rates[a]);
+    const double period = 1.0 / region->schedule.rate_hz;
+    std::vector<int> prescribed;
+    if (a == kPrimaryRegion) prescribed.assign(p.contact_dofs().begin(), p.contact_dofs().end());
+    prescribed.insert(prescribed.end(), dofs.fixed.begin(), dofs.fixed.end());
+    region->outer_offset = prescribed.size();
+    prescribed.insert(prescribed.end(), dofs.outer_interface.begin(), dofs.outer_interface.end());
+    region->prescribed_values.assign(prescribed.size(), 0.0);
+    region->integrator = std::make_unique<RegionIntegrator>(
+        p.stiffness(a), p.dof_mass(), scene.material.damping_per_s, dofs.owned, prescribed,
+        dofs.inner_interface, period / region->schedule.substeps);
+    // The outermost region's controller damps its inner Γ; a middle shell, with links on both
+    // sides, and the primary (its last resort only), all their DOFs (ObserveInwardLink).
+    if (a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
+    if (a + 1 < count) region->integrator->SetPortPrescribedFrom(region->outer_offset);
+
+    if (a + 1 < count) {
+      region->band = std::move(bands[a]);
+      for (int dof : region->band->touched_dofs()) {
+        if (!std::binary_search(dofs.outer_interface.begin(), dofs.outer_interface.end(), dof)) {
+          region->band_layer.push_back(dof);
+        }
+      }
+      const int gamma = static_cast<int>(dofs.outer_interface.size());
+      const int outward_width =
+          coupling_ == Coupling::kForce ? gamma : static_cast<int>(region->band_layer.size());
+      region->inward = std::make_unique<BoundaryChannel>(gamma);
+      region->outward = std::make_unique<BoundaryChannel>(outward_width);
+      region->outer = BoundaryChannel::ReadPair(gamma);
+      region->outward_values.assign(static_cast<size_t>(outward_width), 0.0);
+    }
+    if (a > 0) {
+      const Region& inner = *regions_[a - 1];
+      region->inner = BoundaryChannel::ReadPair(inner.outward->width());
+      region->inward_values.assign(dofs.inner_interface.size(), 0.0);
+      region->load_values.assign(dofs.inner_interface.size(), 0.0);
+      region->band_u = Eigen::VectorXd::Zero(n);
+      region->band_ku = Eigen::VectorXd::Zero(n);
+    }
+    regions_.push_back(std::move(region));
+  }
+  BuildSurface();
+  Reset();
+}
+
+void AsyncRegions::PublishInward(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  const Eigen::VectorXd& u = region.integrator->u();
+  const auto& gamma = region.dofs->inner_interface;
+  for (size_t i = 0; i < gamma.size(); ++i) region.inward_values[i] = u[gamma[i]];
+  regions_[a - 1]->inward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
+                                   region.inward_values);
+}
+
+void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  if (coupling_ == Coupling::kForce) {
+    const Eigen::VectorXd& ku = region.integrator->Forces();
+    const auto& gamma = region.dofs->outer_interface;
+    for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
+  } else {
+    const Eigen::VectorXd& u = region.integrator->u();
+    for (size_t i = 0; i < region.band_layer.size(); ++i)
+      region.outward_values[i] = u[region.band_layer[i]];
+  }
+  region.outward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
+                          region.outward_values);
+}
+
+void AsyncRegions::PublishInitialSnapshots() {
+  for (int a = 0; a < num_regions(); ++a) {
+    if (a > 0) PublishInward(a);
+    if (a + 1 < num_regions()) PublishOutward(a);
+    PublishSurface(*regions_[a]);
+  }
+}
+
+void AsyncRegions::PublishStep(RegionIndex a) noexcept {
+  Region& region = *regions_[a];
+  if (a > 0) PublishInward(a);
+  if (region.inward) PublishOutward(a);
+  if (surface_request_.load(std::memory_order_relaxed) != region.surface_request_served) {
+    PublishSurface(region);
+  }
+}
+
+void AsyncRegions::Reset() {
+  for (auto& region : regions_) {
+    region->integrator->Reset();
+    if (region->inward) region->inward->Clear();
+    if (region->outward) region->outward->Clear();
+    region->state_ticks = 0;
+    region->compute_s = 0;
+    region->last_inexact_follow_ticks.store(INT64_MIN, std::memory_order_relaxed);
+    region->no_lockstep_before_ticks = 0;
+  }
+  ResetEnergyAccount();
+  primary_boundary_age_s_.store(0, std::memory_order_relaxed);
+  PublishInitialSnapshots();
+}
+
+bool AsyncRegions::RegionAtRest(RegionIndex region, double tolerance_m) const noexcept {
+  return regions_[region]->integrator->OwnedStateMaxAbs() <= tolerance_m;
+}
+
+void AsyncRegions::SetRandomState(unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1e-4, 1e-4);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(partition_.mesh().num_dofs());
+  for (int a = 0; a < num_regions(); ++a) {
+    for (int dof : partition_.dofs(a).owned) u[dof] = uniform(rng);
+  }
+  StartFrom(u, Eigen::VectorXd::Zero(u.size()));
+}
+
+void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* contact_next,
+                                std::array<double, 3>* reaction) noexcept {
+  const auto start = Clock::now();
+  Region& region = *regions_[a];
+  RegionIntegrator& integrator = *region.integrator;
+  const double t0 = static_cast<double>(region.state_ticks) / ticks_per_second_;
+  const double h = integrator.substep();
+  const auto& outer_gamma = region.dofs->outer_interface;
+  const auto& inner_gamma = region.dofs->inner_interface;
+  bool followed = true;  // this step's outer Γ is the outer region's own at the step's end
+
+  if (contact_next != nullptr) {
+    for (int c = 0; c < 3; ++c) region.prescribed_values[c] = (*contact_next)[c];
+  }
+  // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
+  if (region.inward) {
+    (void)region.inward->TryReadLatestTwo(&region.outer);
+    // The outer region is ahead: interpolate. If it is late, hold its newest state.
+    const double t = std::min(t0 + h, region.outer.newer.time_s);
+    const double end =
+        static_cast<double>(region.state_ticks + region.period_ticks) / ticks_per_second_;
+    // On the line between the two snapshots, not held short of it nor clamped to a later one.
+    followed = region.outer.older.time_s <= end && end <= region.outer.newer.time_s;
+    if (a == kPrimaryRegion) {
+      primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
+    }
+    for (size_t i = 0; i < outer_gamma.size(); ++i) {
+      region.prescribed_values[region.outer_offset + i] =
+          OnLine(region.outer.older, region.outer.newer, static_cast<int>(i), t);
+    }
+  }
+  if (a > 0) {
+    const Region& inner = *regions_[a - 1];
+    (void)inner.outward->TryReadLatestTwo(&region.inner);
+    // The schedule keeps the inner region less than one of its nominal periods behind; never
+    // extrapolate further than that, should it be late.
+    const double t = std::min(t0, region.inner.newer.time_s + 1.0 / inner.schedule.rate_hz);
+    if (coupling_ == Coupling::kForce) {
+      for (size_t i = 0; i < inner_gamma.size(); ++i) {
+        region.load_values[i] =
+            -OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
+      }
+    } else {
+      // The inner region's force on Γ from its band: its displacements next to Γ on the line
+      // through its newest two states, Γ itself as this region has it now.
+      for (size_t i = 0; i < inner.band_layer.size(); ++i) {
+        region.band_u[inner.band_layer[i]] =
+            OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
+      }
+      const Eigen::VectorXd& u = integrator.u();
+      for (int dof : inner_gamma) region.band_u[dof] = u[dof];
+      inner.band->Apply(region.band_u, region.band_ku);
+      for (size_t i = 0; i < inner_gamma.size(); ++i)
+        region.load_values[i] = -region.band_ku[inner_gamma[i]];
+    }
+  }
+  double asked_inward = 0, asked_outward = 0;
+  PortWorkLimits limits;
+  if (control_ != InterfaceControl::kOff)
+    ControlInterfaces(a, &asked_inward, &asked_outward, &limits);
+  integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward,
+                  limits);
+  if (reaction != nullptr) {
+    for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
+  }
+  AccountStep(a, asked_inward, asked_outward);
+  region.state_ticks += region.period_ticks;
+  if (region.inward && (!followed || integrator.PrescribedWorkRefused() > 0)) {
+    region.last_inexact_follow_ticks.store(region.state_ticks, std::memory_order_release);
+  }
+  PublishStep(a);
+  region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::array<double, 3> AsyncRegions::StepPrimary(
+    const std::array<double, 3>& contact_next) noexcept {
+  std::array<double, 3> reaction{};
+  StepRegionAt(kPrimaryRegion, &contact_next, &reaction);
+  return reaction;
+}
+
+std::array<double, 3> AsyncRegions::primary_contact_m() const noexcept {
+  const Eigen::VectorXd& u = regions_[kPrimaryRegion]->integrator->u();
+  const std::array<int, 3>& dofs = partition_.contact_dofs();
+  return {u[dofs[0]], u[dofs[1]], u[dofs[2]]};
+}
+
+void AsyncRegions::StepRegion(RegionIndex region) noexcept {
+  StepRegionAt(region, nullptr, nullptr);
+}
+
+void AsyncRegions::SkipRegion(RegionIndex a, std::int64_t steps) noexcept {
+  if (a == kPrimaryRegion || steps <= 0) return;
+  Region& region = *regions_[a];
+  // Published twice, one step apart, with the same values: a flat line, so a neighbour reading
+  // between them holds the state instead of interpolating towards the time before the stall.
+  region.state_ticks += (steps - 1) * region.period_ticks;
+  // Neither link is in lock-step across a skip: its band and Γ are the state before the stall.
+  if (region.inward) {
+    region.last_inexact_follow_ticks.store(region.state_ticks + region.period_ticks,
+                                           std::memory_order_release);
+  }
+  region.no_lockstep_before_ticks = region.state_ticks + 3 * region.period_ticks;
+  for (int twice = 0; twice < 2; ++twice) {
+    PublishInward(a);
+    if (region.inward) PublishOutward(a);
+    if (twice == 0) region.state_ticks += region.period_ticks;
+  }
+}
+
+void AsyncRegions::AdvanceRegionTo(RegionIndex a, std::int64_t ticks) noexcept {
+  Region& region = *regions_[a];
+  while (region.state_ticks < ticks) {
+    // Before this region steps to t + P, the region outwards must supply Γ at t + P.
+    if (a + 1 < num_regions()) AdvanceRegionTo(a + 1, region.state_ticks + region.period_ticks);
+    StepRegion(a);
+  }
+}
+
+void AsyncRegions::AdvanceSecondariesTo(std::int64_t ticks) noexcept {
+  if (num_regions() > 1) AdvanceRegionTo(1, ticks);
+}
+
+void AsyncRegions::AdvancePrimaryTo(std::int64_t ticks) noexcept {
+  const std::array<double, 3> held{0, 0, 0};
+  Region& primary = *regions_[kPrimaryRegion];
+  while (primary.state_ticks < ticks) {
+    AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
+    StepPrimary(held);
+  }
+}
+
+double AsyncRegions::KineticEnergy() const noexcept {
+  double kinetic = 0;
+  const Eigen::VectorXd& m = partition_.dof_mass();
+  for (const auto& region : regions_) {
+    const Eigen::VectorXd &u = region->integrator->u(), &up = region->integrator->u_previous();
+    double sum = 0;  // Σ m (u − u⁻)², divided by h² once per region
+    for (int i : region->dofs->owned) sum += m[i] * (u[i] - up[i]) * (u[i] - up[i]);
+    kinetic += sum / std::pow(region->integrator->substep(), 2);
+  }
+  return 0.5 * kinetic;
+}
+
+double AsyncRegions::Energy() noexcept {
+  double energy = 0;
+  for (auto& region : regions_) energy += region->integrator->StateEnergy();
+  return energy;
+}
+
+RegionIndex AsyncRegions::LargestStateRegion() const {
+  RegionIndex largest = kPrimaryRegion;
+  double largest_size = -1;
+  for (int r = 0; r < num_regions(); ++r) {
+    const double size = regions_[r]->integrator->OwnedStateNormSquared();
+    if (!std::isfinite(size)) return r;
+    if (size > largest_size) largest = r, largest_size = size;
+  }
+  return largest;
+}
+
+double AsyncRegions::StateNorm() const {
+  double sum = 0;
+  for (const auto& region : regions_) sum += region->integrator->OwnedStateNormSquared();
+  return std::sqrt(sum);
+}
+
+double AsyncRegions::OrbitNorm() noexcept {
+  double twice = 0;
+  const Eigen::VectorXd& m = partition_.dof_mass();
+  for (auto& region : regions_) {
+    const Eigen::VectorXd& ku = region->integrator->Forces();  // the next step needs it anyway
+    const Eigen::VectorXd& u = region->integrator->u();
+    const Eigen::VectorXd& up = region->integrator->u_previous();
+    const double h = region->integrator->substep();
+    for (int i : region->dofs->owned) {
+      twice += m[i] * (u[i] - up[i]) * (u[i] - up[i]) / (h * h) + up[i] * ku[i];
+    }
+    for (int i : region->dofs->outer_interface) twice += up[i] * ku[i];
+  }
+  if (!std::isfinite(twice)) return twice;  // grown past doubles: for the caller to see
+  return std::sqrt(std::max(0.0, 0.5 * twice));
+}
+
+void AsyncRegions::ScaleAll(double factor) {
+  // Energies scale with the square of the state: so scaled, the interface controllers act on the
+  // scaled state as they would have on the original, and the period map stays homogeneous. The
+  // running sums the neighbours exchange are rebased first (the part already counted on the
+  // other side subtracted from both): renormalised every period by the power iteration, they
+  // would otherwise outgrow each step's work by 10¹⁶ within a few hundred periods and absorb it.
+  // (That leaves Energies' totals meaningless until the next Reset, which the iteration ends on.)
+  for (int a = 1; a < num_regions(); ++a) {
+    Region& outer = *regions_[a];
+    Region& inner = *regions_[a - 1];
+    inner.outer_gamma_work -= outer.inner_work_seen;
+    inner.outward_taken -= outer.inner_taken_seen;
+    outer.inner_work_seen = outer.inner_taken_seen = 0;
+  }
+  const double squared = factor * factor;
+  state_energy_at_reset_j_ *= squared;
+  for (auto& region : regions_) {
+    for (double* energy :
+         {&region->input_work, &region->damping_dissipated, &region->outer_gamma_work,
+          &region->outward_taken, &region->inner_gamma_load_work, &region->inward_taken,
+          &region->excess, &region->unmet, &region->inner_work_seen, &region->inner_taken_seen,
+          &region->port_refused, &region->inward_allowance_peak, &region->outward_allowance_peak,
+          &region->energy_peak, &region->lockstep_load_peak}) {
+      *energy *= squared;
+    }
+    for (std::atomic<double>* published :
+         {&region->energy_published, &region->state_energy_published}) {
+      published->store(squared * published->load(std::memory_order_relaxed),
+                       std::memory_order_relaxed);
+    }
+    PublishEnergyAccount(*region);
+    region->integrator->ScaleState(factor);
+    if (region->inward) region->inward->ScaleAll(factor);
+    if (region->outward) region->outward->ScaleAll(factor);
+  }
+}
+
+CoupledStability AsyncRegions::EstimateCoupledStability(int burn_in_periods, int window_periods,
+                                                        int max_windows, unsigned seed) {
+  // Growth is measured in the orbit norm: the Euclidean norm swings with each oscillating mode's
+  // phase, which made a window's growth wrong by up to ±0.004 per period (a configuration whose
+  // windows all grow in the orbit norm had one that decayed, and the reverse; docs/regions.md).
+  // Where that energy is indefinite — a region past its own step limit, which production
+  // substeps (0.95 of each region's own limit) are chosen to avoid — the Euclidean norm is the
+  // one left, and the estimate says so (orbit_norm).
+  HAPTICSIM_THROW_UNLESS(
+      window_periods >= 1 && burn_in_periods >= window_periods && max_windows >= 1,
+      "the stability estimate needs window_periods ≥ 1, burn_in_periods ≥ "
+      "window_periods and max_windows ≥ 1");
+  std::optional<CoupledStability> estimate =
+      PowerIterate(burn_in_periods, window_periods, max_windows, true, seed);
+  if (!estimate) estimate = PowerIterate(burn_in_periods, window_periods, max_windows, false, seed);
+  return *estimate;
+}
+
+std::optional<CoupledStability> AsyncRegions::PowerIterate(int burn_in_periods, int window_periods,
+                                                           int max_windows, bool orbit_norm,
+                                                           unsigned seed) {
+  auto norm = [&] { return orbit_norm ? OrbitNorm() : StateNorm(); };
+  CoupledStability out;
+  out.common_period_s = static_cast<double>(common_period_ticks_) / ticks_per_second_;
+  out.orbit_norm = orbit_norm;
+  SetRandomState(seed);
+  const double start = norm();
+  if (!(start > 0)) {
+    Reset();
+    return std::nullopt;
+  }
+  ScaleAll(1.0 / start);
+  // Mean log growth per period over the last window_periods periods; after the burn-in, one value
+  // per window. The burn-in's last window is the first comparison.
+  double window_growth = 0, previous_growth = -INFINITY, worst_growth = -INFINITY;
+  int windows = 0;
+  const int window_begin = std::max(0, burn_in_periods - window_periods);
+  for (int period = 1;; ++period) {
+    AdvancePrimaryTo(period * common_period_ticks_);
+    const double size = norm();
+    out.periods = period;
+    if (!std::isfinite(size) || size > 1e100) {
+      out.spectral_radius = INFINITY;
+      out.stable = false;
+      Reset();
+      return out;
+    }
+    if (!(size > 0)) {  // an indefinite orbit energy
+      Reset();
+      return std::nullopt;
+    }
+    if (period > window_begin) window_growth += std::log(size);
+    ScaleAll(1.0 / size);
+    if (period <= window_begin || (period - window_begin) % window_periods != 0) continue;
+    const double growth = window_growth / window_periods;
+    window_growth = 0;
+    if (period <= burn_in_periods) {  // the burn-in's last window
+      previous_growth = growth;
+      continue;
+    }
+    ++windows;
+    worst_growth = std::max(worst_growth, growth);
+    // Done when a window already says unstable, or the growth has stopped rising: a mode that
+    // grows (or decays slowest) but started small takes over gradually, and while it does each
+    // window grows faster than the one before. A near-neutral configuration can rise for
+    // seconds (docs/regions.md, "Coupled stability"); it gets up to max_windows windows.
+    const bool unstable = growth >= std::log(CoupledStability::kStableBelow);
+    const bool rising = growth - previous_growth > kStillRising * std::abs(growth);
+    if (unstable || !rising || windows >= max_windows) break;
+    previous_growth = growth;
+  }
+  out.spectral_radius = std::exp(worst_growth);
+  out.stable = out.spectral_radius < CoupledStability::kStableBelow;
+  Reset();
+  return out;
+}
+
+std::vector<double> AsyncRegions::FreeDecayEnergies(int periods_per_checkpoint, int checkpoints,
+                                                    unsigned seed) {
+  SetRandomState(seed);
+  std::vector<double> energies{Energy()};
+  for (int c = 1; c <= checkpoints; ++c) {
+    AdvancePrimaryTo(static_cast<std::int64_t>(c) * periods_per_checkpoint * common_period_ticks_);
+    energies.push_back(Energy());
+  }
+  Reset();
+  return energies;
+}
+
+}  // namespace hapticsim

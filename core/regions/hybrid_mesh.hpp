@@ -1,0 +1,120 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "core/fem/material.hpp"
+
+namespace hapticsim {
+
+/** Which region an element belongs to: 0 is the primary region, 1… the secondary shells. */
+using RegionIndex = int;
+constexpr RegionIndex kPrimaryRegion = 0;
+constexpr RegionIndex kSecondaryRegion = 1;
+
+/** A cube element of the hybrid mesh. */
+struct HybridElement {
+  std::array<int, 8> nodes{};  ///< mesh nodes in Hex8Element's local order
+  int size_factor = 1;         ///< edge = size_factor · h (1 fine, k coarse)
+  RegionIndex region = kPrimaryRegion;
+};
+
+/** One term of a node's displacement in terms of independent DOFs: u_node += weight·u_r. */
+struct GatherTerm {
+  int independent = 0;
+  double weight = 1.0;
+};
+
+/**
+ * A cube meshed at two resolutions: coarse cells of k × k × k fine intervals, of which some are
+ * refined into k³ fine cells — those meeting the primary box around the contact, and those
+ * around the fixed supports. Where a refined cell meets an unrefined one, the fine nodes that
+ * are not coarse vertices ("hanging nodes") are constrained to the coarse cell's trilinear field,
+ * which on the shared face is bilinear, so the displacement stays continuous (conforming).
+ *
+ * The unknowns are the *independent* nodes (all nodes but the hanging ones), component-blocked
+ * like HexGrid: dof(r, c) = c·N_r + r. A hanging node's displacement is gathered from its masters
+ * with the interpolation weights; its forces and lumped mass are scattered back with the same
+ * weights (u = T·u_r, f_r = Tᵀ·f, M_r = row sums of TᵀMT).
+ *
+ * Nodes live on the fine lattice of the cube ((n−1) intervals of h per axis), so a lattice index
+ * names every node whatever its cell's resolution. With k = 1 there are no hanging nodes and the
+ * mesh is the full-resolution grid.
+ */
+class HybridMesh {
+ public:
+  struct Options {
+    int nodes_per_axis = 13;                        ///< fine lattice points per axis (n)
+    double spacing_m = 0.25 / 12;                   ///< fine spacing h, m
+    int coarse_factor = 2;                          ///< k, must divide n − 1
+    std::array<int, 3> primary_lo{}, primary_hi{};  ///< primary box, lattice indices (closed)
+    std::vector<std::array<int, 3>> supports;       ///< lattice indices of fixed nodes
+    int support_layers = 1;  ///< coarse cells refined around each support, per direction
+    /// Secondary cells split into this many nested shells around the primary cells (regions
+    /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.
+    int secondary_regions = 1;
+    int shell_cells = 1;
+  };
+
+  /** @throws Error when k does not divide n − 1. */
+  explicit HybridMesh(const Options& options);
+
+  const Options& options() const { return options_; }
+  int num_independent() const { return static_cast<int>(independent_lattice_.size()); }
+  int num_dofs() const { return 3 * num_independent(); }
+  int Dof(int independent, int component) const {
+    return component * num_independent() + independent;
+  }
+  const std::vector<HybridElement>& elements() const { return elements_; }
+  int num_hanging() const { return num_hanging_; }
+
+  /** Independent index of the node at a lattice point, or −1 (no node there, or hanging). */
+  int IndependentAt(int ix, int iy, int iz) const;
+  /**
+   * The mesh's displacement at any lattice point as a sum of independent nodes' values: an
+   * independent node's own (one term of weight 1); elsewhere — a point inside or on an unrefined
+   * coarse cell, a hanging node among them — the cell's trilinear field of its 8 vertices, which
+   * are always independent (terms of weight 0 left out). A point on a face shared with a refined
+   * cell gets the same field from either: it depends on the face's vertices alone. Returns the
+   * number of terms written.
+   */
+  int FieldAt(const std::array<int, 3>& point, std::array<GatherTerm, 8>* terms) const;
+  /**
+   * The region of the element covering each fine lattice cell ((n − 1)³ cells, ix slowest): a
+   * coarse element gives its region to the k³ fine cells inside it.
+   */
+  std::vector<RegionIndex> RegionPerLatticeCell() const;
+  /** Lattice indices of an independent node. */
+  const std::array<int, 3>& LatticeOf(int independent) const {
+    return independent_lattice_[independent];
+  }
+
+  /** The gather terms of mesh node `node` (one term of weight 1 for an independent node). */
+  std::pair<const GatherTerm*, const GatherTerm*> Gather(int node) const {
+    return {gather_terms_.data() + gather_start_[node],
+            gather_terms_.data() + gather_start_[node + 1]};
+  }
+
+  /** Lumped mass of each independent DOF for density ρ, kg (component-blocked). */
+  Eigen::VectorXd DofMass(double density_kg_m3) const;
+
+  /** Number of regions that have elements (primary + secondary shells). */
+  int num_regions() const { return num_regions_; }
+  /** Bit r set when elements of region r touch the independent node (through its gathers). */
+  const std::vector<unsigned>& region_mask() const { return region_mask_; }
+
+ private:
+  Options options_;
+  std::vector<HybridElement> elements_;
+  std::vector<int> node_at_lattice_;  // mesh node id per lattice point, −1 if none
+  std::vector<int> gather_start_;     // per mesh node, into gather_terms_ (size nodes + 1)
+  std::vector<GatherTerm> gather_terms_;
+  std::vector<int> independent_of_node_;  // −1 for hanging nodes
+  std::vector<std::array<int, 3>> independent_lattice_;
+  std::vector<unsigned> region_mask_;
+  int num_hanging_ = 0;
+  int num_regions_ = 0;
+};
+
+}  // namespace hapticsim

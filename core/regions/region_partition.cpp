@@ -1,0 +1,142 @@
+#include "core/regions/region_partition.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "core/regions/box_stiffness.hpp"
+#include "core/error.hpp"
+
+namespace hapticsim {
+
+namespace {
+// The shortest rows (nodes along x and y) for which a box region runs on the stencil.
+constexpr int kMinBoxRowNodes = 9;
+}  // namespace
+
+RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
+  ValidateScene(scene);
+  HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
+                         "asynchronous regions need adaptivity.primary_size >= 1");
+  const int n = scene.mesh.nodes, last = n - 1, r = scene.adaptivity.primary_size;
+  const LatticeIndex contact = ContactNode(scene);
+
+  HybridMesh::Options options;
+  options.nodes_per_axis = n;
+  options.spacing_m = scene.mesh.edge_m / last;
+  options.coarse_factor = scene.adaptivity.secondary_lod;
+  for (int a = 0; a < 3; ++a) {
+    options.primary_lo[a] = std::max(0, contact[a] - r);
+    options.primary_hi[a] = std::min(last, contact[a] + r);
+  }
+  const auto supports = CubeSupportNodes(scene.mesh);
+  options.supports.assign(supports.begin(), supports.end());
+  options.support_layers = scene.adaptivity.support_layers;
+  options.secondary_regions = scene.adaptivity.secondary_regions;
+  options.shell_cells = scene.adaptivity.shell_cells;
+  mesh_ = std::make_unique<HybridMesh>(options);
+  dof_mass_ = mesh_->DofMass(scene.material.density_kg_m3);
+
+  const int regions = 1 + scene.adaptivity.secondary_regions;
+  std::vector<std::vector<int>> elements(static_cast<size_t>(regions));
+  for (int e = 0; e < static_cast<int>(mesh_->elements().size()); ++e) {
+    elements[mesh_->elements()[e].region].push_back(e);
+  }
+  for (int region = 1; region < regions; ++region) {
+    HAPTICSIM_THROW_UNLESS(
+        !elements[region].empty(),
+        "adaptivity.primary_size = " + std::to_string(r) +
+            (regions == 2
+                 ? std::string(" leaves no secondary region")
+                 : " leaves secondary region " + std::to_string(region) +
+                       " of adaptivity.secondary_regions = " + std::to_string(regions - 1) +
+                       " empty: use fewer or thinner shells"));
+  }
+  for (int region = 0; region < regions; ++region) {
+    // Fine elements (the primary box; at spacing factor 1 the secondary shells too, boxes with a
+    // hole) run on node stencils where their bounding box's rows are long enough for the vector
+    // path: measured per K·u against the element loop, a 13×13×7 primary box 2.0× faster,
+    // 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar path, are nearly all
+    // of a small box); a 13³ secondary with a hole 1.5–3.0× faster (docs/benchmarks.md).
+    if (auto box =
+            BoxStiffness::TryMake(*mesh_, scene.material, elements[region], kMinBoxRowNodes)) {
+      stiffness_.push_back(std::move(box));
+    } else {
+      stiffness_.push_back(
+          std::make_unique<ElementSetStiffness>(*mesh_, scene.material, elements[region]));
+    }
+  }
+
+  const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
+  HAPTICSIM_THROW_UNLESS(contact_node >= 0, "internal: the contact node is not independent");
+  for (int c = 0; c < 3; ++c) contact_dofs_[c] = mesh_->Dof(contact_node, c);
+  for (const auto& s : options.supports) {
+    const int node = mesh_->IndependentAt(s[0], s[1], s[2]);
+    HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a support node is not independent");
+    for (int c = 0; c < 3; ++c) fixed_dofs_.push_back(mesh_->Dof(node, c));
+  }
+  std::sort(fixed_dofs_.begin(), fixed_dofs_.end());
+
+  const auto& mask = mesh_->region_mask();
+  const int nr = mesh_->num_independent();
+  HAPTICSIM_THROW_UNLESS(mask[contact_node] == 1u,
+                         "internal: the contact must lie inside the primary region");
+  dofs_.resize(static_cast<size_t>(regions));
+  for (int c = 0; c < 3; ++c) {
+    for (int node = 0; node < nr; ++node) {
+      const unsigned m = mask[node];
+      const int dof = c * nr + node;
+      // Nested shells: a node belongs to one region or to two neighbours.
+      const int outermost = 31 - __builtin_clz(m);
+      const int innermost = __builtin_ctz(m);
+      HAPTICSIM_THROW_UNLESS(outermost - innermost <= 1,
+                             "internal: regions " + std::to_string(innermost) + " and " +
+                                 std::to_string(outermost) + " touch without the shell between");
+      if (std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(), dof)) {
+        for (int region = innermost; region <= outermost; ++region)
+          dofs_[region].fixed.push_back(dof);
+        continue;
+      }
+      if (std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end())
+        continue;
+      dofs_[outermost].owned.push_back(dof);
+      if (outermost != innermost) {
+        dofs_[outermost].inner_interface.push_back(dof);
+        dofs_[innermost].outer_interface.push_back(dof);
+      }
+    }
+  }
+
+  // The band of each region next to its outer interface.
+  band_.resize(static_cast<size_t>(regions));
+  for (int region = 0; region + 1 < regions; ++region) {
+    std::vector<char> on_gamma(static_cast<size_t>(nr), 0);
+    for (int dof : dofs_[region].outer_interface) on_gamma[dof % nr] = 1;
+    for (int e : elements[region]) {
+      bool touches = false;
+      for (int node : mesh_->elements()[e].nodes) {
+        const auto [begin, end] = mesh_->Gather(node);
+        for (auto* g = begin; g != end; ++g) touches = touches || on_gamma[g->independent];
+      }
+      if (touches) band_[region].push_back(e);
+    }
+  }
+}
+
+int RegionPartition::num_elements(RegionIndex region) const {
+  return static_cast<int>(
+      std::count_if(mesh_->elements().begin(), mesh_->elements().end(),
+                    [&](const HybridElement& e) { return e.region == region; }));
+}
+
+int RegionPartition::num_nodes(RegionIndex region) const {
+  return static_cast<int>(std::count_if(mesh_->region_mask().begin(), mesh_->region_mask().end(),
+                                        [&](unsigned m) { return (m >> region) & 1u; }));
+}
+
+std::string RegionPartition::RegionName(RegionIndex region) const {
+  if (region == kPrimaryRegion) return "primary";
+  if (num_regions() == 2) return "secondary";
+  return "secondary " + std::to_string(region);
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,76 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "core/regions/element_set_stiffness.hpp"
+#include "core/regions/hybrid_mesh.hpp"
+#include "core/scene/scene.hpp"
+
+namespace hapticsim {
+
+/** The DOF sets one region works on. */
+struct RegionDofs {
+  std::vector<int> owned;            ///< integrated by this region (inner interface included)
+  std::vector<int> fixed;            ///< supports this region touches, held at zero
+  std::vector<int> inner_interface;  ///< Γ with the next region inwards: owned, and loaded with
+                                     ///< that region's forces (empty for the primary)
+  std::vector<int> outer_interface;  ///< Γ with the next region outwards: prescribed from its
+                                     ///< snapshots (empty for the outermost region)
+};
+
+/**
+ * The paper's cube split into asynchronous regions (two-way linking on a hybrid mesh):
+ *
+ * - region 0, the **primary region**: the coarse cells meeting the box of
+ *   adaptivity.primary_size nodes around the contact, refined to the finest spacing h;
+ * - regions 1…n, the **secondary regions** (adaptivity.secondary_regions = n): every other cell,
+ *   of spacing k·h (k = adaptivity.secondary_lod), in nested shells around the primary
+ *   (adaptivity.shell_cells coarse cells thick; the outermost takes the rest) — except
+ *   adaptivity.support_layers coarse cells around each fixed corner, refined to h too because a
+ *   coarse cell at a point support is far too stiff (its stiffness is singular);
+ * - an **interface Γ** between each pair of neighbouring shells: the independent nodes touched by
+ *   elements of both. The outer region owns it (integrates it with the lumped mass of both sides
+ *   and receives the inner region's forces); the inner region takes Γ's displacement as a
+ *   prescribed boundary. Shells are nested, so a node is never shared by non-neighbours (checked).
+ *
+ * With k = 1 the mesh is the full-resolution grid and only the rates differ.
+ */
+class RegionPartition {
+ public:
+  /** @throws Error when the scene's adaptivity settings are invalid (see ValidateScene). */
+  explicit RegionPartition(const Scene& scene);
+
+  const Scene& scene() const { return scene_; }
+  const HybridMesh& mesh() const { return *mesh_; }
+  const Eigen::VectorXd& dof_mass() const { return dof_mass_; }
+  int num_regions() const { return static_cast<int>(stiffness_.size()); }
+  /** K of the region's elements: by node stencils where they are all fine (BoxStiffness). */
+  const StiffnessOperator& stiffness(RegionIndex region) const { return *stiffness_[region]; }
+  const RegionDofs& dofs(RegionIndex region) const { return dofs_[region]; }
+  /** Elements of `region` that touch its outer interface (the band whose forces cross it). */
+  const std::vector<int>& outer_band_elements(RegionIndex region) const { return band_[region]; }
+
+  /** The contact node's x, y, z DOFs (in the primary region). */
+  const std::array<int, 3>& contact_dofs() const { return contact_dofs_; }
+
+  int num_elements(RegionIndex region) const;
+  /** Independent nodes touched by the region's elements. */
+  int num_nodes(RegionIndex region) const;
+  /** "primary", "secondary", or "secondary 1", "secondary 2", … with several shells. */
+  std::string RegionName(RegionIndex region) const;
+
+ private:
+  Scene scene_;
+  std::unique_ptr<HybridMesh> mesh_;
+  Eigen::VectorXd dof_mass_;
+  std::vector<std::unique_ptr<StiffnessOperator>> stiffness_;
+  std::vector<RegionDofs> dofs_;
+  std::vector<std::vector<int>> band_;
+  std::array<int, 3> contact_dofs_{};
+  std::vector<int> fixed_dofs_;
+};
+
+}  // namespace hapticsim

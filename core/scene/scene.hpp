@@ -1,0 +1,156 @@
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/fem/material.hpp"
+
+namespace hapticsim {
+
+/** How the device drives the contact node along its face's inward normal (+z on the front). */
+enum class Waveform {
+  kPress,  ///< s·(1 − cos 2πft)/2: a smooth press into the object and back, no velocity jump
+  kSine,   ///< s·sin 2πft: in and out of the object around the rest position
+};
+
+/** Lattice indices (ix, iy, iz) of a node of the cube. */
+using LatticeIndex = std::array<int, 3>;
+
+struct MeshSettings {
+  int nodes = 13;        ///< nodes per axis of the cube (mesh.nodes)
+  double edge_m = 0.25;  ///< cube edge length, m (mesh.edge)
+};
+
+struct InputSettings {
+  double amplitude_m = 0.01;             ///< s, m (input.amplitude)
+  double frequency_hz = 1.0;             ///< f, Hz (input.frequency)
+  Waveform waveform = Waveform::kPress;  ///< input.waveform
+  double periods = 1.0;                  ///< trial length in periods of f (input.periods)
+  /// The driven surface node (input.contact_node); none: the paper's, the middle node of the
+  /// front face. It moves along the inward normal of its face (see InwardNormal).
+  std::optional<LatticeIndex> contact_node;
+};
+
+struct SolverSettings {
+  double dt_s = 1e-3;  ///< time step, s (solver.dt)
+};
+
+/**
+ * Asynchronous regions (the paper's adaptivity parameters). primary_size = 0 switches them off:
+ * the whole object is then solved on the finest mesh at the primary rate (the reference).
+ */
+struct AdaptivitySettings {
+  int primary_size = 0;   ///< nodes from the contact in every direction (adaptivity.primary_size)
+  int secondary_lod = 2;  ///< secondary spacing factor k (adaptivity.secondary_lod)
+  double secondary_rate_hz = 600;  ///< secondary region rate, Hz (adaptivity.secondary_rate)
+  int support_layers =
+      1;  ///< coarse cells refined around each fixed node (adaptivity.support_layers)
+  int secondary_regions =
+      1;                ///< nested secondary shells, one thread each (adaptivity.secondary_regions)
+  int shell_cells = 1;  ///< thickness of each inner shell, coarse cells (adaptivity.shell_cells)
+  double outer_rate_hz = 600;  ///< rate of the shells beyond the first, Hz (adaptivity.outer_rate)
+  /// What the primary sends the secondary for the interface (adaptivity.coupling):
+  /// true = its displacements next to Γ ("displacement", the default), false = its Γ forces.
+  bool displacement_coupling = true;
+
+  bool enabled() const { return primary_size > 0; }
+};
+
+/**
+ * Everything that defines a simulation trial. The defaults are the paper's scene: a cube of
+ * edge 0.25 m with 13×13×13 nodes, the four back-face corners fixed, the middle node of the
+ * front face driven by a 1 cm press at 1 Hz for one period, E = 10 kPa, ν = 0.45,
+ * ρ = 1000 kg/m³, d = 10 1/s, dt = 1 ms.
+ */
+struct Scene {
+  MeshSettings mesh;
+  Material material;
+  InputSettings input;
+  SolverSettings solver;
+  AdaptivitySettings adaptivity;
+
+  /** Trial length in seconds: periods / frequency. */
+  double duration_s() const { return input.periods / input.frequency_hz; }
+  /** Number of time steps in the trial (the duration rounded to whole steps). */
+  long num_steps() const;
+};
+
+std::string_view WaveformName(Waveform waveform);
+
+/** The shortest text that reads back to exactly `value` ("10000.0", "0.45", "1e-05"). */
+std::string FormatReal(double value);
+
+/**
+ * One settable scene key ("section.key"). The table of keys is the single source of truth for
+ * scene files, --set overrides, printing and validation.
+ */
+struct SceneKeyInfo {
+  std::string_view name;     ///< e.g. "material.poisson_ratio"
+  std::string_view unit;     ///< SI unit, or "" when dimensionless
+  std::string_view allowed;  ///< the allowed range, as a message fragment
+  std::string_view meaning;  ///< one line for --help and docs
+};
+
+/** All keys, in the order they are printed. */
+const std::vector<SceneKeyInfo>& SceneKeys();
+
+/**
+ * Sets `key` from its textual value (as given to --set or read from a scene file).
+ * @throws Error naming the key when the key is unknown, the text is not a value of the key's
+ *         type, or the value is outside the key's allowed range.
+ */
+void SetSceneValue(Scene* scene, std::string_view key, std::string_view value_text);
+
+/** The value of `key` as text that SetSceneValue() reads back to the same value. */
+std::string GetSceneValue(const Scene& scene, std::string_view key);
+
+/**
+ * Checks every key's range and the relations between keys.
+ * @throws Error with one message naming the key and its allowed range.
+ */
+void ValidateScene(const Scene& scene);
+
+/**
+ * The paper's contact: the middle node of the front face (z = 0); with an even node count, the
+ * one just below the centre in x and y. The one definition every model of the cube uses.
+ */
+LatticeIndex CubeContactNode(const MeshSettings& mesh);
+
+/** The paper's supports: the four corner nodes of the back face (z = edge). */
+std::array<LatticeIndex, 4> CubeSupportNodes(const MeshSettings& mesh);
+
+/** The scene's driven node: input.contact_node, or the paper's (CubeContactNode). */
+LatticeIndex ContactNode(const Scene& scene);
+
+/** True for a node on the cube's surface (some index 0 or nodes − 1). */
+bool IsSurfaceNode(const MeshSettings& mesh, const LatticeIndex& node);
+
+/** True for one of the fixed back-face corners. */
+bool IsSupportNode(const MeshSettings& mesh, const LatticeIndex& node);
+
+/**
+ * Why `node` cannot be the driven node of `mesh` — "is outside the mesh: …", "is inside the
+ * object: …", "is a fixed back corner: …" — or "" when it can (ValidateScene's check).
+ */
+std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node);
+
+/**
+ * The unit inward normal of the face a surface node lies on. Nodes on an edge or a corner belong
+ * to the first of their faces in the order front/back (z), left/right (x), bottom/top (y): the
+ * paper presses along z, so the front face wins.
+ */
+std::array<double, 3> InwardNormal(const MeshSettings& mesh, const LatticeIndex& node);
+
+/** The primary region's rate 1/solver.dt, Hz. */
+double PrimaryRateHz(const Scene& scene);
+
+/**
+ * True when a primary box of `primary_size` nodes around the scene's contact node, refined in whole
+ * coarse cells of adaptivity.secondary_lod, would cover every cell of the object.
+ */
+bool PrimaryBoxCoversObject(const Scene& scene, int primary_size);
+
+}  // namespace hapticsim

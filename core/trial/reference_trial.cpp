@@ -1,0 +1,105 @@
+#include "core/trial/reference_trial.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/fem/central_difference_integrator.hpp"
+#include "core/scene/contact_trajectory.hpp"
+
+namespace hapticsim {
+namespace {
+
+// The integrator's displacement in the lattice's order (the grid's nodes are its points).
+ObjectState LatticeState(const ElasticModel& model, const CentralDifferenceIntegrator& integrator) {
+  const HexGrid& grid = model.grid();
+  ObjectState state;
+  state.nodes_per_axis = grid.nx();
+  const int n = state.nodes_per_axis;
+  state.displacement_m.resize(static_cast<size_t>(3) * n * n * n);
+  const Eigen::VectorXd& u = integrator.displacement();
+  for (int ix = 0; ix < n; ++ix) {
+    for (int iy = 0; iy < n; ++iy) {
+      for (int iz = 0; iz < n; ++iz) {
+        const int node = grid.Node(ix, iy, iz);
+        for (int c = 0; c < 3; ++c)
+          state.displacement_m[state.Index(ix, iy, iz) + c] = u[grid.Dof(node, c)];
+      }
+    }
+  }
+  return state;
+}
+
+}  // namespace
+
+std::string_view TrialOutcomeName(TrialOutcome outcome) {
+  switch (outcome) {
+    case TrialOutcome::kCompleted:
+      return "completed";
+    case TrialOutcome::kPredictedUnstable:
+      return "predicted unstable";
+    case TrialOutcome::kDivergedNonFinite:
+      return "diverged: non-finite values";
+    case TrialOutcome::kDivergedEnergy:
+      return "diverged: energy growth";
+  }
+  return "unknown";
+}
+
+TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options) {
+  const Scene& scene = cube.scene();
+  const ElasticModel& model = cube.model();
+  TrialResult result;
+  result.stability = EstimateStability(model);
+  const double dt = scene.solver.dt_s;
+  if (!result.stability.IsStable(dt) && options.substep_to_stability) {
+    result.substeps = static_cast<int>(std::ceil(dt / (0.95 * result.stability.critical_dt_s)));
+  } else if (!result.stability.IsStable(dt) && !options.run_if_predicted_unstable) {
+    result.outcome = TrialOutcome::kPredictedUnstable;
+    return result;
+  }
+  const double h = dt / result.substeps;
+
+  CentralDifferenceIntegrator integrator(model, h);
+  const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
+  const long steps = scene.num_steps();
+  result.samples.reserve(static_cast<size_t>(steps) + 1);
+
+  const auto start = std::chrono::steady_clock::now();
+  // Period n goes from tₙ to tₙ₊₁; its first step yields the reaction at tₙ, so periods 0…N give
+  // samples 0…N.
+  std::array<double, 3> reaction_at_start{};
+  for (long n = 0; n <= steps; ++n) {
+    const double t = n * dt;
+    if (options.frames.Due(n)) options.frames.observe(t, LatticeState(model, integrator));
+    StepStatus status = StepStatus::kOk;
+    for (int q = 1; q <= result.substeps && status == StepStatus::kOk; ++q) {
+      status = integrator.Step(trajectory.DisplacementAt(t + q * h));
+      if (q == 1) {
+        for (int c = 0; c < 3; ++c) reaction_at_start[c] = integrator.driven_reaction()[c];
+      }
+    }
+    if (status != StepStatus::kOk) {
+      result.outcome = status == StepStatus::kNonFinite ? TrialOutcome::kDivergedNonFinite
+                                                        : TrialOutcome::kDivergedEnergy;
+      break;
+    }
+    ForceSample sample;
+    sample.t_s = t;
+    sample.contact_displacement_m = trajectory.DisplacementAt(t);
+    const auto& reaction = reaction_at_start;
+    double magnitude2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      sample.feedback_force_n[c] = -reaction[c];
+      magnitude2 += reaction[c] * reaction[c];
+    }
+    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(magnitude2));
+    result.samples.push_back(sample);
+    result.stopped_at_s = t;
+  }
+  result.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.steps = static_cast<long>(result.samples.size());
+  return result;
+}
+
+}  // namespace hapticsim
