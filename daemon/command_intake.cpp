@@ -40,7 +40,8 @@ void CommandIntake::DrainLcm(std::int64_t now, const Apply& apply) {
       }
       continue;
     }
-    apply(*command, "LCM");
+    // Refused by its fields (out of range, unknown): counted like every other refusal.
+    if (apply(*command, "LCM").rfind("refused:", 0) == 0) counters_.commands_refused.fetch_add(1);
   }
 }
 

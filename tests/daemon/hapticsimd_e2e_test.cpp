@@ -735,6 +735,37 @@ TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeco
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - stop).count(), 2.0) << daemon.Log();
 }
 
+// A command signed with the key but out of range is refused like any other, and counted: the
+// status said nothing of it before (only what the signature gate and the rate limit refused was).
+TEST(HapticsimdCommands, ASignedLcmCommandOutOfRangeIsRefusedAndCounted) {
+  const std::string config = Temp("command-range.toml"), key = Temp("command-range.key");
+  std::filesystem::remove(key);
+  WriteNewCommandKey(key);
+  std::ofstream(config) << "[lcm]\naccept_commands = true\ncommand_key_file = \"" << key << "\"\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config},
+                                    Temp("command-range.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  Client client;
+  ASSERT_TRUE(client.WaitForStatus([](const status_t&) { return true; }, 10)) << daemon.Log();
+  const std::int64_t before = client.LastStatus()->commands_refused;
+  const CommandKey signing = ReadCommandKey(key);
+  command_t target{};
+  target.command = command_t::SET_ERROR_TARGET;
+  target.error_target_percent = 0;  // must be in (0, 100] %
+  client.SignedCommand(target, signing);
+  EXPECT_TRUE(client.WaitForStatus(
+      [&](const status_t& s) { return s.commands_refused == before + 1; }, 5))
+      << daemon.Log();
+  target.error_target_percent = 12;
+  client.SignedCommand(target, signing);
+  EXPECT_TRUE(client.WaitForStatus(
+      [&](const status_t& s) {
+        return s.error_target_percent == 12 && s.commands_refused == before + 1;
+      },
+      5))
+      << daemon.Log();
+}
+
 // The shared-memory interface with a real second process: the example driver client.
 TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersAreKeptOut) {
   const std::string name = testing::PrivateSocketPath();
