@@ -14,7 +14,7 @@
 #include "rt/seqlock_slot.hpp"
 #include "core/regions/stability_stress.hpp"
 #include "daemon/contact_tracker.hpp"
-#include "daemon/deadline_monitor.hpp"
+#include "rt/deadline_monitor.hpp"
 #include "daemon/input_resampler.hpp"
 #include "daemon/port_guard.hpp"
 #include "rt/spsc_ring.hpp"

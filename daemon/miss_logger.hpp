@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "daemon/deadline_monitor.hpp"
+#include "rt/deadline_monitor.hpp"
 
 namespace hapticsim {
 

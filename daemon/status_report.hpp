@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/deadline_monitor.hpp"
+#include "rt/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_counters.hpp"
 #include "daemon/supervisor.hpp"

@@ -1,4 +1,4 @@
-#include "daemon/deadline_monitor.hpp"
+#include "rt/deadline_monitor.hpp"
 
 #include <cmath>
 

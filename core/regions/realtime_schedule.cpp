@@ -3,37 +3,30 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <thread>
 
+#include "rt/deadline_monitor.hpp"
 #include "rt/monotonic_clock.hpp"
 
 namespace hapticsim {
 namespace {
 
-// Per-thread record of one periodic loop, preallocated before the loop starts.
-struct LoopRecord {
-  std::vector<double> execution_s;
-  std::int64_t misses = 0;
-  double worst_lateness_s = 0;
-
-  DeadlineStats Summarise(double period_s) {
-    DeadlineStats stats;
-    stats.period_s = period_s;
-    stats.cycles = static_cast<std::int64_t>(execution_s.size());
-    stats.misses = misses;
-    stats.worst_lateness_s = worst_lateness_s;
-    if (!execution_s.empty()) {
-      std::vector<double> sorted = execution_s;
-      std::sort(sorted.begin(), sorted.end());
-      auto at = [&](double q) { return sorted[static_cast<size_t>(q * (sorted.size() - 1))]; };
-      stats.execution_p50_s = at(0.5);
-      stats.execution_p99_s = at(0.99);
-      stats.execution_max_s = sorted.back();
-    }
-    return stats;
-  }
-};
+// What the deadline statistics of a run say, from its thread's monitor (one snapshot: the
+// whole run). Percentiles are the monitor's histogram bins' upper edges, as the daemon's are.
+DeadlineStats StatsOf(DeadlineMonitor& monitor, double period_s) {
+  const DeadlineSnapshot snapshot = monitor.TakeSnapshot();
+  DeadlineStats stats;
+  stats.period_s = period_s;
+  stats.cycles = snapshot.cycles;
+  stats.misses = snapshot.misses;
+  stats.worst_lateness_s = snapshot.worst_lateness_s;
+  stats.execution_p50_s = snapshot.recent_execution_p50_s;
+  stats.execution_p99_s = snapshot.recent_execution_p99_s;
+  stats.execution_max_s = snapshot.recent_execution_max_s;
+  return stats;
+}
 
 // One thread's injected faults (TimingFaults): a stream of its own, drawn once per wake.
 class FaultDraw {
@@ -72,12 +65,12 @@ TrialResult RealTimeSchedule::RunTrial() {
   result.stability = regions_.schedule(kPrimaryRegion).alone;
   result.samples.resize(static_cast<size_t>(steps) + 1);
   // Each thread wakes once per nominal period and takes that period's substeps in a row.
-  std::vector<LoopRecord> records(static_cast<size_t>(count));
+  std::vector<std::unique_ptr<DeadlineMonitor>> monitors;
   std::vector<std::int64_t> lead_ns(static_cast<size_t>(count), 0);
   std::vector<std::int64_t> nominal_ticks(static_cast<size_t>(count), 0);
   for (int a = 0; a < count; ++a) {
     nominal_ticks[a] = regions_.period_ticks(a) * regions_.schedule(a).substeps;
-    records[a].execution_s.reserve(static_cast<size_t>(end_ticks / nominal_ticks[a] + 4));
+    monitors.push_back(std::make_unique<DeadlineMonitor>(nominal_ticks[a] * tick_ns * 1e-9));
     if (a > 0) {
       lead_ns[a] =
           lead_ns[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ticks[a - 1] * tick_ns);
@@ -92,7 +85,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   std::vector<std::thread> threads;
   for (int a = 1; a < count; ++a) {
     threads.emplace_back([&, a] {
-      LoopRecord& record = records[a];
+      DeadlineMonitor& monitor = *monitors[a];
       FaultCounts& faulted = counts[a];
       FaultDraw draw(faults_.seed, a);
       const std::int64_t period = nominal_ticks[a];
@@ -121,17 +114,12 @@ TrialResult RealTimeSchedule::RunTrial() {
           ++faulted.skips;
         }
         for (int q = 0; q < substeps; ++q) regions_.StepRegion(a);
-        const std::int64_t done = MonotonicNowNs();
-        record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
-        if (woke - release > period_ns || done > release + period_ns) ++record.misses;
-        if (record.execution_s.size() < record.execution_s.capacity()) {
-          record.execution_s.push_back((done - woke) * 1e-9);
-        }
+        monitor.Record(release, woke, MonotonicNowNs());
       }
     });
   }
 
-  LoopRecord& record = records[kPrimaryRegion];
+  DeadlineMonitor& monitor = *monitors[kPrimaryRegion];
   FaultDraw draw(faults_.seed, kPrimaryRegion);
   const double period_ns = primary_period_ticks * tick_ns;
   for (long n = 0; n <= steps; ++n) {
@@ -153,10 +141,7 @@ TrialResult RealTimeSchedule::RunTrial() {
           regions_.StepPrimary(trajectory.DisplacementAt(t + q * dt / primary_substeps));
       if (q == 1) r = rq;
     }
-    const std::int64_t done = MonotonicNowNs();
-    record.worst_lateness_s = std::max(record.worst_lateness_s, (woke - release) * 1e-9);
-    if (woke - release > period_ns || done > release + period_ns) ++record.misses;
-    record.execution_s.push_back((done - woke) * 1e-9);
+    monitor.Record(release, woke, MonotonicNowNs());
 
     ForceSample& sample = result.samples[static_cast<size_t>(n)];
     sample.t_s = t;
@@ -179,7 +164,7 @@ TrialResult RealTimeSchedule::RunTrial() {
   for (const FaultCounts& c : counts) counts_ += c;
   for (int a = 0; a < count; ++a) {
     result.wall_time_s += regions_.compute_seconds(a);
-    stats_.push_back(records[a].Summarise(stretch_ / regions_.schedule(a).rate_hz));
+    stats_.push_back(StatsOf(*monitors[a], stretch_ / regions_.schedule(a).rate_hz));
   }
   return result;
 }

@@ -8,7 +8,8 @@
 
 namespace hapticsim {
 
-/** Deadline statistics of one periodic thread. */
+/** Deadline statistics of one periodic thread over a run, as its DeadlineMonitor kept them
+ *  (rt/deadline_monitor.hpp, the daemon's too): percentiles are its bins' upper edges, 25 % wide. */
 struct DeadlineStats {
   double period_s = 0;          ///< wall-clock period, s
   std::int64_t cycles = 0;

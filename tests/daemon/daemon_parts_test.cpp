@@ -11,7 +11,7 @@
 #include "core/error.hpp"
 #include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
-#include "daemon/deadline_monitor.hpp"
+#include "rt/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
 #include "daemon/overload_watch.hpp"
