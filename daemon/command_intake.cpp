@@ -13,8 +13,8 @@ CommandIntake::CommandIntake(LcmBridge* bridge, ControlServer* control, InputCou
                              const DaemonConfig& config)
     : bridge_(bridge), control_(control), counters_(counters), config_(config) {}
 
-bool CommandIntake::LineDue(std::int64_t now) const {
-  return hapticsim::LineDue(now, last_refusal_line_ns_, config_.max_log_lines_per_s);
+bool CommandIntake::RefusalLineDue(std::int64_t now) const {
+  return LineDue(now, last_refusal_line_ns_, config_.max_log_lines_per_s);
 }
 
 void CommandIntake::Drain(std::int64_t now, const Apply& apply) {
@@ -24,7 +24,7 @@ void CommandIntake::Drain(std::int64_t now, const Apply& apply) {
 
 void CommandIntake::DrainLcm(std::int64_t now, const Apply& apply) {
   if (const LcmBridge::Refusals refusals = bridge_->CommandRefusals();
-      refusals.count != lcm_refusals_logged_ && LineDue(now)) {
+      refusals.count != lcm_refusals_logged_ && RefusalLineDue(now)) {
     last_refusal_line_ns_ = now;
     lcm_refusals_logged_ = refusals.count;
     spdlog::warn("command on {} refused: {}; {} refused so far", config_.command_channel,
@@ -33,7 +33,7 @@ void CommandIntake::DrainLcm(std::int64_t now, const Apply& apply) {
   while (std::optional<command_t> command = bridge_->PopCommand()) {
     if (!lcm_limit_.Admit(now)) {
       counters_.commands_refused.fetch_add(1);
-      if (LineDue(now)) {
+      if (RefusalLineDue(now)) {
         last_refusal_line_ns_ = now;
         spdlog::warn("command refused: more than {} a second ({} refused so far)",
                      CommandRateLimit::kPerSecond, lcm_limit_.refused());
@@ -68,7 +68,7 @@ void CommandIntake::DrainControl(std::int64_t now, const Apply& apply) {
     counters_.commands_refused.fetch_add(control_->refused() - control_refused_seen_);
     control_refused_seen_ = control_->refused();
   }
-  if (control_->refused() != control_refused_logged_ && LineDue(now)) {
+  if (control_->refused() != control_refused_logged_ && RefusalLineDue(now)) {
     last_refusal_line_ns_ = now;
     control_refused_logged_ = control_->refused();
     spdlog::warn("control socket: refused {} ({} refused so far)", control_->last_refusal(),

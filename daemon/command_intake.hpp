@@ -36,7 +36,7 @@ class CommandIntake {
  private:
   void DrainLcm(std::int64_t now_ns, const Apply& apply);
   void DrainControl(std::int64_t now_ns, const Apply& apply);
-  bool LineDue(std::int64_t now_ns) const;
+  bool RefusalLineDue(std::int64_t now_ns) const;
 
   LcmBridge* bridge_;
   ControlServer* control_;

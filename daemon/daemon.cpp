@@ -9,9 +9,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/fem/cpu_dispatch.hpp"
 #include "core/error.hpp"
 #include "core/errormap/error_sweep.hpp"
+#include "core/fem/cpu_dispatch.hpp"
 #include "daemon/error_map_loading.hpp"
 #include "daemon/status_report.hpp"
 #include "daemon/supervisor.hpp"
@@ -122,9 +122,9 @@ void Daemon::SayDeviceEnvelope() const {
   spdlog::info(
       "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage ramp "
       "{} N/ms, fault above {} N or a {} s primary stall, passivity {}",
-      DeviceInputOf(config_) == "shm" ? "shared memory" : "LCM", config_.port.max_force_n,
-      config_.port.max_force_rate_n_per_ms, config_.port.engage_rate_n_per_ms,
-      config_.port.fault_force_n, config_.port.watchdog_s, config_.port.passivity ? "on" : "off");
+      DeviceInputName(config_), config_.port.max_force_n, config_.port.max_force_rate_n_per_ms,
+      config_.port.engage_rate_n_per_ms, config_.port.fault_force_n, config_.port.watchdog_s,
+      config_.port.passivity ? "on" : "off");
 }
 
 int Daemon::Run(const sigset_t& signals) {
@@ -171,8 +171,9 @@ long Daemon::Tick(std::int64_t now) {
   });
   const bool move_soon = supervisor_->Tick(now);
   if (events_->ReadFaults(now)) supervisor_->RestartFromRest("force fault");
-  if (now >= next_status_ns_) UpdateStatus(now);
-  health_->Report(now, health_->Stalled(now, HealthSigns()));
+  const std::vector<Stall> stalls = health_->Stalled(now, HealthSigns());
+  if (now >= next_status_ns_) UpdateStatus(now, stalls);
+  health_->Report(now, stalls);
   return move_soon ? kTickBeforeAMove_ns : kTick_ns;
 }
 
@@ -181,7 +182,7 @@ ServiceHealth::Signs Daemon::HealthSigns() const {
           supervisor_->check_running_since_ns()};
 }
 
-void Daemon::UpdateStatus(std::int64_t now) {
+void Daemon::UpdateStatus(std::int64_t now, const std::vector<Stall>& stalls) {
   next_status_ns_ = now + static_cast<std::int64_t>(1e9 / config_.status_rate_hz);
   std::vector<DeadlineSnapshot> snapshots;
   for (int r = 0; r < loop_->regions().num_regions(); ++r) {
@@ -190,7 +191,7 @@ void Daemon::UpdateStatus(std::int64_t now) {
   last_status_ = MakeStatus(*loop_, snapshots, supervisor_->Shown(), supervisor_->target_percent(),
                             supervisor_->pinned(), supervisor_->map_path(), &counters_);
   last_status_.input_owner = DeviceInputOf(config_);
-  last_status_.stalled_threads = DescribeStalls(health_->Stalled(now, HealthSigns()));
+  last_status_.stalled_threads = DescribeStalls(stalls);
   if (bridge_) bridge_->PostStatus(last_status_);
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "daemon/command_intake.hpp"
 #include "daemon/configuration_supervisor.hpp"
@@ -75,7 +76,7 @@ class Daemon {
  private:
   void StartTransports();
   void SayDeviceEnvelope() const;
-  void UpdateStatus(std::int64_t now_ns);
+  void UpdateStatus(std::int64_t now_ns, const std::vector<Stall>& stalls);
   ServiceHealth::Signs HealthSigns() const;
 
   const DaemonArguments args_;

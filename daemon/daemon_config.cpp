@@ -312,6 +312,10 @@ std::string DeviceInputOf(const DaemonConfig& config) {
   return config.shm_enabled ? "shm" : "lcm";
 }
 
+const char* DeviceInputName(const DaemonConfig& config, bool other) {
+  return (DeviceInputOf(config) == "shm") != other ? "shared memory" : "LCM";
+}
+
 DaemonConfig DefaultDaemonConfig() {
   DaemonConfig config;
   DefaultAdaptivity(&config.scene);

@@ -88,6 +88,9 @@ DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& o
 
 /** The transport that owns the device input: device.input, or its default. */
 std::string DeviceInputOf(const DaemonConfig& config);
+/** As the log names it: "shared memory" or "LCM", the transport that owns the device input, or
+ *  with `other` the one that does not. */
+const char* DeviceInputName(const DaemonConfig& config, bool other = false);
 
 /**
  * Why `url` may not be lcm.url, or "" if it may: a provider LCM has (udpm, mpudpm, tcpq, memq,

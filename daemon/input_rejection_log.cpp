@@ -8,11 +8,10 @@
 namespace hapticsim {
 
 InputRejectionLog::InputRejectionLog(InputCounters& counters, const DaemonConfig& config)
-    : counters_(counters), config_(config) {
-  const bool shm_owns_input = DeviceInputOf(config) == "shm";
-  owner_name_ = shm_owns_input ? "shared memory" : "LCM";
-  other_name_ = shm_owns_input ? "LCM" : "shared memory";
-}
+    : counters_(counters),
+      config_(config),
+      owner_name_(DeviceInputName(config)),
+      other_name_(DeviceInputName(config, true)) {}
 
 void InputRejectionLog::Read(std::int64_t now) {
   const bool may_log = LineDue(now, last_line_ns_, config_.max_log_lines_per_s);
