@@ -60,14 +60,21 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
   supervisor.join();
   loop.Stop();
   EXPECT_GT(loop.paused_periods(), 0);
-  // One answer per release: the primary's release grid from the first answer to the last.
+  // One answer per release: the primary's release grid from the first answer to the last. An
+  // answer is stamped when its period ends, at most (worst lateness + longest step) after its
+  // release, so the span between the first and last stamps is the releases between them give or
+  // take that much. A stop and restart would lose at least 5 periods per reconfiguration, 30 here.
   ASSERT_GT(forces.size(), 100u);
   const double span_periods = (forces.back().utime_us - forces.front().utime_us) / 1000.0;
-  // (A period woken late stretches the span a little; a stop and restart would lose at least 5
-  // periods per reconfiguration, 30 here.)
+  const DeadlineSnapshot primary = loop.monitor(kPrimaryRegion).TakeSnapshot();
+  const double stamp_delay_periods =
+      (primary.worst_lateness_s + primary.recent_execution_max_s) / primary.period_s;
   EXPECT_NEAR(static_cast<double>(forces.size()) - 1, span_periods,
-              std::max(2.0, 0.005 * span_periods))
-      << "answers lost or doubled across " << replaced << " reconfigurations";
+              std::max(2.0, 0.005 * span_periods) + stamp_delay_periods)
+      << "answers lost or doubled across " << replaced << " reconfigurations (the stamps lag"
+      << " their releases by up to " << stamp_delay_periods << " periods)";
+  EXPECT_LT(stamp_delay_periods, 25) << "the primary lagged too far for the count to tell";
+  EXPECT_EQ(loop.forces().dropped(), 0u) << "the answer ring overflowed";
   for (size_t i = 1; i < forces.size(); ++i) ASSERT_GE(forces[i].seq, forces[i - 1].seq);
 }
 
