@@ -10,7 +10,6 @@
 
 #include "core/error.hpp"
 #include "rt/monotonic_clock.hpp"
-#include "rt/futex.hpp"
 
 namespace hapticsim {
 namespace {
@@ -60,7 +59,7 @@ std::array<double, 3> HapticLoop::StepPrimaryPeriod(
 }
 
 std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
-  const std::int64_t code = wanted_node_code_.load(std::memory_order_relaxed);
+  const std::int64_t code = counters_.wanted_node_code.value();
   if (code < 0) return std::nullopt;
   const std::int64_t n = nodes_;
   return LatticeIndex{static_cast<int>(code / (n * n)), static_cast<int>(code / n % n),
@@ -68,54 +67,34 @@ std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
 }
 
 void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcept {
-  error_percent_.store(error_percent, std::memory_order_relaxed);
-  error_flags_.store(flags, std::memory_order_relaxed);
+  error_percent_.Set(error_percent);
+  error_flags_.Set(flags);
 }
 
-void HapticLoop::OfferInput(const DeviceSample& sample) noexcept {
-  // The slot first: a primary that sees the ring's drop count move then finds this input (or a
-  // newer one) in it. A full ring (a primary stalled for 256 inputs) drops it; the slot has it.
-  input_.Write(sample);
-  inputs_.Push(sample);
-  // Sequentially consistent with the primary's waiting flag: either it sees this arrival before
-  // it waits, or this sees it waiting and wakes it.
-  input_arrivals_.fetch_add(1);
-  if (primary_waiting_.load()) FutexWakeAll(&input_arrivals_);
-}
+void HapticLoop::OfferInput(const DeviceSample& sample) noexcept { inputs_.Offer(sample); }
 
 std::int64_t HapticLoop::primary_alive_ns() const {
   return std::max(monitors_[kPrimaryRegion]->last_done_ns(),
-                  alive_ns_.load(std::memory_order_relaxed));
+                  counters_.alive_ns.value());
 }
 
 void HapticLoop::WaitForInput() noexcept {
-  primary_waiting_.store(true);
-  // An input offered since the period read the slot, a reconfiguration or a stop: no wait.
-  if (input_arrivals_.load() == arrivals_seen_ && !stop_.load() &&
-      !pause_requested_.load(std::memory_order_acquire)) {
-    FutexWait(&input_arrivals_, arrivals_seen_, kIdleWait_s);
-  }
-  primary_waiting_.store(false);
-  alive_ns_.store(NowNs(), std::memory_order_relaxed);
+  // Not at all after an input offered since the period took its inputs, a reconfiguration or a
+  // stop.
+  inputs_.WaitForArrival(kIdleWait_s,
+                         [this] { return stop_.load() || handover_.pause_requested(); });
+  counters_.alive_ns.Set(NowNs());
 }
 
 void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noexcept {
-  arrivals_seen_ = input_arrivals_.load();
-  DeviceSample sample;
-  // At most the ring's worth: a producer pushing as fast as this pops cannot hold the period.
-  for (std::size_t n = 0; n < kInputRingSize && inputs_.Pop(&sample); ++n) TakeInput(sample);
-  // The ring was full: the newest input still counts (the ones in between are lost).
-  if (inputs_.dropped() != inputs_dropped_seen_ && input_.Read(&sample)) {
-    inputs_dropped_seen_ = inputs_.dropped();
-    TakeInput(sample);
-  }
+  inputs_.Drain([this](const DeviceSample& sample) { TakeInput(sample); });
   const bool have = last_input_.seq >= 0;
   const bool stale =
       !have || static_cast<double>(now_ns - last_input_.received_ns) > options_.stale_after_s * 1e9;
-  std::int32_t flags = error_flags_.load(std::memory_order_relaxed);
+  std::int32_t flags = error_flags_.value();
   if (stale) {
     flags |= force_flags::kInputStale;
-    if (have) stale_periods_.fetch_add(1, std::memory_order_relaxed);
+    if (have) counters_.stale_periods.Add();
   }
   if (last_input_.latest_rejected) flags |= force_flags::kInputRejected;
 
@@ -126,7 +105,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     holding_ = false;
     ApplyRestart(release_ns);
   } else {
-    paused_periods_.fetch_add(1, std::memory_order_relaxed);
+    counters_.paused_periods.Add();
     flags |= force_flags::kReconfiguring;
   }
 
@@ -143,11 +122,11 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   if (usable) engaged_ = in_contact;
   if (!contact.engaged) holding_ = false;  // lifted off while held: a new touch is not held
   if (contact.waiting) flags |= force_flags::kReconfiguring;
-  contact_waiting_.store(contact.waiting, std::memory_order_relaxed);
+  counters_.contact_waiting.Set(contact.waiting);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
   const std::int64_t n = nodes_;
-  wanted_node_code_.store(wanted ? ((*wanted)[0] * n + (*wanted)[1]) * n + (*wanted)[2] : -1,
-                          std::memory_order_relaxed);
+  counters_.wanted_node_code.Set(wanted ? ((*wanted)[0] * n + (*wanted)[1]) * n + (*wanted)[2]
+                                        : -1);
 
   std::array<double, 3> reaction{};
   if (usable) {
@@ -167,7 +146,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   } else if (holding) {
     reaction = held_reaction_;
   }
-  idle_.store(usable && sleep_state_ == kAsleep && stale, std::memory_order_relaxed);
+  counters_.idle.Set(usable && sleep_state_ == kAsleep && stale);
   const bool render = in_contact && !(stale && options_.zero_force_when_stale);
   PortGuard::Input port;
   port.now_ns = now_ns;
@@ -184,51 +163,49 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   UpdateFaultState(sent);
   if (sent.limited) {
     flags |= force_flags::kForceLimited;
-    limited_periods_.fetch_add(1, std::memory_order_relaxed);
+    counters_.limited_periods.Add();
   }
   if (sent.dissipating) {
     flags |= force_flags::kPortDissipating;
-    dissipating_periods_.fetch_add(1, std::memory_order_relaxed);
+    counters_.dissipating_periods.Add();
   }
   if (sent.latched) flags |= force_flags::kFaultLatched;
   if (in_contact) {
     flags |= force_flags::kInContact;
-    last_contact_ns_.store(now_ns, std::memory_order_relaxed);
+    counters_.last_contact_ns.Set(now_ns);
   }
   PublishPeriod(now_ns, sent.force_n, port.simulated_n, flags);
 }
 
 bool HapticLoop::RegionsAreOurs(std::int64_t release_ns) noexcept {
-  if (pause_requested_.load(std::memory_order_acquire)) {
+  bool pause_began = false;
+  const RegionHandover::Period period = handover_.Check(release_ns, &pause_began);
+  if (pause_began) {
     // Paused to carry the motion to new regions, a contact engaged until now keeps its node and
     // the force it had, until they take over (at most kMaxHold_s); any other contact gets none.
-    if (!paused_.load(std::memory_order_relaxed)) {
-      holding_ = hold_force_while_paused_.load(std::memory_order_relaxed) && engaged_;
-      held_periods_ = 0;
-    }
-    paused_.store(true, std::memory_order_release);
-    return false;
+    holding_ = handover_.hold_force() && engaged_;
+    held_periods_ = 0;
   }
-  return release_ns >= resume_at_ns_.load(std::memory_order_acquire);  // new regions start there
+  return period == RegionHandover::Period::kOurs;
 }
 
 void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
-  switch (restart_kind_.exchange(kNoRestart, std::memory_order_acq_rel)) {
-    case kRestartFromRest:
+  switch (handover_.TakeRestart()) {
+    case RegionRestart::kFromRest:
       contact_.RestartFromRest();
       restarted_since_fault_ = guard_.latched();
       guard_.Reengage();
       break;
-    case kRestartKeepingContact:
+    case RegionRestart::kKeepingContact:
       contact_.RestartKeepingContact();
       guard_.Reengage();
       break;
-    case kRestartCarryingMotion:
+    case RegionRestart::kCarryingMotion:
       // The new regions hold the contact where the last period before the pause left it.
       contact_.CatchUpFrom(regions_->primary_contact_m(),
                            release_ns - static_cast<std::int64_t>(primary_period_ns_));
       break;
-    default:
+    case RegionRestart::kNone:
       return;
   }
   balance_peak_stored_j_ = 0;  // the balance starts afresh with the new regions
@@ -246,7 +223,7 @@ void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>&
   first_taken_seq_ = -1;
   taken_in_sequence_ = true;
   out.utime_us = now_ns / 1000;
-  out.error_percent = error_percent_.load(std::memory_order_relaxed);
+  out.error_percent = error_percent_.value();
   out.force_n = force_n;
   out.flags = flags;
   forces_.Push(out);
@@ -278,41 +255,37 @@ void HapticLoop::TakeInput(const DeviceSample& sample) noexcept {
 
 void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
   if (sent.new_fault != PortGuard::Fault::kNone) {
-    last_fault_.store(static_cast<int>(sent.new_fault), std::memory_order_relaxed);
-    fault_latched_.store(true, std::memory_order_relaxed);
+    counters_.last_fault.Set(static_cast<int>(sent.new_fault));
+    counters_.fault_latched.Set(true);
     restarted_since_fault_ = false;
-    force_faults_.fetch_add(1, std::memory_order_relaxed);  // the supervisor restarts the regions
+    counters_.force_faults.Add();  // the supervisor restarts the regions
   }
   // Re-armed only from rest with the tool out of the object: the next touch engages from zero.
   if (guard_.latched() && restarted_since_fault_ && contact_.outside()) {
     guard_.Rearm();
     restarted_since_fault_ = false;
-    fault_latched_.store(false, std::memory_order_relaxed);
-    rearms_.fetch_add(1, std::memory_order_relaxed);
+    counters_.fault_latched.Set(false);
+    counters_.rearms.Add();
   }
-  port_dissipated_j_.store(guard_.dissipated_j(), std::memory_order_relaxed);
+  counters_.port_dissipated_j.Set(guard_.dissipated_j());
 }
 
 void HapticLoop::WatchEnergyBalance() noexcept {
   const AsyncRegions::PublishedBalanceView balance = regions_->PublishedBalance();
   balance_peak_stored_j_ = std::max(balance_peak_stored_j_, balance.stored_j);
-  interface_backlog_j_.store(balance.backlog_j, std::memory_order_relaxed);
-  if (balance.backlog_j > interface_backlog_max_j_.load(std::memory_order_relaxed)) {
-    interface_backlog_max_j_.store(balance.backlog_j, std::memory_order_relaxed);
-  }
+  counters_.interface_backlog_j.Set(balance.backlog_j);
+  counters_.interface_backlog_max_j.RaiseTo(balance.backlog_j);
   const double scale = std::max(balance_peak_stored_j_, regions_->port_floor_j());
   // Above the reserve the primary leaves to the shells by design, as EnergyAboveBound counts.
   if (balance.backlog_j - balance.primary_reserve_j > kBacklogTolerance * scale) {
-    balance_violations_.fetch_add(1, std::memory_order_relaxed);
+    counters_.balance_violations.Add();
   }
   // Once per set of regions: the supervisor takes them off this configuration (release: the
   // regions it reads with the count are the ones that ran away).
   if (!runaway_seen_ && regions_->RunawayHeld(balance, &runaway_periods_)) {
     runaway_seen_ = true;
-    runaway_state_j_.store(balance.state_energy_j, std::memory_order_relaxed);
-    runaway_allowed_j_.store(std::max(balance.allowed_j, regions_->port_floor_j()),
-                             std::memory_order_relaxed);
-    runaways_.fetch_add(1, std::memory_order_release);
+    counters_.PublishRunaway(
+        {balance.state_energy_j, std::max(balance.allowed_j, regions_->port_floor_j())});
   }
 }
 
@@ -326,7 +299,7 @@ void HapticLoop::PrimaryThread(std::int64_t origin_ns) {
     const std::int64_t woke = NowNs();
     PrimaryPeriod(release, woke);
     monitor.Record(release, woke, NowNs());
-    if (idle_.load(std::memory_order_relaxed)) {
+    if (counters_.idle.value()) {
       // Asleep and no device: nothing to answer until an input arrives. Then back on the release
       // grid at its next release (the periods waited through had nothing to answer).
       WaitForInput();
@@ -343,13 +316,10 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
   const double period_ns = 1e9 / regions_->schedule(region).rate_hz;
   std::int64_t woken_ns = 0;  // when it last came out of parking
   while (!stop_secondaries_.load(std::memory_order_acquire)) {
-    const std::uint32_t generation = wake_generation_.load(std::memory_order_acquire);
+    const std::uint32_t generation = parking_.generation();
     if (!SecondaryMayStep(region)) {
-      while (wake_generation_.load(std::memory_order_acquire) == generation &&
-             !stop_secondaries_.load(std::memory_order_acquire)) {
-        FutexWait(&wake_generation_, generation, kIdleWait_s);
-      }
-      const std::int64_t wake_origin = wake_origin_ns_.load(std::memory_order_relaxed);
+      const std::int64_t wake_origin =
+          parking_.WaitForWake(generation, stop_secondaries_, kIdleWait_s);
       if (wake_origin >= 0) origin_ns = wake_origin;  // the regions restart from rest there
       woken_ns = NowNs();
       continue;
@@ -369,8 +339,8 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
     const auto missed = static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
     if (missed > kSkipAfterLatePeriods) {
       regions_->SkipRegion(region, missed * substeps);
-      skipped_periods_[region].fetch_add(missed, std::memory_order_relaxed);
-      stalls_[region].fetch_add(1, std::memory_order_relaxed);
+      counters_.skipped_periods[region].Add(missed);
+      counters_.stalls[region].Add();
     }
     for (int q = 0; q < substeps; ++q) regions_->StepRegion(region);
     monitor.Record(release, woke, NowNs());
@@ -387,8 +357,7 @@ void HapticLoop::StartSecondaries(std::int64_t origin_ns) {
 
 void HapticLoop::StopSecondaries() {
   stop_secondaries_ = true;
-  wake_generation_.fetch_add(1);  // parked ones come round and see the stop
-  FutexWakeAll(&wake_generation_);
+  parking_.WakeAll();  // parked ones come round and see the stop
   for (std::thread& thread : secondary_threads_) {
     if (thread.joinable()) thread.join();
   }
@@ -399,12 +368,10 @@ std::string HapticLoop::Start() {
   if (running_) return "";
   regions_->Reset();
   ForgetSleep();
-  restart_kind_ = kRestartFromRest;
-  pause_requested_ = false;
   stop_ = false;
   const std::int64_t origin_ns = NowNs() + 5'000'000 + lead_ns_.back();
   origin_ns_ = origin_ns;
-  resume_at_ns_ = origin_ns;
+  handover_.Reset(RegionRestart::kFromRest, origin_ns);
   primary_thread_ = std::thread([this, origin_ns] { PrimaryThread(origin_ns); });
   std::string refused = ApplyRealtimeSettings(primary_thread_);
   StartSecondaries(origin_ns);
@@ -436,8 +403,7 @@ std::string HapticLoop::ApplyRealtimeSettings(std::thread& thread) const {
 
 void HapticLoop::Stop() {
   stop_ = true;
-  input_arrivals_.fetch_add(1);  // an idle primary waiting for input comes round now
-  FutexWakeAll(&input_arrivals_);
+  inputs_.Nudge();  // an idle primary waiting for input comes round now
   if (primary_thread_.joinable()) primary_thread_.join();
   StopSecondaries();
   running_ = false;

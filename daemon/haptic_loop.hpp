@@ -11,23 +11,18 @@
 #include <vector>
 
 #include "core/regions/async_regions.hpp"
-#include "rt/seqlock_slot.hpp"
 #include "core/regions/stability_stress.hpp"
 #include "daemon/contact_tracker.hpp"
-#include "rt/deadline_monitor.hpp"
+#include "daemon/input_handoff.hpp"
 #include "daemon/input_resampler.hpp"
+#include "daemon/loop_counters.hpp"
 #include "daemon/port_guard.hpp"
+#include "daemon/region_handover.hpp"
+#include "daemon/secondary_parking.hpp"
+#include "rt/deadline_monitor.hpp"
 #include "rt/spsc_ring.hpp"
 
 namespace hapticsim {
-
-/** The newest accepted device input, as the I/O thread hands it to the primary thread. */
-struct DeviceSample {
-  std::int64_t seq = -1;
-  std::int64_t received_ns = 0;  ///< CLOCK_MONOTONIC when it arrived
-  std::array<double, 3> position_m{};
-  bool latest_rejected = false;  ///< the newest message after this one was refused
-};
 
 /** One primary period's answer, as the primary thread hands it to the I/O thread. */
 struct ForceRecord {
@@ -174,15 +169,15 @@ class HapticLoop {
   /** The node the tool wants the regions centred on (see ContactTracker::wanted_node). */
   std::optional<LatticeIndex> wanted_contact_node() const;
   /** True while the tip is inside on a node the regions are not centred on (force zero). */
-  bool contact_waiting() const { return contact_waiting_.load(std::memory_order_relaxed); }
+  bool contact_waiting() const { return counters_.contact_waiting.value(); }
   /** The node the regions are centred on. Supervisor thread only. */
   const LatticeIndex& centre_node() const { return centre_; }
   /** Regions replaced since the loop was made (Reconfigure calls that took effect). */
   std::int64_t reconfigurations() const { return reconfigurations_; }
   /** Primary periods answered while the regions were paused for a reconfiguration. */
-  std::int64_t paused_periods() const { return paused_periods_.load(std::memory_order_relaxed); }
+  std::int64_t paused_periods() const { return counters_.paused_periods.value(); }
   /** CLOCK_MONOTONIC of the last primary period in contact, ns (0: never). */
-  std::int64_t last_contact_ns() const { return last_contact_ns_.load(std::memory_order_relaxed); }
+  std::int64_t last_contact_ns() const { return counters_.last_contact_ns.value(); }
   bool running() const { return running_.load(); }
 
   /**
@@ -192,14 +187,14 @@ class HapticLoop {
    */
   void OfferInput(const DeviceSample& sample) noexcept;
   /** True while the regions sleep at rest (not stepped; the secondary threads parked). */
-  bool asleep() const { return asleep_.load(std::memory_order_relaxed); }
+  bool asleep() const { return counters_.asleep.value(); }
   /**
    * True while asleep with no fresh input: the primary thread waits for an input instead of
    * running periods, and the I/O thread may wait longer between polls.
    */
-  bool idle() const { return idle_.load(std::memory_order_relaxed); }
+  bool idle() const { return counters_.idle.value(); }
   /** Times the regions went to sleep since the loop was made. */
-  std::int64_t sleeps() const { return sleeps_.load(std::memory_order_relaxed); }
+  std::int64_t sleeps() const { return counters_.sleeps.value(); }
   /**
    * CLOCK_MONOTONIC of the primary thread's last sign of life, ns: a period done, or a wait for
    * input that came round (at least every kIdleWait_s). 0 before the first period.
@@ -215,30 +210,26 @@ class HapticLoop {
   DeadlineMonitor& monitor(RegionIndex region) { return *monitors_[region]; }
   const AsyncRegions& regions() const { return *regions_; }
   /** Primary periods run on stale input. */
-  std::int64_t stale_periods() const { return stale_periods_.load(std::memory_order_relaxed); }
+  std::int64_t stale_periods() const { return counters_.stale_periods.value(); }
   /**
    * Faults the port guard latched (non-finite or diverging force, a stalled primary), and the
    * re-arms since: a latched fault holds the force at zero until the regions have restarted from
    * rest (the supervisor's RestartFromRest) and the tool is out of the object.
    */
-  std::int64_t force_faults() const { return force_faults_.load(std::memory_order_relaxed); }
-  std::int64_t rearms() const { return rearms_.load(std::memory_order_relaxed); }
-  bool fault_latched() const { return fault_latched_.load(std::memory_order_relaxed); }
+  std::int64_t force_faults() const { return counters_.force_faults.value(); }
+  std::int64_t rearms() const { return counters_.rearms.value(); }
+  bool fault_latched() const { return counters_.fault_latched.value(); }
   /** The kind of the newest latched fault (PortGuard::Fault). */
   PortGuard::Fault last_fault() const {
-    return static_cast<PortGuard::Fault>(last_fault_.load(std::memory_order_relaxed));
+    return static_cast<PortGuard::Fault>(counters_.last_fault.value());
   }
   /** Periods whose force the guard limited (envelope, ramp, slew) or dissipated energy from. */
-  std::int64_t limited_periods() const { return limited_periods_.load(std::memory_order_relaxed); }
-  std::int64_t dissipating_periods() const {
-    return dissipating_periods_.load(std::memory_order_relaxed);
-  }
+  std::int64_t limited_periods() const { return counters_.limited_periods.value(); }
+  std::int64_t dissipating_periods() const { return counters_.dissipating_periods.value(); }
   const PortGuardSettings& port_settings() const { return options_.port; }
   bool port_guard_off() const { return options_.port_guard_off; }
   /** Energy the port guard's passivity controller has dissipated, J. */
-  double port_energy_dissipated_j() const {
-    return port_dissipated_j_.load(std::memory_order_relaxed);
-  }
+  double port_energy_dissipated_j() const { return counters_.port_dissipated_j.value(); }
   /**
    * The coupling's own energy balance, watched every primary period (AsyncRegions::
    * PublishedBalance): what the interface observers hold now and the most since the loop was
@@ -247,38 +238,27 @@ class HapticLoop {
    * started from rest (at least their port floor): energy the exchanges created faster than the
    * controllers took it out. Any thread.
    */
-  double interface_backlog_j() const {
-    return interface_backlog_j_.load(std::memory_order_relaxed);
-  }
-  double interface_backlog_max_j() const {
-    return interface_backlog_max_j_.load(std::memory_order_relaxed);
-  }
-  std::int64_t energy_balance_violations() const {
-    return balance_violations_.load(std::memory_order_relaxed);
-  }
+  double interface_backlog_j() const { return counters_.interface_backlog_j.value(); }
+  double interface_backlog_max_j() const { return counters_.interface_backlog_max_j.value(); }
+  std::int64_t energy_balance_violations() const { return counters_.balance_violations.value(); }
   /**
    * Sets of regions whose state outgrew what the energy balance allows (AsyncRegions::Runaway,
    * watched every primary period; counted once per set of regions): the supervisor moves the
    * regions off that configuration to equal rates. Any thread.
    */
-  std::int64_t runaways() const { return runaways_.load(std::memory_order_acquire); }
+  std::int64_t runaways() const { return counters_.runaways(); }
   /** The last runaway's state energy and what the balance allowed then, J (read after runaways()
    *  rose: stored before its count is released). */
-  RunawayEnergies last_runaway() const {
-    return {runaway_state_j_.load(std::memory_order_relaxed),
-            runaway_allowed_j_.load(std::memory_order_relaxed)};
-  }
+  RunawayEnergies last_runaway() const { return counters_.last_runaway(); }
   /** The stress test's tolerance for a controlled exchange (StressOutcome::kGrowingBacklog). */
   static constexpr double kBacklogTolerance = StressOutcome::kGrowingBacklog;
   /**
    * A secondary region's stalls (woke more than kSkipAfterLatePeriods of its periods late) and the
    * periods it skipped holding its state, since the loop was made. Any thread.
    */
-  std::int64_t stalls(RegionIndex region) const {
-    return stalls_[region].load(std::memory_order_relaxed);
-  }
+  std::int64_t stalls(RegionIndex region) const { return counters_.stalls[region].value(); }
   std::int64_t skipped_periods(RegionIndex region) const {
-    return skipped_periods_[region].load(std::memory_order_relaxed);
+    return counters_.skipped_periods[region].value();
   }
   /** A secondary region woken more periods late than this skips them instead of stepping them. */
   static constexpr int kSkipAfterLatePeriods = AsyncRegions::kSkipAfterLatePeriods;
@@ -359,27 +339,20 @@ class HapticLoop {
   // [0] the primary's (kept across reconfigurations: its period never changes), then one per
   // secondary region of the installed regions.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
-  static constexpr std::size_t kInputRingSize = 256;
-  SpscRing<DeviceSample, kInputRingSize> inputs_;  // every input offered, in order
-  SeqlockSlot<DeviceSample> input_;                // the newest, for when the ring was full
-  ForceRing forces_;
-  BlackBoxRing black_box_;
-  std::atomic<double> error_percent_{-1};
-  std::atomic<std::int32_t> error_flags_{0};
-  std::atomic<std::int64_t> stale_periods_{0}, force_faults_{0}, last_contact_ns_{0},
-      paused_periods_{0}, rearms_{0}, limited_periods_{0}, dissipating_periods_{0};
-  std::atomic<bool> fault_latched_{false};
-  std::atomic<int> last_fault_{0};
-  std::atomic<double> port_dissipated_j_{0};
-  std::atomic<double> interface_backlog_j_{0}, interface_backlog_max_j_{0};
-  std::atomic<std::int64_t> balance_violations_{0};
+  // The loop's protocols between its threads, one type each (see each one's memory order):
+  InputHandoff inputs_;                        // I/O → primary: every input, and the idle wait
+  ForceRing forces_;                           // primary → I/O: the answers
+  BlackBoxRing black_box_;                     // primary → supervisor: every period's record
+  RegionHandover handover_;                    // supervisor ↔ primary: a reconfiguration
+  SecondaryParking<kMaxRegions> parking_;      // primary ↔ secondaries: sleeping at rest
+  LoopCounters<kMaxRegions> counters_;         // region threads → anyone: counts and gauges
+  // Supervisor → primary: the error and flags every answer carries (each a value of its own).
+  Relaxed<double> error_percent_{-1};
+  Relaxed<std::int32_t> error_flags_{0};
   double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
   bool runaway_seen_ = false;         // primary thread: these regions' runaway is counted
   int runaway_periods_ = 0;           // primary thread: periods in a row above the watch's line
-  std::atomic<std::int64_t> runaways_{0};
-  std::atomic<double> runaway_state_j_{0}, runaway_allowed_j_{0};
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
-  std::array<std::atomic<std::int64_t>, kMaxRegions> stalls_{}, skipped_periods_{};
   std::thread primary_thread_;
   std::vector<std::thread> secondary_threads_;
   std::vector<std::int64_t> lead_ns_;
@@ -393,18 +366,6 @@ class HapticLoop {
   std::mutex surface_mutex_;
   std::int64_t installs_ = 0;  // under surface_mutex_
 
-  // The handshake of a reconfiguration (supervisor ↔ primary thread).
-  std::atomic<bool> pause_requested_{false}, paused_{false};
-  std::atomic<std::int64_t> resume_at_ns_{0};  // new regions run from this release on
-  enum RestartKind : int {
-    kNoRestart = 0,
-    kRestartFromRest = 1,
-    kRestartKeepingContact = 2,
-    kRestartCarryingMotion = 3,
-  };
-  std::atomic<int> restart_kind_{kNoRestart};  // what the primary does to the contact on resume
-  // Set before a pause that carries the motion: the primary renders the held force meanwhile.
-  std::atomic<bool> hold_force_while_paused_{false};
   // Primary thread: the last period's reaction and centre, for a pause that holds the force (the
   // regions and centre_ are the supervisor's while paused); whether this pause holds it (latched
   // at its first period), for how many periods so far, and whether the last period on the
@@ -414,28 +375,8 @@ class HapticLoop {
   bool holding_ = false, engaged_ = false;
   std::int64_t held_periods_ = 0;
 
-  // Published by the primary thread for the supervisor.
-  std::atomic<std::int64_t> wanted_node_code_{-1};  // (ix · n + iy) · n + iz, −1: none
-  std::atomic<bool> contact_waiting_{false};
-
-  // Sleeping at rest. Primary → secondaries: park before your next step (each sets its parked_);
-  // a new wake generation (futex-woken) releases them, to restart on wake_origin_ns_ (−1: carry
-  // on on their own grid).
-  std::atomic<bool> park_secondaries_{false}, asleep_{false}, idle_{false};
-  std::array<std::atomic<bool>, kMaxRegions> parked_{};
-  // The primary watches for rest in numbered watches (0: not watching); a secondary found at rest
-  // stores the watch it was found in, so a finding from before a touch cannot count after it.
-  std::atomic<std::uint32_t> watch_{0};
-  std::array<std::atomic<std::uint32_t>, kMaxRegions> at_rest_in_watch_{};
-  std::uint32_t watches_ = 0;  // primary thread
-  std::atomic<std::uint32_t> wake_generation_{0};
-  std::atomic<std::int64_t> wake_origin_ns_{-1}, sleeps_{0}, alive_ns_{0};
-  // I/O → primary: inputs offered (the futex an idle primary waits on) and whether it waits.
-  std::atomic<std::uint32_t> input_arrivals_{0};
-  std::atomic<bool> primary_waiting_{false};
   enum SleepState : int { kAwake, kParking, kAsleep };
   SleepState sleep_state_ = kAwake;  // primary thread (supervisor only while it is paused)
-  std::uint32_t arrivals_seen_ = 0;  // primary thread: input_arrivals_ at its last period
 
   // Input arrives with jitter: the tip the primary drives is the device's, resampled at each
   // release on the device's own timeline (one seq per primary period), continued for at most
@@ -451,7 +392,6 @@ class HapticLoop {
   // another (only then does an answer cover first_seq … seq).
   std::int64_t first_taken_seq_ = -1;
   bool taken_in_sequence_ = true;
-  std::size_t inputs_dropped_seen_ = 0;  // inputs_.dropped() when the primary last looked
   std::int64_t periods_run_ = 0;         // primary periods answered since the loop was made
   DeviceSample last_input_;
 };

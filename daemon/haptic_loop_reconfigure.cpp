@@ -7,7 +7,6 @@
 
 #include "core/error.hpp"
 #include "rt/monotonic_clock.hpp"
-#include "rt/futex.hpp"
 #include "daemon/haptic_loop.hpp"
 
 namespace hapticsim {
@@ -60,39 +59,34 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     throw Error("the motion can be carried only to regions around the same contact node");
   }
   ++reconfigurations_;
-  RestartKind restart = carry                           ? kRestartCarryingMotion
-                        : handover == Handover::kRampIn ? kRestartKeepingContact
-                                                        : kRestartFromRest;
+  RegionRestart restart = carry                           ? RegionRestart::kCarryingMotion
+                          : handover == Handover::kRampIn ? RegionRestart::kKeepingContact
+                                                          : RegionRestart::kFromRest;
   // The last reconfiguration's restart, if the primary has not applied it yet (its regions not yet
   // resumed), is not undone by a milder one: a reset stays a reset (a fault re-arms only after
   // it), a ramp-in stays a ramp-in. (Applied meanwhile, this only makes the restart stricter.)
-  const int unapplied = restart_kind_.load(std::memory_order_acquire);
-  if (unapplied == kRestartFromRest ||
-      (unapplied == kRestartKeepingContact && restart == kRestartCarryingMotion)) {
-    restart = static_cast<RestartKind>(unapplied);
+  const RegionRestart unapplied = handover_.unapplied_restart();
+  if (unapplied == RegionRestart::kFromRest ||
+      (unapplied == RegionRestart::kKeepingContact && restart == RegionRestart::kCarryingMotion)) {
+    restart = unapplied;
   }
-  const bool carrying = restart == kRestartCarryingMotion;
+  const bool carrying = restart == RegionRestart::kCarryingMotion;
   if (!running_.load()) {
     if (carrying) regions->RestoreState(regions_->CaptureState());
-    restart_kind_.store(restart);
+    handover_.SetRestartWhileStopped(restart);
     ForgetSleep();
     Install(scene, std::move(regions));
     return;
   }
-  hold_force_while_paused_.store(carrying, std::memory_order_relaxed);  // published by the request
-  paused_.store(false);
-  pause_requested_.store(true, std::memory_order_release);
-  // An idle primary waiting for input comes round now (the count moves, so a primary about to
-  // wait does not wait either).
-  input_arrivals_.fetch_add(1);
-  FutexWakeAll(&input_arrivals_);
+  handover_.RequestPause(carrying);
+  inputs_.Nudge();  // an idle primary waiting for input comes round now
   // The primary acknowledges at its next release; after that it does not touch the regions.
   const std::int64_t give_up_ns = NowNs() + 1'000'000'000;
-  while (!paused_.load(std::memory_order_acquire)) {
+  while (!handover_.Acknowledged()) {
     if (NowNs() > give_up_ns) {
       // A primary thread that does not come round in a second is hung: joining it would hang the
       // supervisor too. Leave everything as it is; the watchdog stops getting pings.
-      pause_requested_.store(false, std::memory_order_release);
+      handover_.Withdraw();
       throw Error("the primary thread did not answer within 1 s: regions not replaced");
     }
     SleepUntilMonotonicNs(NowNs() + 100'000);
@@ -106,9 +100,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   // grid, late enough for the secondaries to be released ahead of it.
   const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());
   StartSecondaries(resume_at);
-  restart_kind_.store(restart, std::memory_order_relaxed);  // published by the release below
-  resume_at_ns_.store(resume_at, std::memory_order_release);
-  pause_requested_.store(false, std::memory_order_release);
+  handover_.Resume(restart, resume_at);
 }
 
 }  // namespace hapticsim
