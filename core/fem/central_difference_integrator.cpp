@@ -1,33 +1,55 @@
 #include "core/fem/central_difference_integrator.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
 #include "core/error.hpp"
 
 namespace hapticsim {
+namespace {
+
+// Every DOF neither fixed nor driven, in order.
+std::vector<int> FreeDofs(const ElasticModel& model) {
+  const auto& constraints = model.constraints();
+  std::vector<bool> prescribed(static_cast<size_t>(model.grid().num_dofs()), false);
+  for (int dof : constraints.fixed_dofs) prescribed[dof] = true;
+  for (int dof : constraints.driven_dofs) prescribed[dof] = true;
+  std::vector<int> free;
+  for (int dof = 0; dof < model.grid().num_dofs(); ++dof) {
+    if (!prescribed[dof]) free.push_back(dof);
+  }
+  return free;
+}
+
+std::vector<int> FixedThenDriven(const ElasticModel& model) {
+  std::vector<int> dofs = model.constraints().fixed_dofs;
+  dofs.insert(dofs.end(), model.constraints().driven_dofs.begin(),
+              model.constraints().driven_dofs.end());
+  return dofs;
+}
+
+double CheckedStep(double dt_s) {
+  HAPTICSIM_THROW_UNLESS(std::isfinite(dt_s) && dt_s > 0, "the time step must be > 0 s");
+  return dt_s;
+}
+
+}  // namespace
 
 CentralDifferenceIntegrator::CentralDifferenceIntegrator(const ElasticModel& model, double dt_s)
-    : model_(model), dt_(dt_s) {
-  HAPTICSIM_THROW_UNLESS(std::isfinite(dt_s) && dt_s > 0, "the time step must be > 0 s");
-  const int n = model.grid().num_dofs();
-  const double d = model.material().damping_per_s;
-  damping_minus_ = 1.0 - d * dt_ / 2.0;
-  inv_damping_plus_ = 1.0 / (1.0 + d * dt_ / 2.0);
-  dt2_over_mass_ = (dt_ * dt_) * model.dof_mass().cwiseInverse();
-  for (auto& buffer : buffers_) buffer = Eigen::VectorXd::Zero(n);
-  u_previous_ = &buffers_[0];
-  u_ = &buffers_[1];
-  u_next_ = &buffers_[2];
-  ku_ = Eigen::VectorXd::Zero(n);
-  driven_reaction_ =
-      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.constraints().driven_dofs.size()));
+    : model_(model),
+      dt_(CheckedStep(dt_s)),
+      region_(model.stiffness(), model.dof_mass(), model.material().damping_per_s,
+              FreeDofs(model), FixedThenDriven(model), {}, dt_s),
+      prescribed_next_(region_.prescribed().size(), 0.0),
+      driven_reaction_(model.constraints().driven_dofs.size(), 0.0),
+      driven_before_(driven_reaction_.size(), 0.0) {
+  region_.SetEnergyTerms(false);  // the divergence watch below takes the energy over every DOF
 }
 
 void CentralDifferenceIntegrator::Reset() {
-  u_previous_->setZero();
-  u_->setZero();
-  driven_reaction_.setZero();
+  region_.Reset();
+  std::fill(driven_reaction_.begin(), driven_reaction_.end(), 0.0);
   energy_ = 0.0;
   energy_budget_start_ = -1.0;
   input_work_ = 0.0;
@@ -35,50 +57,39 @@ void CentralDifferenceIntegrator::Reset() {
 
 void CentralDifferenceIntegrator::SetState(const Eigen::VectorXd& u,
                                            const Eigen::VectorXd& u_previous) {
-  HAPTICSIM_THROW_UNLESS(u.size() == u_->size() && u_previous.size() == u_->size(),
+  HAPTICSIM_THROW_UNLESS(u.size() == region_.u().size() && u_previous.size() == u.size(),
                          "state vectors must have one entry per DOF");
   Reset();
-  *u_ = u;
-  *u_previous_ = u_previous;
+  region_.SetState(u, u_previous);
 }
 
 StepStatus CentralDifferenceIntegrator::Step(std::span<const double> driven_next) noexcept {
-  const auto& constraints = model_.constraints();
-  assert(driven_next.size() == constraints.driven_dofs.size());
-  model_.stiffness().Apply(*u_, ku_);
-
-  const Eigen::Index n = ku_.size();
-  const double* ku = ku_.data();
-  const double* u = u_->data();
-  const double* up = u_previous_->data();
-  const double* dt2m = dt2_over_mass_.data();
-  const double* mass = model_.dof_mass().data();
-  double* next = u_next_->data();
+  const size_t fixed = model_.constraints().fixed_dofs.size();
+  assert(driven_next.size() == model_.constraints().driven_dofs.size());
+  // The energy at tₙ over every DOF (the driven ones' motion too), from the K·u the step uses.
+  const Eigen::VectorXd& ku = region_.Forces();
+  const Eigen::VectorXd& u = region_.u();
+  const Eigen::VectorXd& up = region_.u_previous();
+  const Eigen::VectorXd& mass = model_.dof_mass();
   double kinetic_sum = 0.0;  // Σ m (u − u⁻)²
   double strain_sum = 0.0;   // Σ u (K u)
-  for (Eigen::Index i = 0; i < n; ++i) {
-    next[i] = (-dt2m[i] * ku[i] + 2.0 * u[i] - damping_minus_ * up[i]) * inv_damping_plus_;
+  for (Eigen::Index i = 0; i < ku.size(); ++i) {
     const double du = u[i] - up[i];
     kinetic_sum += mass[i] * du * du;
     strain_sum += u[i] * ku[i];
   }
-  for (int dof : constraints.fixed_dofs) next[dof] = 0.0;
+  energy_ = 0.5 * kinetic_sum / (dt_ * dt_) + 0.5 * strain_sum;
 
-  const double d = model_.material().damping_per_s;
-  for (size_t k = 0; k < constraints.driven_dofs.size(); ++k) {
-    const int dof = constraints.driven_dofs[k];
-    next[dof] = driven_next[k];
-    const double m = mass[dof];
-    const double reaction = ku[dof] + m * (next[dof] - 2.0 * u[dof] + up[dof]) / (dt_ * dt_) +
-                            d * m * (next[dof] - up[dof]) / (2.0 * dt_);
-    driven_reaction_[static_cast<Eigen::Index>(k)] = reaction;
-    const double work = reaction * (next[dof] - up[dof]) / 2.0;
+  const std::vector<int>& driven = model_.constraints().driven_dofs;
+  for (size_t k = 0; k < driven.size(); ++k) driven_before_[k] = up[driven[k]];  // uₙ₋₁
+  std::copy(driven_next.begin(), driven_next.end(), prescribed_next_.begin() + fixed);
+  region_.Step(prescribed_next_, {});
+  for (size_t k = 0; k < driven.size(); ++k) {
+    const double reaction = region_.PrescribedReaction(static_cast<int>(fixed + k));
+    driven_reaction_[k] = reaction;
+    const double work = reaction * (driven_next[k] - driven_before_[k]) / 2.0;
     if (work > 0) input_work_ += work;
   }
-
-  energy_ = 0.5 * kinetic_sum / (dt_ * dt_) + 0.5 * strain_sum;
-  std::swap(u_previous_, u_);
-  std::swap(u_, u_next_);
 
   if (!std::isfinite(energy_) || !std::isfinite(input_work_)) return StepStatus::kNonFinite;
   if (energy_budget_start_ < 0) energy_budget_start_ = energy_;

@@ -11,7 +11,7 @@
 #include "core/scene/contact_trajectory.hpp"
 #include "core/fem/object_state.hpp"
 #include "core/trial/reference_trial.hpp"
-#include "core/regions/region_integrator.hpp"
+#include "core/fem/region_integrator.hpp"
 #include "core/regions/region_partition.hpp"
 #include "core/regions/region_schedule.hpp"
 #include "core/fem/stability_estimate.hpp"

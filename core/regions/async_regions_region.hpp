@@ -12,7 +12,7 @@
 #include "core/regions/async_regions.hpp"
 #include "core/regions/boundary_channel.hpp"
 #include "core/regions/element_set_stiffness.hpp"
-#include "core/regions/region_integrator.hpp"
+#include "core/fem/region_integrator.hpp"
 #include "core/regions/region_partition.hpp"
 #include "rt/seqlock_array.hpp"
 

@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "core/regions/region_integrator.hpp"
+#include "core/fem/region_integrator.hpp"
 #include "core/regions/region_partition.hpp"
 #include "tests/support/adaptive_scene.hpp"
 

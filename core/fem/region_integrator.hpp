@@ -96,6 +96,12 @@ class RegionIntegrator {
   double PrescribedWorkRefused() const { return prescribed_work_refused_; }
   /** What the step's dissipate_j actually took out, J (≥ 0; less when one step cannot). */
   double ControlledDissipated() const { return controlled_dissipated_; }
+  /**
+   * Whether Step() sums the material damping's share of its energy balance (DampingDissipated;
+   * default: yes; else it reads 0). Without it — a run that watches its energy another way, like
+   * CentralDifferenceIntegrator — the same step costs one serial reduction over the DOFs less.
+   */
+  void SetEnergyTerms(bool keep) { energy_terms_ = keep; }
   /** The owned DOFs a dissipate_j damps (default: the loaded ones). */
   void SetControlledDofs(std::vector<int> dofs) { controlled_ = std::move(dofs); }
   /**
@@ -164,6 +170,7 @@ class RegionIntegrator {
   std::vector<double> prescribed_work_;
   std::vector<int> controlled_;
   size_t port_prescribed_from_ = SIZE_MAX;
+  bool energy_terms_ = true;
   double load_scale_ = 1;  // α the load limit applied in the last step
   double load_work_ = 0, damping_dissipated_ = 0, controlled_dissipated_ = 0;
   double load_work_refused_ = 0, prescribed_work_refused_ = 0;
