@@ -7,6 +7,7 @@
 #include <random>
 #include <thread>
 
+#include "core/trial/trial_recorder.hpp"
 #include "rt/deadline_monitor.hpp"
 #include "rt/monotonic_clock.hpp"
 
@@ -63,7 +64,7 @@ TrialResult RealTimeSchedule::RunTrial() {
 
   TrialResult result;
   result.stability = regions_.schedule(kPrimaryRegion).alone;
-  result.samples.resize(static_cast<size_t>(steps) + 1);
+  TrialRecorder recorder(trajectory, dt, steps, &result);
   // Each thread wakes once per nominal period and takes that period's substeps in a row.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors;
   std::vector<std::int64_t> lead_ns(static_cast<size_t>(count), 0);
@@ -143,22 +144,10 @@ TrialResult RealTimeSchedule::RunTrial() {
     }
     monitor.Record(release, woke, MonotonicNowNs());
 
-    ForceSample& sample = result.samples[static_cast<size_t>(n)];
-    sample.t_s = t;
-    sample.contact_displacement_m = trajectory.DisplacementAt(t);
-    for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
-    result.peak_force_n =
-        std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
-    result.steps = n + 1;
-    result.stopped_at_s = t;
-    if (!std::isfinite(r[0] + r[1] + r[2])) {
-      result.outcome = TrialOutcome::kDivergedNonFinite;
-      break;
-    }
+    if (!recorder.Record(n, r)) break;  // not finite: the trial ends there
   }
   primary_done.store(true, std::memory_order_release);
   for (std::thread& thread : threads) thread.join();
-  result.samples.resize(static_cast<size_t>(result.steps));
   stats_.clear();
   counts_ = {};
   for (const FaultCounts& c : counts) counts_ += c;

@@ -2,19 +2,14 @@
 // the primary's coming step needs, then the primary, period after period, with the same
 // divergence checks as the reference (RunReferenceTrial).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "core/regions/async_regions.hpp"
 #include "core/regions/async_regions_region.hpp"
 #include "core/scene/contact_trajectory.hpp"
+#include "core/trial/trial_recorder.hpp"
 
 namespace hapticsim {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-}  // namespace
 
 TrialResult AsyncRegions::RunTrial() { return RunTrial(partition_.scene().input); }
 
@@ -44,11 +39,10 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
   // As Scene::num_steps(), so a trial of the scene's own input matches the reference's length.
   const long steps =
       std::lround(input.periods / input.frequency_hz / partition_.scene().solver.dt_s);
-  result.samples.reserve(static_cast<size_t>(steps) + 1);
+  TrialRecorder recorder(trajectory, dt, steps, &result);
   const double budget = Energy();  // 0 from rest
   double work = 0;
   int runaway_periods = 0;  // in a row (kRunawayPeriods)
-  const auto start = Clock::now();
   Region& primary = *regions_[kPrimaryRegion];
   const int substeps = primary.schedule.substeps;
   const double h = dt / substeps;
@@ -74,31 +68,22 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
     const double energy =
         control_ != InterfaceControl::kOff ? balance.state_energy_j : KineticEnergy();
     if (!std::isfinite(energy) || !std::isfinite(r[0] + r[1] + r[2])) {
-      result.outcome = TrialOutcome::kDivergedNonFinite;
+      recorder.Stop(TrialOutcome::kDivergedNonFinite);
       break;
     }
     if (energy > kEnergyGrowthFactor * (budget + work) && energy > 0) {
-      result.outcome = TrialOutcome::kDivergedEnergy;
+      recorder.Stop(TrialOutcome::kDivergedEnergy);
       break;
     }
     // What the daemon watches for, with the same numbers: a trial it would have taken off these
     // regions is not a sample of them.
     if (RunawayHeld(balance, &runaway_periods)) {
-      result.outcome = TrialOutcome::kDivergedEnergy;
-      result.runaway = true;
+      recorder.Stop(TrialOutcome::kDivergedEnergy, /*runaway=*/true);
       break;
     }
-    ForceSample sample;
-    sample.t_s = t;
-    sample.contact_displacement_m = trajectory.DisplacementAt(t);
-    for (int c = 0; c < 3; ++c) sample.feedback_force_n[c] = -r[c];
-    result.peak_force_n =
-        std::max(result.peak_force_n, std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
-    result.samples.push_back(sample);
-    result.stopped_at_s = t;
-    result.steps = n + 1;
+    recorder.Record(n, r);
   }
-  result.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  result.wall_time_s = recorder.ElapsedS();
   return result;
 }
 

@@ -1,10 +1,10 @@
 #include "core/trial/reference_trial.hpp"
 
-#include <chrono>
 #include <cmath>
 
 #include "core/fem/central_difference_integrator.hpp"
 #include "core/scene/contact_trajectory.hpp"
+#include "core/trial/trial_recorder.hpp"
 
 namespace hapticsim {
 namespace {
@@ -62,9 +62,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
   CentralDifferenceIntegrator integrator(model, h);
   const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
   const long steps = scene.num_steps();
-  result.samples.reserve(static_cast<size_t>(steps) + 1);
-
-  const auto start = std::chrono::steady_clock::now();
+  TrialRecorder recorder(trajectory, dt, steps, &result);
   // Period n goes from tₙ to tₙ₊₁; its first step yields the reaction at tₙ, so periods 0…N give
   // samples 0…N.
   std::array<double, 3> reaction_at_start{};
@@ -79,26 +77,13 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
       }
     }
     if (status != StepStatus::kOk) {
-      result.outcome = status == StepStatus::kNonFinite ? TrialOutcome::kDivergedNonFinite
-                                                        : TrialOutcome::kDivergedEnergy;
+      recorder.Stop(status == StepStatus::kNonFinite ? TrialOutcome::kDivergedNonFinite
+                                                     : TrialOutcome::kDivergedEnergy);
       break;
     }
-    ForceSample sample;
-    sample.t_s = t;
-    sample.contact_displacement_m = trajectory.DisplacementAt(t);
-    const auto& reaction = reaction_at_start;
-    double magnitude2 = 0;
-    for (int c = 0; c < 3; ++c) {
-      sample.feedback_force_n[c] = -reaction[c];
-      magnitude2 += reaction[c] * reaction[c];
-    }
-    result.peak_force_n = std::max(result.peak_force_n, std::sqrt(magnitude2));
-    result.samples.push_back(sample);
-    result.stopped_at_s = t;
+    if (!recorder.Record(n, reaction_at_start)) break;
   }
-  result.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  result.steps = static_cast<long>(result.samples.size());
+  result.wall_time_s = recorder.ElapsedS();
   return result;
 }
 
