@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "core/fem/material.hpp"
@@ -105,6 +106,12 @@ class HybridMesh {
   const std::vector<unsigned>& region_mask() const { return region_mask_; }
 
  private:
+  std::vector<std::array<int, 3>> BuildElements(const std::vector<char>& refined,
+                                                const std::vector<RegionIndex>& region);
+  void BuildGather(const std::vector<std::vector<std::pair<int, double>>>& masters,
+                   const std::vector<std::array<int, 3>>& node_lattice);
+  void BuildRegionMasks();
+
   Options options_;
   std::vector<HybridElement> elements_;
   std::vector<int> node_at_lattice_;  // mesh node id per lattice point, −1 if none
