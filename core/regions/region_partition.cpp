@@ -11,15 +11,12 @@ namespace hapticsim {
 namespace {
 // The shortest rows (nodes along x and y) for which a box region runs on the stencil.
 constexpr int kMinBoxRowNodes = 9;
-}  // namespace
 
-RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
-  ValidateScene(scene);
-  HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
-                         "asynchronous regions need adaptivity.primary_size >= 1");
+// The hybrid mesh the scene's adaptivity asks for: the primary box around the contact node, the
+// supports refined, the shells.
+HybridMesh::Options MeshOptionsOf(const Scene& scene) {
   const int n = scene.mesh.nodes, last = n - 1, r = scene.adaptivity.primary_size;
   const LatticeIndex contact = ContactNode(scene);
-
   HybridMesh::Options options;
   options.nodes_per_axis = n;
   options.spacing_m = scene.mesh.edge_m / last;
@@ -33,43 +30,63 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
   options.support_layers = scene.adaptivity.support_layers;
   options.secondary_regions = scene.adaptivity.secondary_regions;
   options.shell_cells = scene.adaptivity.shell_cells;
-  mesh_ = std::make_unique<HybridMesh>(options);
-  dof_mass_ = mesh_->DofMass(scene.material.density_kg_m3);
+  return options;
+}
 
+// Each region's elements. @throws Error when a secondary region has none.
+std::vector<std::vector<int>> ElementsByRegion(const HybridMesh& mesh, const Scene& scene) {
   const int regions = 1 + scene.adaptivity.secondary_regions;
   std::vector<std::vector<int>> elements(static_cast<size_t>(regions));
-  for (int e = 0; e < static_cast<int>(mesh_->elements().size()); ++e) {
-    elements[mesh_->elements()[e].region].push_back(e);
+  for (int e = 0; e < static_cast<int>(mesh.elements().size()); ++e) {
+    elements[mesh.elements()[e].region].push_back(e);
   }
   for (int region = 1; region < regions; ++region) {
     HAPTICSIM_THROW_UNLESS(
         !elements[region].empty(),
-        "adaptivity.primary_size = " + std::to_string(r) +
+        "adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
             (regions == 2
                  ? std::string(" leaves no secondary region")
                  : " leaves secondary region " + std::to_string(region) +
                        " of adaptivity.secondary_regions = " + std::to_string(regions - 1) +
                        " empty: use fewer or thinner shells"));
   }
-  for (int region = 0; region < regions; ++region) {
+  return elements;
+}
+
+}  // namespace
+
+RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
+  ValidateScene(scene);
+  HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
+                         "asynchronous regions need adaptivity.primary_size >= 1");
+  const HybridMesh::Options options = MeshOptionsOf(scene);
+  mesh_ = std::make_unique<HybridMesh>(options);
+  dof_mass_ = mesh_->DofMass(scene.material.density_kg_m3);
+  const std::vector<std::vector<int>> elements = ElementsByRegion(*mesh_, scene);
+  for (const std::vector<int>& region_elements : elements) {
     // Fine elements (the primary box; at spacing factor 1 the secondary shells too, boxes with a
     // hole) run on node stencils where their bounding box's rows are long enough for the vector
     // path: measured per K·u against the element loop, a 13×13×7 primary box 2.0× faster,
     // 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar path, are nearly all
     // of a small box); a 13³ secondary with a hole 1.5–3.0× faster (docs/benchmarks.md).
     if (auto box =
-            BoxStiffness::TryMake(*mesh_, scene.material, elements[region], kMinBoxRowNodes)) {
+            BoxStiffness::TryMake(*mesh_, scene.material, region_elements, kMinBoxRowNodes)) {
       stiffness_.push_back(std::move(box));
     } else {
       stiffness_.push_back(
-          std::make_unique<ElementSetStiffness>(*mesh_, scene.material, elements[region]));
+          std::make_unique<ElementSetStiffness>(*mesh_, scene.material, region_elements));
     }
   }
+  AssignDofs(options.supports, static_cast<int>(elements.size()));
+  FindBands(elements);
+}
 
+void RegionPartition::AssignDofs(const std::vector<std::array<int, 3>>& supports, int regions) {
+  const LatticeIndex contact = ContactNode(scene_);
   const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
   HAPTICSIM_THROW_UNLESS(contact_node >= 0, "internal: the contact node is not independent");
   for (int c = 0; c < 3; ++c) contact_dofs_[c] = mesh_->Dof(contact_node, c);
-  for (const auto& s : options.supports) {
+  for (const auto& s : supports) {
     const int node = mesh_->IndependentAt(s[0], s[1], s[2]);
     HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a support node is not independent");
     for (int c = 0; c < 3; ++c) fixed_dofs_.push_back(mesh_->Dof(node, c));
@@ -105,8 +122,12 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
       }
     }
   }
+}
 
-  // The band of each region next to its outer interface.
+// The band of each region next to its outer interface.
+void RegionPartition::FindBands(const std::vector<std::vector<int>>& elements) {
+  const int regions = static_cast<int>(elements.size());
+  const int nr = mesh_->num_independent();
   band_.resize(static_cast<size_t>(regions));
   for (int region = 0; region + 1 < regions; ++region) {
     std::vector<char> on_gamma(static_cast<size_t>(nr), 0);

@@ -63,6 +63,10 @@ class RegionPartition {
   std::string RegionName(RegionIndex region) const;
 
  private:
+  // The contact's and supports' DOFs, and each region's owned, fixed and interface DOFs.
+  void AssignDofs(const std::vector<std::array<int, 3>>& supports, int regions);
+  void FindBands(const std::vector<std::vector<int>>& elements);
+
   Scene scene_;
   std::unique_ptr<HybridMesh> mesh_;
   Eigen::VectorXd dof_mass_;
