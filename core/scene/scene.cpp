@@ -140,93 +140,108 @@ KeyAccess ContactNodeKey() {
                    }};
 }
 
+// The object: its mesh and its material.
+void AddObjectKeys(std::vector<KeyAccess>& keys) {
+  keys.push_back(Integer(
+      {"mesh.nodes", "", "a whole number from 2 to 401", "nodes per axis of the cube"},
+      [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
+  keys.push_back(Real(
+      {"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
+      [](Scene& s) -> double& { return s.mesh.edge_m; }, [](double v) { return v > 0; }));
+  keys.push_back(Real(
+      {"material.youngs_modulus", "Pa", "finite and > 0", "Young's modulus E"},
+      [](Scene& s) -> double& { return s.material.youngs_modulus_pa; },
+      [](double v) { return v > 0; }));
+  keys.push_back(Real(
+      {"material.poisson_ratio", "", "in the open interval (-1, 0.5)", "Poisson's ratio ν"},
+      [](Scene& s) -> double& { return s.material.poisson_ratio; },
+      [](double v) { return v > -1.0 && v < 0.5; }));
+  keys.push_back(Real(
+      {"material.density", "kg/m^3", "finite and > 0", "mass density ρ"},
+      [](Scene& s) -> double& { return s.material.density_kg_m3; },
+      [](double v) { return v > 0; }));
+  keys.push_back(Real(
+      {"material.damping", "1/s", "finite and >= 0", "mass-proportional damping d in C = d·M"},
+      [](Scene& s) -> double& { return s.material.damping_per_s; },
+      [](double v) { return v >= 0; }));
+}
+
+// The device's input and the time step.
+void AddInputKeys(std::vector<KeyAccess>& keys) {
+  keys.push_back(Real(
+      {"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
+       "amplitude s of the contact node's motion along its face's inward normal"},
+      [](Scene& s) -> double& { return s.input.amplitude_m; }, [](double v) { return v >= 0; }));
+  keys.push_back(Real(
+      {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
+      [](Scene& s) -> double& { return s.input.frequency_hz; }, [](double v) { return v > 0; }));
+  keys.push_back(Choice(
+      {"input.waveform", "", "\"press\" or \"sine\"",
+       "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
+      {"press", "sine"},
+      [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
+      [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
+  keys.push_back(ContactNodeKey());
+  keys.push_back(Real(
+      {"input.periods", "", "finite and > 0", "trial length in input periods"},
+      [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
+  keys.push_back(Real(
+      {"solver.dt", "s", "finite and > 0", "time step of the simulation"},
+      [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
+}
+
+// The asynchronous regions.
+void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
+  keys.push_back(Integer(
+      {"adaptivity.primary_size", "", "a whole number from 0 to 1000 (0 = no adaptivity)",
+       "primary region: nodes from the contact in every direction (0 = off)"},
+      [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
+  keys.push_back(Integer(
+      {"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
+       "secondary spacing factor k (× the finest spacing)"},
+      [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
+  keys.push_back(Real(
+      {"adaptivity.secondary_rate", "Hz",
+       "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+       "update rate of the secondary region"},
+      [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
+      [](double v) { return v >= 1 && v == std::floor(v); }));
+  keys.push_back(Integer(
+      {"adaptivity.support_layers", "", "a whole number from 0 to 100",
+       "coarse cells refined around each fixed node (the supports are "
+       "singular: a coarse cell there is far too stiff)"},
+      [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
+  keys.push_back(Integer(
+      {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
+       "secondary regions: nested shells around the primary, each with its "
+       "own thread"},
+      [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
+  keys.push_back(Integer(
+      {"adaptivity.shell_cells", "", "a whole number from 1 to 100",
+       "thickness of each secondary shell but the last, in coarse cells"},
+      [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
+  keys.push_back(Real(
+      {"adaptivity.outer_rate", "Hz",
+       "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+       "update rate of the secondary shells beyond the first"},
+      [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
+      [](double v) { return v >= 1 && v == std::floor(v); }));
+  keys.push_back(Choice(
+      {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
+       "what an inner region sends the outer one: its displacements next to "
+       "the interface (displacement) or its interface forces (force); see "
+       "docs/regions.md"},
+      {"displacement", "force"},
+      [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
+      [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
+}
+
 const std::vector<KeyAccess>& KeyTable() {
   static const std::vector<KeyAccess> table = [] {
     std::vector<KeyAccess> keys;
-    keys.push_back(Integer(
-        {"mesh.nodes", "", "a whole number from 2 to 401", "nodes per axis of the cube"},
-        [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
-    keys.push_back(Real(
-        {"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
-        [](Scene& s) -> double& { return s.mesh.edge_m; }, [](double v) { return v > 0; }));
-    keys.push_back(Real(
-        {"material.youngs_modulus", "Pa", "finite and > 0", "Young's modulus E"},
-        [](Scene& s) -> double& { return s.material.youngs_modulus_pa; },
-        [](double v) { return v > 0; }));
-    keys.push_back(Real(
-        {"material.poisson_ratio", "", "in the open interval (-1, 0.5)", "Poisson's ratio ν"},
-        [](Scene& s) -> double& { return s.material.poisson_ratio; },
-        [](double v) { return v > -1.0 && v < 0.5; }));
-    keys.push_back(Real(
-        {"material.density", "kg/m^3", "finite and > 0", "mass density ρ"},
-        [](Scene& s) -> double& { return s.material.density_kg_m3; },
-        [](double v) { return v > 0; }));
-    keys.push_back(Real(
-        {"material.damping", "1/s", "finite and >= 0", "mass-proportional damping d in C = d·M"},
-        [](Scene& s) -> double& { return s.material.damping_per_s; },
-        [](double v) { return v >= 0; }));
-    keys.push_back(Real(
-        {"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
-         "amplitude s of the contact node's motion along its face's inward normal"},
-        [](Scene& s) -> double& { return s.input.amplitude_m; }, [](double v) { return v >= 0; }));
-    keys.push_back(Real(
-        {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
-        [](Scene& s) -> double& { return s.input.frequency_hz; }, [](double v) { return v > 0; }));
-    keys.push_back(Choice(
-        {"input.waveform", "", "\"press\" or \"sine\"",
-         "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-        {"press", "sine"},
-        [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
-        [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
-    keys.push_back(ContactNodeKey());
-    keys.push_back(Real(
-        {"input.periods", "", "finite and > 0", "trial length in input periods"},
-        [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
-    keys.push_back(Real(
-        {"solver.dt", "s", "finite and > 0", "time step of the simulation"},
-        [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
-    keys.push_back(Integer(
-        {"adaptivity.primary_size", "", "a whole number from 0 to 1000 (0 = no adaptivity)",
-         "primary region: nodes from the contact in every direction (0 = off)"},
-        [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
-    keys.push_back(Integer(
-        {"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
-         "secondary spacing factor k (× the finest spacing)"},
-        [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
-    keys.push_back(Real(
-        {"adaptivity.secondary_rate", "Hz",
-         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-         "update rate of the secondary region"},
-        [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
-        [](double v) { return v >= 1 && v == std::floor(v); }));
-    keys.push_back(Integer(
-        {"adaptivity.support_layers", "", "a whole number from 0 to 100",
-         "coarse cells refined around each fixed node (the supports are "
-         "singular: a coarse cell there is far too stiff)"},
-        [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
-    keys.push_back(Integer(
-        {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
-         "secondary regions: nested shells around the primary, each with its "
-         "own thread"},
-        [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
-    keys.push_back(Integer(
-        {"adaptivity.shell_cells", "", "a whole number from 1 to 100",
-         "thickness of each secondary shell but the last, in coarse cells"},
-        [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
-    keys.push_back(Real(
-        {"adaptivity.outer_rate", "Hz",
-         "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-         "update rate of the secondary shells beyond the first"},
-        [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
-        [](double v) { return v >= 1 && v == std::floor(v); }));
-    keys.push_back(Choice(
-        {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
-         "what an inner region sends the outer one: its displacements next to "
-         "the interface (displacement) or its interface forces (force); see "
-         "docs/regions.md"},
-        {"displacement", "force"},
-        [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
-        [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
+    AddObjectKeys(keys);
+    AddInputKeys(keys);
+    AddAdaptivityKeys(keys);
     return keys;
   }();
   return table;
