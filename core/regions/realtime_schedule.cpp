@@ -49,83 +49,108 @@ class FaultDraw {
 
 }  // namespace
 
+namespace {
+
+// A run's wall-clock grid: simulation ticks to CLOCK_MONOTONIC, each thread's nominal period
+// (one wake takes a period's substeps in a row) and how far ahead of the primary it is released.
+struct RunGrid {
+  double tick_ns = 0;
+  std::int64_t origin_ns = 0;  // simulation time 0
+  std::int64_t end_ticks = 0;  // the primary's last period's end
+  std::vector<std::int64_t> nominal_ticks, lead_ns;
+};
+
+RunGrid MakeGrid(const AsyncRegions& regions, double stretch, long steps) {
+  RunGrid grid;
+  const int count = regions.num_regions();
+  grid.tick_ns = stretch * 1e9 / static_cast<double>(regions.ticks_per_second());
+  grid.nominal_ticks.assign(static_cast<size_t>(count), 0);
+  grid.lead_ns.assign(static_cast<size_t>(count), 0);
+  for (int a = 0; a < count; ++a) {
+    grid.nominal_ticks[a] = regions.period_ticks(a) * regions.schedule(a).substeps;
+    if (a > 0) {
+      grid.lead_ns[a] = grid.lead_ns[a - 1] +
+                        static_cast<std::int64_t>(1.25 * grid.nominal_ticks[a - 1] * grid.tick_ns);
+    }
+  }
+  grid.end_ticks = (steps + 1) * grid.nominal_ticks[kPrimaryRegion];
+  // Far enough ahead for the outer regions' leads.
+  grid.origin_ns = MonotonicNowNs() + 20'000'000 + grid.lead_ns.back();
+  return grid;
+}
+
+// Secondary region a's thread: a wake per period on its release grid, its faults injected, a
+// stall held over as the daemon holds it, until the primary is done.
+void RunSecondary(AsyncRegions& regions, const RunGrid& grid, int a, const TimingFaults& faults,
+                  DeadlineMonitor& monitor, FaultCounts& faulted,
+                  const std::atomic<bool>& primary_done) {
+  FaultDraw draw(faults.seed, a);
+  const std::int64_t period = grid.nominal_ticks[a];
+  const int substeps = regions.schedule(a).substeps;
+  const double period_ns = period * grid.tick_ns;
+  while (!primary_done.load(std::memory_order_acquire)) {
+    const std::int64_t state = regions.state_ticks(a);
+    if (state >= grid.end_ticks + period) break;
+    const auto release =
+        grid.origin_ns + static_cast<std::int64_t>(state * grid.tick_ns) - grid.lead_ns[a];
+    SleepUntilMonotonicNs(release);
+    std::int64_t held_ns = 0;
+    if (draw.Happens(faults.secondary_lags_per_s, period_ns * 1e-9)) {
+      held_ns = static_cast<std::int64_t>(draw.Periods(faults.max_lag_periods) * period_ns);
+      ++faulted.secondary_lags;
+    } else if (draw.Happens(faults.secondary_stalls_per_s, period_ns * 1e-9)) {
+      held_ns = static_cast<std::int64_t>(draw.Seconds(faults.max_stall_s) * 1e9);
+      ++faulted.secondary_stalls;
+    }
+    if (held_ns > 0) SleepUntilMonotonicNs(MonotonicNowNs() + held_ns);
+    const std::int64_t woke = MonotonicNowNs();
+    // Woken far too late: hold the state over the missed periods, as the daemon does.
+    const auto missed = static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
+    if (missed > AsyncRegions::kSkipAfterLatePeriods) {
+      regions.SkipRegion(a, missed * substeps);
+      ++faulted.skips;
+    }
+    for (int q = 0; q < substeps; ++q) regions.StepRegion(a);
+    monitor.Record(release, woke, MonotonicNowNs());
+  }
+}
+
+}  // namespace
+
 TrialResult RealTimeSchedule::RunTrial() {
   const Scene& scene = regions_.partition().scene();
   const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
   const int count = regions_.num_regions();
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();
-  const double tick_ns = stretch_ * 1e9 / static_cast<double>(regions_.ticks_per_second());
   const int primary_substeps = regions_.schedule(kPrimaryRegion).substeps;
-  const std::int64_t primary_period_ticks =
-      regions_.period_ticks(kPrimaryRegion) * primary_substeps;
-  const std::int64_t end_ticks = (steps + 1) * primary_period_ticks;
   regions_.Reset();
-
   TrialResult result;
   result.stability = regions_.schedule(kPrimaryRegion).alone;
   TrialRecorder recorder(trajectory, dt, steps, &result);
-  // Each thread wakes once per nominal period and takes that period's substeps in a row.
+
+  const RunGrid grid = MakeGrid(regions_, stretch_, steps);
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors;
-  std::vector<std::int64_t> lead_ns(static_cast<size_t>(count), 0);
-  std::vector<std::int64_t> nominal_ticks(static_cast<size_t>(count), 0);
   for (int a = 0; a < count; ++a) {
-    nominal_ticks[a] = regions_.period_ticks(a) * regions_.schedule(a).substeps;
-    monitors.push_back(std::make_unique<DeadlineMonitor>(nominal_ticks[a] * tick_ns * 1e-9));
-    if (a > 0) {
-      lead_ns[a] =
-          lead_ns[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ticks[a - 1] * tick_ns);
-    }
+    monitors.push_back(
+        std::make_unique<DeadlineMonitor>(grid.nominal_ticks[a] * grid.tick_ns * 1e-9));
   }
-
-  // Wall-clock origin of simulation time 0, far enough ahead for the outer regions' leads.
-  const std::int64_t origin_ns = MonotonicNowNs() + 20'000'000 + lead_ns.back();
   std::atomic<bool> primary_done{false};
-
   std::vector<FaultCounts> counts(static_cast<size_t>(count));
   std::vector<std::thread> threads;
   for (int a = 1; a < count; ++a) {
     threads.emplace_back([&, a] {
-      DeadlineMonitor& monitor = *monitors[a];
-      FaultCounts& faulted = counts[a];
-      FaultDraw draw(faults_.seed, a);
-      const std::int64_t period = nominal_ticks[a];
-      const int substeps = regions_.schedule(a).substeps;
-      const double period_ns = period * tick_ns;
-      while (!primary_done.load(std::memory_order_acquire)) {
-        const std::int64_t state = regions_.state_ticks(a);
-        if (state >= end_ticks + period) break;
-        const auto release = origin_ns + static_cast<std::int64_t>(state * tick_ns) - lead_ns[a];
-        SleepUntilMonotonicNs(release);
-        std::int64_t held_ns = 0;
-        if (draw.Happens(faults_.secondary_lags_per_s, period_ns * 1e-9)) {
-          held_ns = static_cast<std::int64_t>(draw.Periods(faults_.max_lag_periods) * period_ns);
-          ++faulted.secondary_lags;
-        } else if (draw.Happens(faults_.secondary_stalls_per_s, period_ns * 1e-9)) {
-          held_ns = static_cast<std::int64_t>(draw.Seconds(faults_.max_stall_s) * 1e9);
-          ++faulted.secondary_stalls;
-        }
-        if (held_ns > 0) SleepUntilMonotonicNs(MonotonicNowNs() + held_ns);
-        const std::int64_t woke = MonotonicNowNs();
-        // Woken far too late: hold the state over the missed periods, as the daemon does.
-        const auto missed =
-            static_cast<std::int64_t>(static_cast<double>(woke - release) / period_ns);
-        if (missed > AsyncRegions::kSkipAfterLatePeriods) {
-          regions_.SkipRegion(a, missed * substeps);
-          ++faulted.skips;
-        }
-        for (int q = 0; q < substeps; ++q) regions_.StepRegion(a);
-        monitor.Record(release, woke, MonotonicNowNs());
-      }
+      RunSecondary(regions_, grid, a, faults_, *monitors[a], counts[a], primary_done);
     });
   }
 
   DeadlineMonitor& monitor = *monitors[kPrimaryRegion];
   FaultDraw draw(faults_.seed, kPrimaryRegion);
-  const double period_ns = primary_period_ticks * tick_ns;
+  const std::int64_t period_ticks = grid.nominal_ticks[kPrimaryRegion];
+  const double period_ns = period_ticks * grid.tick_ns;
   for (long n = 0; n <= steps; ++n) {
     const std::int64_t release =
-        origin_ns + static_cast<std::int64_t>(n * primary_period_ticks * tick_ns);
+        grid.origin_ns + static_cast<std::int64_t>(n * period_ticks * grid.tick_ns);
     SleepUntilMonotonicNs(release);
     if (draw.Happens(faults_.primary_late_wakes_per_s, period_ns * 1e-9)) {
       // Late: the periods it missed are then stepped back to back, as their releases have passed.
@@ -143,7 +168,6 @@ TrialResult RealTimeSchedule::RunTrial() {
       if (q == 1) r = rq;
     }
     monitor.Record(release, woke, MonotonicNowNs());
-
     if (!recorder.Record(n, r)) break;  // not finite: the trial ends there
   }
   primary_done.store(true, std::memory_order_release);
