@@ -125,45 +125,82 @@ std::string MapProblem(const Scene& scene, const ErrorMap& map) {
   return "";
 }
 
+namespace {
+
+struct Candidate {
+  RegionConfiguration configuration;
+  double error = -1, cost = 0;
+  bool clamped = false;
+};
+
+// Mean measured cost of each configuration (secondary_lod, primary_size, secondary_rate) over the
+// map's ok samples, µs per simulated ms.
+std::map<std::array<double, 3>, double> MeanCosts(const ErrorMap& map) {
+  std::map<std::array<double, 3>, std::pair<double, int>> sums;
+  for (const MapSample& s : map.samples) {
+    if (s.status != SampleStatus::kOk) continue;
+    auto& entry = sums[{s.point[kLod], s.point[kSize], s.point[kRate]}];
+    entry.first += s.total_cost_us_per_ms();
+    entry.second += 1;
+  }
+  std::map<std::array<double, 3>, double> means;
+  for (const auto& [key, sum] : sums) means[key] = sum.first / sum.second;
+  return means;
+}
+
+// Every configuration of the map usable at this scene (the pinned one only, when pinned) that
+// costs less than `below_cost_us_per_ms`, with its looked-up error and measured cost.
+std::vector<Candidate> MapCandidates(const Scene& scene, const ErrorMap& map,
+                                     const std::optional<RegionConfiguration>& pinned,
+                                     double below_cost_us_per_ms) {
+  std::vector<Candidate> candidates;
+  const ErrorLookup lookup(map, ErrorField::kMagnitude);
+  const std::map<std::array<double, 3>, double> cost = MeanCosts(map);
+  const MapPoint at = PointOfScene(scene);
+  for (double lod : map.axes[kLod]) {
+    for (double size : map.axes[kSize]) {
+      for (double rate : map.axes[kRate]) {
+        const RegionConfiguration c{static_cast<int>(size), static_cast<int>(lod), rate};
+        if (pinned && !(c == *pinned)) continue;
+        const LookupResult result = lookup.Lookup(ConfigurationQuery(map, at, c));
+        if (!result.usable()) continue;  // predicted unstable or diverged in the map
+        const auto entry = cost.find({lod, size, rate});
+        const double mean_cost = entry == cost.end() ? 1e9 : entry->second;
+        if (!(mean_cost < below_cost_us_per_ms)) continue;
+        candidates.push_back({c, result.error, mean_cost, result.clamped});
+      }
+    }
+  }
+  return candidates;
+}
+
+// Why a candidate was chosen, as the log and the status say it.
+std::string ReasonFor(const Candidate& candidate, bool have_map, bool target_met,
+                      double target_percent) {
+  std::ostringstream reason;
+  reason << DescribeConfiguration(candidate.configuration);
+  if (have_map) {
+    reason << ": looked-up error " << candidate.error << " % against the target "
+           << target_percent << " %" << (target_met ? "" : " (TARGET EXCEEDED)")
+           << (candidate.clamped ? " (the scene is outside the map: clamped)" : "");
+  } else {
+    reason << ": no error map, the error is unknown";
+  }
+  return reason.str();
+}
+
+}  // namespace
+
 SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
                                        double target_percent,
                                        const std::optional<RegionConfiguration>& pinned,
                                        double below_cost_us_per_ms) {
   const bool capped = below_cost_us_per_ms < std::numeric_limits<double>::infinity();
-  struct Candidate {
-    RegionConfiguration configuration;
-    double error = -1, cost = 0;
-    bool clamped = false;
-  };
   std::vector<Candidate> candidates;
   // Only a map it can use: its lookup takes every axis and its configuration values are whole
-  // numbers in range (they are cast to int below).
+  // numbers in range (they are cast to int).
   if (map && map->grid && MapProblem(scene, *map).empty()) {
-    const ErrorLookup lookup(*map, ErrorField::kMagnitude);
-    // Mean measured cost of each configuration over the map's ok samples.
-    std::map<std::array<double, 3>, std::pair<double, int>> cost;
-    for (const MapSample& s : map->samples) {
-      if (s.status != SampleStatus::kOk) continue;
-      auto& entry = cost[{s.point[kLod], s.point[kSize], s.point[kRate]}];
-      entry.first += s.total_cost_us_per_ms();
-      entry.second += 1;
-    }
-    const MapPoint at = PointOfScene(scene);
-    for (double lod : map->axes[kLod]) {
-      for (double size : map->axes[kSize]) {
-        for (double rate : map->axes[kRate]) {
-          const RegionConfiguration c{static_cast<int>(size), static_cast<int>(lod), rate};
-          if (pinned && !(c == *pinned)) continue;
-          const LookupResult result = lookup.Lookup(ConfigurationQuery(*map, at, c));
-          if (!result.usable()) continue;  // predicted unstable or diverged in the map
-          const auto entry = cost.find({lod, size, rate});
-          const double mean_cost =
-              entry == cost.end() ? 1e9 : entry->second.first / entry->second.second;
-          if (!(mean_cost < below_cost_us_per_ms)) continue;
-          candidates.push_back({c, result.error, mean_cost, result.clamped});
-        }
-      }
-    }
+    candidates = MapCandidates(scene, *map, pinned, below_cost_us_per_ms);
   }
   if (candidates.empty() && capped) {
     throw Error("no usable configuration in the error map is cheaper than " +
@@ -197,16 +234,7 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
     decision.cost_us_per_ms = candidate.cost;
     decision.clamped = candidate.clamped;
     decision.target_met = have_map && candidate.error <= target_percent;
-    std::ostringstream reason;
-    reason << DescribeConfiguration(candidate.configuration);
-    if (have_map) {
-      reason << ": looked-up error " << candidate.error << " % against the target "
-             << target_percent << " %" << (decision.target_met ? "" : " (TARGET EXCEEDED)")
-             << (candidate.clamped ? " (the scene is outside the map: clamped)" : "");
-    } else {
-      reason << ": no error map, the error is unknown";
-    }
-    decision.reason = reason.str();
+    decision.reason = ReasonFor(candidate, have_map, decision.target_met, target_percent);
     return decision;
   }
   throw Error(pinned ? "the pinned configuration " + DescribeConfiguration(*pinned) +
