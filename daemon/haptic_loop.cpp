@@ -122,35 +122,57 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   if (usable) engaged_ = in_contact;
   if (!contact.engaged) holding_ = false;  // lifted off while held: a new touch is not held
   if (contact.waiting) flags |= force_flags::kReconfiguring;
+  PublishContactRequest(contact);
+  const std::array<double, 3> reaction =
+      PeriodReaction(usable, holding, contact, release_ns, &flags);
+  counters_.idle.Set(usable && sleep_state_ == kAsleep && stale);
+  const bool render = in_contact && !(stale && options_.zero_force_when_stale);
+  const std::array<double, 3> simulated_n{-reaction[0], -reaction[1], -reaction[2]};
+  const PortGuard::Output sent = GuardPeriod(now_ns, simulated_n, render, contact, have, &flags);
+  if (in_contact) {
+    flags |= force_flags::kInContact;
+    counters_.last_contact_ns.Set(now_ns);
+  }
+  PublishPeriod(now_ns, sent.force_n, simulated_n, flags);
+}
+
+void HapticLoop::PublishContactRequest(const ContactTracker::Contact& contact) noexcept {
   counters_.contact_waiting.Set(contact.waiting);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
   const std::int64_t n = nodes_;
   counters_.wanted_node_code.Set(wanted ? ((*wanted)[0] * n + (*wanted)[1]) * n + (*wanted)[2]
                                         : -1);
+}
 
+std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,
+                                                 const ContactTracker::Contact& contact,
+                                                 std::int64_t release_ns,
+                                                 std::int32_t* flags) noexcept {
+  if (!usable) return holding ? held_reaction_ : std::array<double, 3>{};
   std::array<double, 3> reaction{};
-  if (usable) {
-    // Asleep, the regions are exactly at rest at time 0: a touch steps on from there in this very
-    // period, with the secondaries restarted on this release.
-    if (sleep_state_ == kAsleep && contact.engaged) WakeSecondaries(release_ns);
-    if (sleep_state_ != kAsleep) {
-      reaction = StepPrimaryPeriod(contact.displacement_m);
-      // Only here: while paused for a reconfiguration the regions are not the primary's to read.
-      if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
-        flags |= force_flags::kBoundaryStale;
-      }
-      WatchEnergyBalance();
-      if (options_.sleep_at_rest) WatchForRest(contact.engaged);
+  // Asleep, the regions are exactly at rest at time 0: a touch steps on from there in this very
+  // period, with the secondaries restarted on this release.
+  if (sleep_state_ == kAsleep && contact.engaged) WakeSecondaries(release_ns);
+  if (sleep_state_ != kAsleep) {
+    reaction = StepPrimaryPeriod(contact.displacement_m);
+    // Only here: while paused for a reconfiguration the regions are not the primary's to read.
+    if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
+      *flags |= force_flags::kBoundaryStale;
     }
-    held_reaction_ = reaction;
-  } else if (holding) {
-    reaction = held_reaction_;
+    WatchEnergyBalance();
+    if (options_.sleep_at_rest) WatchForRest(contact.engaged);
   }
-  counters_.idle.Set(usable && sleep_state_ == kAsleep && stale);
-  const bool render = in_contact && !(stale && options_.zero_force_when_stale);
+  held_reaction_ = reaction;
+  return reaction;
+}
+
+PortGuard::Output HapticLoop::GuardPeriod(std::int64_t now_ns,
+                                          const std::array<double, 3>& simulated_n, bool render,
+                                          const ContactTracker::Contact& contact, bool have,
+                                          std::int32_t* flags) noexcept {
   PortGuard::Input port;
   port.now_ns = now_ns;
-  port.simulated_n = {-reaction[0], -reaction[1], -reaction[2]};
+  port.simulated_n = simulated_n;
   port.render = render;
   port.engaged = contact.engaged;
   // The port's motion: in contact, the contact point's path — the positions received, resampled
@@ -162,19 +184,15 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   const PortGuard::Output sent = guard_.Period(port);
   UpdateFaultState(sent);
   if (sent.limited) {
-    flags |= force_flags::kForceLimited;
+    *flags |= force_flags::kForceLimited;
     counters_.limited_periods.Add();
   }
   if (sent.dissipating) {
-    flags |= force_flags::kPortDissipating;
+    *flags |= force_flags::kPortDissipating;
     counters_.dissipating_periods.Add();
   }
-  if (sent.latched) flags |= force_flags::kFaultLatched;
-  if (in_contact) {
-    flags |= force_flags::kInContact;
-    counters_.last_contact_ns.Set(now_ns);
-  }
-  PublishPeriod(now_ns, sent.force_n, port.simulated_n, flags);
+  if (sent.latched) *flags |= force_flags::kFaultLatched;
+  return sent;
 }
 
 bool HapticLoop::RegionsAreOurs(std::int64_t release_ns) noexcept {

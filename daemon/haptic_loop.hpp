@@ -319,6 +319,17 @@ class HapticLoop {
   // Primary thread: one period's steps, the contact moved to `contact_m` over its substeps; the
   // reaction at the period's start, N.
   std::array<double, 3> StepPrimaryPeriod(const std::array<double, 3>& contact_m) noexcept;
+  // Primary thread: the node the contact wants the regions on, for the supervisor.
+  void PublishContactRequest(const ContactTracker::Contact& contact) noexcept;
+  // Primary thread: the period's reaction at its start — stepped on regions that are its own,
+  // held while a pause holds it, else none.
+  std::array<double, 3> PeriodReaction(bool usable, bool holding,
+                                       const ContactTracker::Contact& contact,
+                                       std::int64_t release_ns, std::int32_t* flags) noexcept;
+  // Primary thread: the simulated force through the port guard, its flags and counts.
+  PortGuard::Output GuardPeriod(std::int64_t now_ns, const std::array<double, 3>& simulated_n,
+                                bool render, const ContactTracker::Contact& contact, bool have,
+                                std::int32_t* flags) noexcept;
   // Primary thread: an input from the I/O thread (the resampler, the answers, the newest).
   void TakeInput(const DeviceSample& sample) noexcept;
   // Back to awake with nothing parked (supervisor, while the primary is paused or stopped).
