@@ -182,7 +182,7 @@ TEST_P(PredictionAgreesWithFreeDecay, ForEveryPaperConfiguration) {
   for (int k : {1, 2, 3}) {
     for (int r : {1, 2, 3, 4}) {
       for (double rate : {1000.0, 900.0, 800.0, 700.0, 600.0}) {
-        // The bare exchange: the prediction the daemon's supervisor relies on.
+        // The bare exchange (controllers off): the spectral estimate against free decay.
         AsyncRegions dut(Adaptive(r, k, rate, nu), AsyncRegions::kSubstepSafety,
                          AsyncRegions::InterfaceControl::kOff);
         const CoupledStability prediction = dut.EstimateCoupledStability();

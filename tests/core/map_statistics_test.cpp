@@ -66,13 +66,16 @@ TEST(MapStatistics, APValueCountsOnlyTheControlsThatVary) {
   // 30 samples: the rate's p-value controls for ν and E (k = 2), not for the nine constant axes
   // as well (k = 11 would be a t distribution of 17 degrees of freedom instead of 26).
   const PartialCorrelationTable table = PartialCorrelations(LinearMap(30, 5), ErrorField::kL2);
+  int rate_rows = 0;
   for (const PartialCorrelationRow& r : table.rows) {
     if (r.name != "secondary_rate") continue;
+    ++rate_rows;
     ASSERT_TRUE(r.pearson);
     EXPECT_DOUBLE_EQ(r.pearson->p_value, CorrelationPValue(r.pearson->coefficient, 30, 2));
     EXPECT_GT(std::abs(r.pearson->p_value - CorrelationPValue(r.pearson->coefficient, 30, 11)),
               1e-6);
   }
+  EXPECT_EQ(rate_rows, 1) << "the table has one secondary_rate row";
 }
 
 TEST(MapStatistics, TooFewSamplesForTheVaryingParametersAreRefused) {

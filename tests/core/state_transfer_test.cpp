@@ -236,7 +236,7 @@ TEST(StateTransfer, RefusesAStateOfAnotherLattice) {
 
 // The paper's press (1 cm, 1 Hz) switched, at three moments, between multirate configurations
 // of the default scene that differ in every parameter: the force must not step by more than
-// 0.1 N between periods across the switch (the bound at the device port).
+// 0.03 N between periods across the switch (a third of the 0.1 N a device port is held to).
 TEST(StateTransfer, ASwitchBetweenMultirateConfigurationsInThePressDoesNotStepTheForce) {
   const long periods = 1000;
   const std::vector<std::pair<Scene, Scene>> switches = {

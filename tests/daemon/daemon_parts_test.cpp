@@ -194,8 +194,6 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       << ConfigError("[lcm\nurl = 3\n");
 }
 
-// LCM traffic stays on this host unless the config says, in a key of its own, that it may leave:
-// ttl=255 and a TCP provider to another machine were accepted as any URL with "://".
 // What the scene's adaptivity does in the daemon: the supervisor chooses primary_size,
 // secondary_lod and secondary_rate; everything else — here two shells with the outer one at
 // adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
@@ -223,6 +221,8 @@ TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {
   EXPECT_EQ(RegionConfiguration{}.secondary_rate_hz, AdaptivitySettings{}.secondary_rate_hz);
 }
 
+// LCM traffic stays on this host unless the config says, in a key of its own, that it may leave:
+// ttl=255 and a TCP provider to another machine were accepted as any URL with "://".
 TEST(DaemonConfig, AnLcmUrlThatLeavesTheHostNeedsAllowNetwork) {
   for (const char* url : {"udpm://239.255.76.67:7667?ttl=0", "udpm://239.255.76.68:7700?ttl=0",
                           "udpm://239.255.76.67:7667?recv_buf_size=2097152&ttl=0", "memq://",

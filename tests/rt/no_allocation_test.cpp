@@ -167,9 +167,9 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
   EXPECT_TRUE(record.flags & force_flags::kInputStale);
 }
 
-// The port guard acting in the primary period: the envelope saturating, the engagement ramp, the
-// passivity controller and a fault latching (a fault_force_n below the press's force) cost no
-// allocation either.
+// The port guard acting in the primary period: the envelope saturating, the engagement ramp and a
+// fault latching (a fault_force_n below the press's force) cost no allocation either. (Its
+// passivity controller dissipating: PortGuardPeriod.NeverAllocatesWhileDissipating, below.)
 TEST(DaemonPrimaryPeriod, NeverAllocatesWhileThePortGuardActs) {
   Scene scene;
   scene.adaptivity.primary_size = 3;

@@ -300,6 +300,8 @@ TEST(LoopCounters, EveryCountedPeriodIsAFlaggedAnswer) {
   EXPECT_GT(contact, 100);
   EXPECT_EQ(loop.stale_periods(), stale);
   EXPECT_EQ(loop.limited_periods(), limited);
+  // (This press may leave the passivity controller idle: then both are 0. The stale and limited
+  // counts above are the ones this test can see fail.)
   EXPECT_EQ(loop.dissipating_periods(), dissipating);
   EXPECT_GT(loop.last_contact_ns(), 0);
 }

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
+
 #include "core/trial/force_error.hpp"
 
 namespace hapticsim {
@@ -84,6 +87,12 @@ TEST(RealTimeSchedule, CompletesWithFiniteForcesWhateverTheTiming) {
   EXPECT_EQ(threaded.samples.size(), 1001u);
   EXPECT_GT(threaded.peak_force_n, 1.0);
   EXPECT_LT(threaded.peak_force_n, 5.0);
+  int non_finite = 0;
+  for (const ForceSample& s : threaded.samples) {
+    non_finite += !std::isfinite(s.feedback_force_n[0] + s.feedback_force_n[1] +
+                                 s.feedback_force_n[2]);
+  }
+  EXPECT_EQ(non_finite, 0) << "every answer's force is finite";
   long misses = 0;
   for (int r = 0; r < regions.num_regions(); ++r) misses += dut.stats(r).misses;
   if (misses == 0) {

@@ -4,7 +4,7 @@
 Runs inside a private network namespace (tests/support/in_private_netns.sh): hapticsimd, the
 view's server, a simulated device pressing and Chromium all talk on its loopback only.
 
-Checks, as the issue asks:
+Checks:
   - the page loads without console errors (the browser's log has no SEVERE entry);
   - a screenshot shows the object (most of the picture outside the panel is not background);
   - a second screenshot taken during a press differs where the tool is (around the tool tip's
