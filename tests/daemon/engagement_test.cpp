@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -207,8 +208,22 @@ TEST(Engagement, NewRegionsWhileTheToolPressesRampInFromZero) {
   const Played played = Play(loop, PressTo(0.006), 3000, [&](int n) {
     if (n == 1200) loop.Reconfigure(other, HapticLoop::Handover::kRampIn);
   });
+  ASSERT_EQ(loop.reconfigurations(), 1);
   ExpectSmooth(played, "reconfiguration in contact");
-  EXPECT_LT(played.force_z.back(), -0.5);  // pressing again
+  // New regions start from rest, the tool's depth ramped in on them: the force sent ramps
+  // down (at the engage rate, never stepped) until it meets their own force rising from zero
+  // (measured: from 0.59 N to 0.051 N in 10 ms), then rises with it to what the new regions
+  // give pressed alone. Carried over instead, it would not have fallen at all.
+  ASSERT_LT(played.force_z[1199], -0.5) << "pressing before the new regions";
+  const auto after = played.force_z.begin() + 1200;
+  const auto lowest = std::max_element(after, after + 200);  // the force nearest zero (z < 0)
+  EXPECT_GT(*lowest, 0.15 * played.force_z[1199]) << "the force was not ramped in from near zero";
+  HapticLoop alone(other, HapticLoop::Options{});
+  const double other_settles = Play(alone, PressTo(0.006), 3000).force_z.back();
+  EXPECT_NEAR(played.force_z.back(), other_settles, 0.02 * std::abs(other_settles));
+  std::printf("new regions at 6 mm: force %.3f N before, %.4f N at its lowest %td periods later, "
+              "%.4f N at the end (those regions pressed alone: %.4f N)\n",
+              played.force_z[1199], *lowest, lowest - after, played.force_z.back(), other_settles);
 }
 
 // A configuration switched while the tool presses (hapticsimd does this as soon as a better one is
@@ -343,6 +358,40 @@ TEST(Substeps, APrimaryTakingSubstepsMovesTheContactAsTheOfflineScheduleDoes) {
   EXPECT_GT(largest_force, 0.5) << "a press that shows nothing";
   EXPECT_LT(largest_difference, 1e-9 * largest_force)
       << "the daemon's primary steps its substeps otherwise than the offline schedule";
+}
+
+// A tissue twenty times stiffer than the default and undamped, vibrated 2 mm at 20 Hz about 3 mm
+// deep: sampled at 1 kHz its contact force changes so much between periods that the force held
+// over each (the zero-order hold) would hand the user more energy on the way out than the port
+// absorbed on the way in. The passivity controller takes that excess out; every period it acts is
+// flagged on the answer and counted, and the energy it took is summed. The force still pushes
+// back: lowered along the motion, not zeroed.
+TEST(Passivity, ADissipatingPeriodIsFlaggedCountedAndItsEnergySummed) {
+  Scene stiff = DefaultScene();
+  stiff.material.youngs_modulus_pa *= 20;
+  stiff.material.damping_per_s = 0;
+  HapticLoop loop(stiff, HapticLoop::Options{});
+  const double pi = 3.141592653589793;
+  const Played played = Play(
+      loop,
+      [&](int n) -> std::optional<double> {
+        return n < 50 ? -0.002 : 0.003 + 0.002 * std::sin(2 * pi * 20 * n / 1000.0);
+      },
+      1000);
+  std::int64_t flagged = 0;
+  double strongest = 0;
+  for (size_t n = 0; n < played.flags.size(); ++n) {
+    flagged += (played.flags[n] & force_flags::kPortDissipating) != 0;
+    strongest = std::min(strongest, played.force_z[n]);
+  }
+  EXPECT_GT(flagged, 10) << "the passivity controller never acted";
+  EXPECT_EQ(loop.dissipating_periods(), flagged);
+  EXPECT_GT(loop.port_energy_dissipated_j(), 0.0);
+  EXPECT_LT(strongest, -2.0) << "a 5 mm press on this tissue pushes back with several N";
+  EXPECT_LE(played.most_attractive_n, 1e-12) << "a force pulling the tool in";
+  std::printf("stiff undamped tissue vibrated: %lld periods dissipating, %.3g J taken out; the "
+              "force reached %.2f N\n",
+              static_cast<long long>(flagged), loop.port_energy_dissipated_j(), strongest);
 }
 
 }  // namespace

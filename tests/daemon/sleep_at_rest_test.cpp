@@ -154,15 +154,24 @@ TEST(SleepAtRest, ATouchWhileTheSecondaryParksIsNotThrownAway) {
 }
 
 TEST(SleepAtRest, AnObjectThatNeverRingsDownNeverSleeps) {
-  // No damping: the first press's vibration never dies away, so the regions must stay awake
-  // after it (at rest before it, they may sleep).
-  Scene scene;
-  scene.adaptivity.primary_size = 3;
-  scene.material.damping_per_s = 0;
-  HapticLoop loop(scene, HapticLoop::Options{});
-  const Played played = Play(loop, TwoPresses, 2000);
-  EXPECT_EQ(loop.sleeps(), 1);
-  EXPECT_FALSE(played.asleep.back());
+  // The first press and the 4 s above the object after it. Damped (the control: the same run
+  // must be able to sleep), the object rings down and the regions sleep again; undamped, its
+  // vibration never dies away, so they must stay awake after it (at rest before it, both sleep).
+  constexpr int kFirstPressAndRest = 5300;
+  auto sleeps_of = [](double damping_per_s, bool* asleep_at_end) {
+    Scene scene;
+    scene.adaptivity.primary_size = 3;
+    scene.material.damping_per_s = damping_per_s;
+    HapticLoop loop(scene, HapticLoop::Options{});
+    const Played played = Play(loop, TwoPresses, kFirstPressAndRest);
+    *asleep_at_end = played.asleep.back();
+    return loop.sleeps();
+  };
+  bool damped_asleep = false, undamped_asleep = true;
+  EXPECT_EQ(sleeps_of(Scene{}.material.damping_per_s, &damped_asleep), 2);
+  EXPECT_TRUE(damped_asleep) << "the control never slept after the press";
+  EXPECT_EQ(sleeps_of(0, &undamped_asleep), 1);
+  EXPECT_FALSE(undamped_asleep);
 }
 
 }  // namespace

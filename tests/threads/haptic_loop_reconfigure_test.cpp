@@ -250,6 +250,38 @@ PressResult PaperPress(bool switch_configurations, int busy_threads) {
   return result;
 }
 
+// Each switch in a press: the answers from the one before its hold (the periods answered while
+// the new regions were installed, flagged reconfiguring in contact) to the fifth after it.
+struct SwitchWindow {
+  double largest_jump_n = 0;  // between any two consecutive answers in it
+  bool on_time = true;        // none of them near a late wake
+};
+
+std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces) {
+  std::vector<Wake> wakes;
+  for (const ForceRecord& f : forces) wakes.push_back({f.period, f.utime_us});
+  const std::vector<bool> near_late = NearALateWake(wakes);
+  auto held = [&](size_t i) {
+    return (forces[i].flags & force_flags::kReconfiguring) &&
+           (forces[i].flags & force_flags::kInContact);
+  };
+  std::vector<SwitchWindow> windows;
+  for (size_t i = 1; i < forces.size(); ++i) {
+    if (!held(i) || held(i - 1)) continue;
+    size_t end = i;
+    while (end < forces.size() && held(end)) ++end;
+    SwitchWindow w;
+    for (size_t k = i; k < std::min(forces.size(), end + 5); ++k) {
+      w.largest_jump_n =
+          std::max(w.largest_jump_n, std::abs(forces[k].force_n[2] - forces[k - 1].force_n[2]));
+      w.on_time = w.on_time && !near_late[k] && !near_late[k - 1];
+    }
+    windows.push_back(w);
+    i = end;
+  }
+  return windows;
+}
+
 // A configuration switched while the tool presses: the force is held for the few periods the new
 // regions are being installed (never dropped to zero), the object's motion carries over, and the
 // force does not step by more than 0.1 N between periods — quiet, and beside two busy threads.
@@ -271,6 +303,16 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
       }
     }
     EXPECT_GT(held, 3) << "no period was answered while the regions were replaced";
+    const std::vector<SwitchWindow> windows = SwitchWindows(switched.forces);
+    int on_time = 0;
+    double across_on_time = 0, across_any = 0;
+    for (const SwitchWindow& w : windows) {
+      across_any = std::max(across_any, w.largest_jump_n);
+      if (w.on_time) ++on_time, across_on_time = std::max(across_on_time, w.largest_jump_n);
+    }
+    std::printf("%d busy threads: %zu holds, %d on time; largest change across a switch %.4f N on "
+                "time, %.4f N any\n",
+                busy, windows.size(), on_time, across_on_time, across_any);
     std::printf(
         "%d busy threads: largest force change between periods woken on time %.4f N with 3 "
         "switches in the press (%d periods held), %.4f N without; between any periods %.4f N "
@@ -278,11 +320,20 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
         busy, switched.largest_jump_n, held, plain.largest_jump_n, switched.largest_jump_any_n,
         plain.largest_jump_any_n, switched.near_late_wakes, plain.near_late_wakes,
         switched.forces.size());
+    EXPECT_EQ(windows.size(), 3u) << "each switch in the press is a hold of its own";
     if (kSanitized) continue;
     // Beside two busy threads 1–31 % of the answers were near a late wake (with or without
-    // switches): half, and what is left still covers the switches.
+    // switches): half, and what is left still covers the press.
     EXPECT_LT(switched.near_late_wakes, switched.forces.size() / 2);
-    EXPECT_LE(switched.largest_jump_n, 0.1);
+    // The unswitched press is smooth, and the switches add at most 50 mN to its largest change
+    // (measured: 0.0132 N against 0.0075 N quiet, 0.0185 N against 0.0092 N beside two busy
+    // threads).
+    EXPECT_LE(plain.largest_jump_n, 0.1);
+    EXPECT_LE(switched.largest_jump_n, plain.largest_jump_n + 0.05);
+    // Across each switch itself, late wakes included: a late wake there is no excuse for a step.
+    // Quiet, the 0.1 N of every smoothness check; beside busy threads, where a late wake alone
+    // steps the force (the soak's worst in contact under load: 0.2 N), 0.25 N.
+    EXPECT_LE(across_any, busy == 0 ? 0.1 : 0.25);
   }
 }
 

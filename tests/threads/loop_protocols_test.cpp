@@ -300,8 +300,9 @@ TEST(LoopCounters, EveryCountedPeriodIsAFlaggedAnswer) {
   EXPECT_GT(contact, 100);
   EXPECT_EQ(loop.stale_periods(), stale);
   EXPECT_EQ(loop.limited_periods(), limited);
-  // (This press may leave the passivity controller idle: then both are 0. The stale and limited
-  // counts above are the ones this test can see fail.)
+  // An ordinary press on the default tissue is passive as the loop renders it: the controller
+  // stays idle here, and both are 0. Passivity.ADissipatingPeriodIsFlaggedCountedAndItsEnergy…
+  // (tests/daemon/engagement_test.cpp) makes it act and checks its count.
   EXPECT_EQ(loop.dissipating_periods(), dissipating);
   EXPECT_GT(loop.last_contact_ns(), 0);
 }

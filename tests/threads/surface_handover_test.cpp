@@ -96,13 +96,14 @@ TEST(SurfaceHandover, FramesStayWholeWhileTheRegionsAreReplacedAndSleep) {
   HapticLoop loop(scene, HapticLoop::Options{});
   loop.Start();
   std::atomic<bool> done{false};
-  std::atomic<int> frames{0}, refused{0};
+  std::atomic<int> frames{0}, refused{0}, asleep_frames{0};
   std::atomic<std::int64_t> last_configuration{-1};
   std::atomic<bool> bad{false};
   // The deformation thread's part, as fast as it can ask.
   std::thread deformation([&] {
     HapticLoop::SurfaceFrame frame;
     while (!done) {
+      const bool asleep_before = loop.asleep();
       if (!loop.TakeSurface(20'000'000, &frame)) {
         ++refused;
         continue;
@@ -113,6 +114,7 @@ TEST(SurfaceHandover, FramesStayWholeWhileTheRegionsAreReplacedAndSleep) {
       if (!whole || !finite || frame.configuration_id < last_configuration) bad = true;
       last_configuration = frame.configuration_id;
       ++frames;
+      if (asleep_before && loop.asleep()) ++asleep_frames;  // asleep all through the taking
     }
   });
   // The supervisor's part: four replacements, on two nodes and two configurations.
@@ -142,9 +144,12 @@ TEST(SurfaceHandover, FramesStayWholeWhileTheRegionsAreReplacedAndSleep) {
   // (Under a sanitizer the steps are too slow to keep up, and whether the regions reach rest in
   // time is not what is checked there.)
   EXPECT_GE(sleeps, 1) << "the regions never slept: the frames taken while asleep were not tested";
+  EXPECT_GT(asleep_frames, 0) << "no frame was taken while the regions slept";
 #endif
-  std::printf("surface frames: %d taken, %d asked again after a replacement; %lld sleeps\n",
-              frames.load(), refused.load(), static_cast<long long>(sleeps));
+  std::printf(
+      "surface frames: %d taken (%d while asleep), %d asked again after a replacement; %lld "
+      "sleeps\n",
+      frames.load(), asleep_frames.load(), refused.load(), static_cast<long long>(sleeps));
 }
 
 }  // namespace
