@@ -220,30 +220,41 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   }
   const size_t before = client.Forces().size();
   ASSERT_GT(before, 0u);
+  const std::int64_t replaced_before = client.LastStatus()->reconfigurations;
   EXPECT_EQ(Ctl("set-error-target 5").rfind("ok:", 0), 0u);  // size 1 meets it, and is cheaper
   for (std::int64_t seq = 901; seq <= 2400; ++seq) {         // held at 8 mm for 1.5 s
     client.Send(seq, kEdge / 2, kEdge / 2, 0.008);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  EXPECT_EQ(client.LastStatus()->primary_size, 1) << "not switched in contact\n" << daemon_->Log();
+  const std::optional<status_t> switched = client.LastStatus();
+  EXPECT_EQ(switched->primary_size, 1) << "not switched in contact\n" << daemon_->Log();
+  EXPECT_GT(switched->reconfigurations, replaced_before) << "the regions were never replaced";
   const auto pressed = client.Forces();
   const double pressing_n = pressed[before - 1].force[2];
   ASSERT_LT(pressing_n, -0.5) << "8 mm in pushes back with about 0.7 N";
   // The force nearest to zero and farthest from it, N (z < 0 pushes back).
   double largest_step = 0, weakest = -1e9, strongest = 0;
+  int held_answers = 0, switching_answers = 0;
   for (size_t i = before; i < pressed.size(); ++i) {
     // After the last input the answers go stale and the force is released: not the switch's.
     if (pressed[i].flags & force_feedback_t::FLAG_INPUT_STALE) break;
     ASSERT_TRUE(pressed[i].flags & force_feedback_t::FLAG_IN_CONTACT) << "seq " << pressed[i].seq;
+    ++held_answers;
+    if (pressed[i].flags & force_feedback_t::FLAG_RECONFIGURING) ++switching_answers;
     largest_step = std::max(largest_step, std::abs(pressed[i].force[2] - pressed[i - 1].force[2]));
     weakest = std::max(weakest, static_cast<double>(pressed[i].force[2]));
     strongest = std::min(strongest, static_cast<double>(pressed[i].force[2]));
   }
   std::printf(
       "switched in contact at 8 mm: largest force change between periods %.4f N, force "
-      "between %.3f N and %.3f N (it pressed with %.3f N before)\n",
-      largest_step, strongest, weakest, pressing_n);
+      "between %.3f N and %.3f N (it pressed with %.3f N before); %d answers held, %d of them "
+      "while the regions were replaced\n",
+      largest_step, strongest, weakest, pressing_n, held_answers, switching_answers);
+  // The 1.5 s held at 8 mm were answered (a lost LCM message now and then aside), and the
+  // switch happened among them: the step and the force below are measured across it.
+  EXPECT_GT(held_answers, 1300) << daemon_->Log();
+  EXPECT_GT(switching_answers, 0) << "no answer in contact came while the regions were replaced";
   EXPECT_LE(largest_step, 0.1);
   // It relaxes from the press's overshoot towards the static 0.7–0.75 N; a force dropped and
   // ramped in again (a switch from rest) would pass near zero.
@@ -379,6 +390,33 @@ TEST(HapticsimdFaults, AForceAboveTheLimitIsNeverSentAndTheBlackBoxIsLogged) {
   EXPECT_FALSE(forces.back().flags & force_feedback_t::FLAG_IN_CONTACT);
   EXPECT_NE(log.find("black box (force fault): the last"), std::string::npos) << log;
   EXPECT_NE(log.find("black box: t +0.0 ms seq"), std::string::npos) << log;
+
+  // The tool leaves the object: the simulation, restarted from rest, re-arms the fault.
+  std::int64_t seq = 800;
+  auto play = [&](int periods, const std::function<double(int)>& z) {
+    for (int n = 0; n < periods; ++n) {
+      client.Send(++seq, kEdge / 2, kEdge / 2, z(n));
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  };
+  play(300, [](int) { return -0.002; });
+  ASSERT_TRUE(client.WaitForStatus(
+      [](const status_t& s) { return s.fault_rearms == 1 && !s.fault_latched; }, 5))
+      << "not re-armed with the tool out\n"
+      << daemon.Log();
+  EXPECT_GE(client.LastStatus()->reconfigurations, 1) << "the regions were not restarted";
+  // A press within the limits afterwards is rendered: 2 mm in at 10 mm/s, held (about 0.27 N).
+  const size_t before = client.Forces().size();
+  play(700, [](int n) { return std::min(0.002, -0.002 + 2e-5 * n); });
+  const auto again = client.Forces();
+  ASSERT_GT(again.size(), before + 500);
+  const force_feedback_t& held = again.back();
+  EXPECT_TRUE(held.flags & force_feedback_t::FLAG_IN_CONTACT) << held.flags;
+  EXPECT_FALSE(held.flags & force_feedback_t::FLAG_FAULT_LATCHED) << held.flags;
+  EXPECT_LT(held.force[2], -0.15) << "the press after the re-arm was not rendered";
+  EXPECT_GT(held.force[2], -0.4);
+  EXPECT_EQ(client.LastStatus()->latched_faults, 1) << daemon.Log();
+  std::printf("after the re-arm, held 2 mm in: %.3f N\n", held.force[2]);
   daemon.Signal(SIGTERM);
   EXPECT_EQ(daemon.Wait(5), 0);
 }
@@ -787,10 +825,10 @@ TEST(HapticsimdSharedMemory, ADriverProcessGetsAForceForEveryInputAndOtherUsersA
     EXPECT_NE(at, std::string::npos) << key;
     return std::stod(json.substr(at + key.size() + 4));
   };
-  // Two free-running 1 kHz clocks: the primary answers the newest input at each of its periods,
-  // so an input that arrives just after another within one period is superseded. Measured:
-  // 1961 of 2000 on an idle machine, about 1600 with both cores busy.
-  EXPECT_GE(number("distinct_seqs_answered"), 1400) << json;  // of 2000 periods
+  // Every input is answered: by the period that first used it, from the answer's first_seq to
+  // its seq (two free-running 1 kHz clocks: a period may take two inputs, and the newest is the
+  // seq it answers). The rings on both sides hold 256 ms, more than a shared machine's stalls.
+  EXPECT_EQ(number("inputs_answered"), 2000) << json;
   // The answer's lag behind the newest input: a few periods, but a shared machine stalls a
   // process for 30–100 ms now and then (measured here and in CI), so the bound is 150 periods; a
   // daemon that stopped answering or fell behind for good is seconds behind by the end.
@@ -936,10 +974,21 @@ TEST(SimulatedDevice, DrivesTheDaemonOverLcmAndSharedMemoryAndReplaysARecordedSe
   EXPECT_EQ(report["inputs_sent"], 2000);
   EXPECT_EQ(report["nonfinite_forces"], 0);
   EXPECT_EQ(report["force_out_of_contact"], 0);
-  EXPECT_GT(report["largest_force_step_N"].get<double>(), 0.0);     // measured, finite
   EXPECT_GT(report["contact_answers"].get<int>(), 500) << lcm.out;  // the press is in for ~0.6 s
+  // Each 1 s press is the paper's (1 cm, 1 Hz): its peak is the reference run's within the
+  // configuration's error and the guard's ramps (measured: 1.53 N and 1.43 N against 1.486 N).
+  const auto reference = testing::RunCommand({HAPTICSIM_CLI_PATH, "simulate", "--json"});
+  ASSERT_EQ(reference.exit_status, 0) << reference.err;
+  const double reference_peak_n = nlohmann::json::parse(reference.out)["peak_force_N"];
+  ASSERT_EQ(report["press_peaks_n"].size(), 2u) << lcm.out;
+  for (const auto& peak : report["press_peaks_n"]) {
+    EXPECT_NEAR(peak.get<double>(), reference_peak_n, 0.1 * reference_peak_n) << lcm.out;
+  }
+  // A press is smooth: the port guard's slew would allow 0.5 N per period (measured: 0.12 N).
+  EXPECT_LT(report["largest_force_step_N"].get<double>(), 0.3) << lcm.out;
+  // The round trip: answered within a couple of periods (measured median 1.08 ms).
   EXPECT_GT(report["latency_us"]["median"].get<double>(), 0);
-  EXPECT_GE(report["latency_us"]["max"].get<double>(), report["latency_us"]["p99"].get<double>());
+  EXPECT_LT(report["latency_us"]["median"].get<double>(), 3000) << lcm.out;
   EXPECT_EQ(report["daemon"]["regions"][0]["name"], "primary");
   // The primary thread's compute time per period over the whole session: a status every 200 ms
   // (the default rate), each with its interval's percentiles.

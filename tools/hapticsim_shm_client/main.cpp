@@ -1,15 +1,20 @@
 // hapticsim-shm-client: a device driver's side of the shared-memory interface, as an example for
 // driver writers and a probe for tests. At 1 kHz (absolute-time sleeps) it moves the tool tip
 // from above the surface into the object at the paper's contact point and back, reads the force
-// for every period, and prints a JSON summary.
+// for every period, and prints a JSON summary. Every answer the daemon wrote is read from the
+// output ring (not only the newest), so the summary can tell which inputs were never answered.
 //
 //   hapticsim-shm-client [--socket /run/hapticsim/hapticsimd.sock] [--duration 2] [--depth 0.01]
 #include <time.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <thread>
+#include <vector>
 
 #include "core/error.hpp"
 #include "ipc/shm_device_client.hpp"
@@ -44,6 +49,19 @@ int main(int argc, char** argv) {
     std::int64_t max_lag = 0, last_seen = -1, out_of_order = 0, no_source = 0;
     double max_push_back = 0;
     std::set<std::int64_t> seen;
+    // Each input is answered by the period that first used it: every seq from an answer's
+    // first_seq to its seq. Read from the ring after each period, and once more at the end.
+    std::vector<bool> answered(static_cast<std::size_t>(periods) + 1, false);
+    std::int64_t last_period_read = -1;
+    auto mark_answered = [&] {
+      last_period_read =
+          client.ReadForcesSince(last_period_read, [&](const hapticsim::shm::ShmForceOutput& f) {
+            for (std::int64_t s = std::max<std::int64_t>(f.first_seq, 1);
+                 s <= std::min(f.seq, periods); ++s) {
+              answered[static_cast<std::size_t>(s)] = true;
+            }
+          });
+    };
     const std::int64_t start = NowNs() + 1'000'000;
     for (std::int64_t seq = 1; seq <= periods; ++seq) {
       const std::int64_t release = start + (seq - 1) * 1'000'000;
@@ -67,6 +85,7 @@ int main(int argc, char** argv) {
         ++no_source;
         continue;
       }
+      mark_answered();
       hapticsim::shm::ShmForceOutput force;
       if (!client.ReadForce(&force) || force.seq < 0) continue;
       if (force.seq == seq) ++answered_same_period;
@@ -79,12 +98,17 @@ int main(int argc, char** argv) {
       if (force.flags & 8) ++stale;
       max_push_back = std::max(max_push_back, -force.force_n[2]);
     }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the last input's period
+    mark_answered();
+    const auto inputs_answered = std::count(answered.begin() + 1, answered.end(), true);
     std::printf(
-        "{\"periods\": %lld, \"answered_same_period\": %lld, \"distinct_seqs_answered\": %zu, "
+        "{\"periods\": %lld, \"inputs_answered\": %lld, \"answered_same_period\": %lld, "
+        "\"distinct_seqs_answered\": %zu, "
         "\"max_lag_periods\": %lld, \"out_of_order\": %lld, \"nonfinite_forces\": %lld, "
         "\"in_contact_periods\": %lld, \"stale_periods\": %lld, \"max_push_back_N\": %.6g, "
         "\"no_force_source_periods\": %lld, \"daemon_running\": %s}\n",
-        static_cast<long long>(periods), static_cast<long long>(answered_same_period), seen.size(),
+        static_cast<long long>(periods), static_cast<long long>(inputs_answered),
+        static_cast<long long>(answered_same_period), seen.size(),
         static_cast<long long>(max_lag), static_cast<long long>(out_of_order),
         static_cast<long long>(nonfinite), static_cast<long long>(in_contact),
         static_cast<long long>(stale), max_push_back, static_cast<long long>(no_source),
