@@ -7,18 +7,27 @@
 namespace hapticsim {
 
 AssembledStiffness::AssembledStiffness(const HexGrid& grid, const Material& material)
+    : AssembledStiffness(grid, MaterialField(grid, material)) {}
+
+AssembledStiffness::AssembledStiffness(const HexGrid& grid, const MaterialField& field)
     : StiffnessOperator(grid.num_dofs()), matrix_(grid.num_dofs(), grid.num_dofs()) {
-  const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(grid.spacing(), material);
+  std::vector<Hex8Element::Matrix24> ke;
+  for (const Material& material : field.materials()) {
+    ke.push_back(Hex8Element::Stiffness(grid.spacing(), material));
+  }
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<size_t>(grid.num_elements()) * 24 * 24);
+  triplets.reserve(static_cast<size_t>(field.num_occupied()) * 24 * 24);
   for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
     for (int ey = 0; ey + 1 < grid.ny(); ++ey) {
       for (int ex = 0; ex + 1 < grid.nx(); ++ex) {
+        const std::int16_t m = field.material_of(field.Element(ex, ey, ez));
+        if (m == MaterialField::kEmpty) continue;
+        const Hex8Element::Matrix24& k = ke[static_cast<size_t>(m)];
         const auto nodes = grid.ElementNodes(ex, ey, ez);
         for (int i = 0; i < 24; ++i) {
           const int row = grid.Dof(nodes[i / 3], i % 3);
           for (int j = 0; j < 24; ++j) {
-            triplets.emplace_back(row, grid.Dof(nodes[j / 3], j % 3), ke(i, j));
+            triplets.emplace_back(row, grid.Dof(nodes[j / 3], j % 3), k(i, j));
           }
         }
       }

@@ -4,6 +4,7 @@
 
 #include "core/fem/hex_grid.hpp"
 #include "core/fem/material.hpp"
+#include "core/fem/material_field.hpp"
 #include "core/fem/stiffness_operator.hpp"
 
 namespace hapticsim {
@@ -16,6 +17,8 @@ namespace hapticsim {
 class AssembledStiffness final : public StiffnessOperator {
  public:
   AssembledStiffness(const HexGrid& grid, const Material& material);
+  /** Over the occupied elements of `field`, each with its material's element stiffness. */
+  AssembledStiffness(const HexGrid& grid, const MaterialField& field);
 
   void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
              Eigen::Ref<Eigen::VectorXd> ku) const override;

@@ -9,15 +9,12 @@
 namespace hapticsim {
 namespace {
 
-// Every DOF neither fixed nor driven, in order.
+// Every free DOF, in order: neither fixed nor driven, and on the object (a node off an object's
+// shape has no mass; it is neither stepped nor prescribed, and stays at rest).
 std::vector<int> FreeDofs(const ElasticModel& model) {
-  const auto& constraints = model.constraints();
-  std::vector<bool> prescribed(static_cast<size_t>(model.grid().num_dofs()), false);
-  for (int dof : constraints.fixed_dofs) prescribed[dof] = true;
-  for (int dof : constraints.driven_dofs) prescribed[dof] = true;
   std::vector<int> free;
   for (int dof = 0; dof < model.grid().num_dofs(); ++dof) {
-    if (!prescribed[dof]) free.push_back(dof);
+    if (model.free_mask()[dof] > 0) free.push_back(dof);
   }
   return free;
 }
@@ -39,7 +36,7 @@ double CheckedStep(double dt_s) {
 CentralDifferenceIntegrator::CentralDifferenceIntegrator(const ElasticModel& model, double dt_s)
     : model_(model),
       dt_(CheckedStep(dt_s)),
-      region_(model.stiffness(), model.dof_mass(), model.material().damping_per_s,
+      region_(model.stiffness(), model.dof_mass(), model.damping_per_s(),
               FreeDofs(model), FixedThenDriven(model), {}, dt_s),
       prescribed_next_(region_.prescribed().size(), 0.0),
       driven_reaction_(model.constraints().driven_dofs.size(), 0.0),

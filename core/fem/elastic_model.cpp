@@ -1,35 +1,70 @@
 #include "core/fem/elastic_model.hpp"
 
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
+#include "core/fem/elementwise_stiffness.hpp"
 #include "core/fem/stencil_stiffness.hpp"
 
 namespace hapticsim {
 
 ElasticModel::ElasticModel(const HexGrid& grid, const Material& material,
                            DofConstraints constraints)
+    : ElasticModel(grid, MaterialField(grid, material), std::move(constraints)) {}
+
+ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstraints constraints)
     : grid_(grid),
-      material_(material),
-      stiffness_(std::make_unique<StencilStiffness>(grid, material)),
+      field_(std::move(field)),
       constraints_(std::move(constraints)),
-      dof_mass_(grid.num_dofs()),
+      dof_mass_(Eigen::VectorXd::Zero(grid.num_dofs())),
       free_mask_(Eigen::VectorXd::Ones(grid.num_dofs())) {
-  const double h = grid.spacing();
-  const double element_node_mass = material.density_kg_m3 * h * h * h / 8.0;
-  const int n = grid.num_nodes();
-  for (int node = 0; node < n; ++node) {
-    const auto idx = grid.NodeIndices(node);
-    const std::array<int, 3> counts{grid.nx(), grid.ny(), grid.nz()};
-    int adjacent = 1;
-    for (int axis = 0; axis < 3; ++axis) {
-      const bool on_face = idx[axis] == 0 || idx[axis] == counts[axis] - 1;
-      adjacent *= on_face ? 1 : 2;
-    }
-    for (int c = 0; c < 3; ++c) dof_mass_[grid.Dof(node, c)] = adjacent * element_node_mass;
+  for (const Material& m : field_.materials()) {
+    HAPTICSIM_THROW_UNLESS(m.damping_per_s == damping_per_s(),
+                           "the materials' damping differs (" + std::to_string(m.damping_per_s) +
+                               " and " + std::to_string(damping_per_s()) +
+                               " 1/s): C = d·M takes one d for the whole object");
   }
+  if (field_.uniform_and_full()) {
+    stiffness_ = std::make_unique<StencilStiffness>(grid, field_.materials().front());
+  } else {
+    stiffness_ = std::make_unique<ElementwiseStiffness>(grid, field_);
+  }
+  LumpMass();
+  Constrain();
+}
+
+void ElasticModel::LumpMass() {
+  // Counted per material, then multiplied: a node's k equal shares as k·share, as exactly as the
+  // cube always had it (a sum of k equal terms can round differently).
+  const double h = grid_.spacing();
+  const int n = grid_.num_nodes();
+  const size_t materials = field_.materials().size();
+  std::vector<int> count(static_cast<size_t>(n) * materials, 0);
+  for (int ez = 0; ez + 1 < grid_.nz(); ++ez) {
+    for (int ey = 0; ey + 1 < grid_.ny(); ++ey) {
+      for (int ex = 0; ex + 1 < grid_.nx(); ++ex) {
+        const std::int16_t m = field_.material_of(field_.Element(ex, ey, ez));
+        if (m == MaterialField::kEmpty) continue;
+        for (int node : grid_.ElementNodes(ex, ey, ez)) {
+          ++count[static_cast<size_t>(node) * materials + static_cast<size_t>(m)];
+        }
+      }
+    }
+  }
+  for (int node = 0; node < n; ++node) {
+    double mass = 0;
+    for (size_t m = 0; m < materials; ++m) {
+      const double share = field_.materials()[m].density_kg_m3 * h * h * h / 8.0;
+      mass += count[static_cast<size_t>(node) * materials + m] * share;
+    }
+    for (int c = 0; c < 3; ++c) dof_mass_[grid_.Dof(node, c)] = mass;
+  }
+}
+
+void ElasticModel::Constrain() {
   auto constrain = [&](int dof) {
-    HAPTICSIM_THROW_UNLESS(dof >= 0 && dof < grid.num_dofs(),
+    HAPTICSIM_THROW_UNLESS(dof >= 0 && dof < grid_.num_dofs(),
                            "constrained DOF " + std::to_string(dof) + " is outside the grid");
     HAPTICSIM_THROW_UNLESS(free_mask_[dof] == 1.0,
                            "DOF " + std::to_string(dof) + " is constrained twice");
@@ -37,6 +72,11 @@ ElasticModel::ElasticModel(const HexGrid& grid, const Material& material,
   };
   for (int dof : constraints_.fixed_dofs) constrain(dof);
   for (int dof : constraints_.driven_dofs) constrain(dof);
+  // Off the object: no mass, no stiffness, held where it is (after the checks above, so a
+  // constraint there is not counted twice).
+  for (int dof = 0; dof < grid_.num_dofs(); ++dof) {
+    if (dof_mass_[dof] == 0.0) free_mask_[dof] = 0.0;
+  }
 }
 
 }  // namespace hapticsim

@@ -6,6 +6,7 @@
 
 #include "core/fem/hex_grid.hpp"
 #include "core/fem/material.hpp"
+#include "core/fem/material_field.hpp"
 #include "core/fem/stiffness_operator.hpp"
 
 namespace hapticsim {
@@ -21,26 +22,40 @@ struct DofConstraints {
  *   M ü + C u̇ + K u = f,  C = d·M,
  * with the matrix-free stiffness K, the lumped (diagonal) mass M, and the prescribed DOFs.
  *
- * Lumped mass: every element gives ρ·h³/8 to each of its 8 nodes, so a node's mass is
- * ρ·h³·(number of adjacent elements)/8.
+ * Lumped mass: every occupied element gives ρ_e·h³/8 to each of its 8 nodes, so a node's mass
+ * is the sum over the occupied elements around it. A node no occupied element touches (outside
+ * an object of another shape than the grid's box) has neither mass nor stiffness: it is held
+ * like a fixed one (free_mask 0) and never moves.
  */
 class ElasticModel {
  public:
-  /** @throws Error when a constrained DOF index is out of range or listed twice. */
+  /** The whole grid of one material (the paper's cube): the stencil operator. */
   ElasticModel(const HexGrid& grid, const Material& material, DofConstraints constraints);
+  /**
+   * Any shape and materials on the grid: the element-by-element operator, unless the field is
+   * one material in every element (then as above, to the bit).
+   * @throws Error when a constrained DOF index is out of range or listed twice, or when the
+   *         materials' damping differs (C = d·M takes one d for the whole object).
+   */
+  ElasticModel(const HexGrid& grid, MaterialField field, DofConstraints constraints);
 
   const HexGrid& grid() const { return grid_; }
-  const Material& material() const { return material_; }
+  const MaterialField& field() const { return field_; }
+  /** d in C = d·M, 1/s: the same for every material of the field. */
+  double damping_per_s() const { return field_.materials().front().damping_per_s; }
   const StiffnessOperator& stiffness() const { return *stiffness_; }
   const DofConstraints& constraints() const { return constraints_; }
-  /** Lumped mass of every DOF, kg (component-blocked like the displacements). */
+  /** Lumped mass of every DOF, kg (component-blocked like the displacements); 0 off the object. */
   const Eigen::VectorXd& dof_mass() const { return dof_mass_; }
-  /** 1 for a free DOF, 0 for a fixed or driven one. */
+  /** 1 for a free DOF, 0 for a fixed or driven one or one off the object. */
   const Eigen::VectorXd& free_mask() const { return free_mask_; }
 
  private:
+  void LumpMass();
+  void Constrain();
+
   HexGrid grid_;
-  Material material_;
+  MaterialField field_;
   std::unique_ptr<StiffnessOperator> stiffness_;
   DofConstraints constraints_;
   Eigen::VectorXd dof_mass_;

@@ -1,7 +1,9 @@
 #include "core/fem/stability_estimate.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdint>
 
 #include "core/fem/hex8_element.hpp"
@@ -9,14 +11,19 @@
 namespace hapticsim {
 
 double ElementBoundCriticalDt(const ElasticModel& model) {
+  // The bound of every material; the smallest holds for all (the stiffest, lightest one's).
   const double h = model.grid().spacing();
-  const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(h, model.material());
-  const double lambda_ke =
-      Eigen::SelfAdjointEigenSolver<Hex8Element::Matrix24>(ke, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-  const double element_node_mass = model.material().density_kg_m3 * h * h * h / 8.0;
-  return 2.0 / std::sqrt(lambda_ke / element_node_mass);
+  double critical_dt = std::numeric_limits<double>::infinity();
+  for (const Material& material : model.field().materials()) {
+    const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(h, material);
+    const double lambda_ke =
+        Eigen::SelfAdjointEigenSolver<Hex8Element::Matrix24>(ke, Eigen::EigenvaluesOnly)
+            .eigenvalues()
+            .maxCoeff();
+    const double element_node_mass = material.density_kg_m3 * h * h * h / 8.0;
+    critical_dt = std::min(critical_dt, 2.0 / std::sqrt(lambda_ke / element_node_mass));
+  }
+  return critical_dt;
 }
 
 StabilityEstimate EstimateStability(const ElasticModel& model,
@@ -34,7 +41,9 @@ StabilityEstimate EstimateStability(const StiffnessOperator& stiffness,
   const Eigen::Index n = stiffness.num_dofs();
   // D = M^(-1/2) on free DOFs, 0 on constrained ones: A = D K D is symmetric and has the
   // eigenvalues of M⁻¹K on the free DOFs (plus zeros).
-  const Eigen::VectorXd scale = free_mask.cwiseProduct(dof_mass.cwiseSqrt().cwiseInverse());
+  // (Where free_mask is 0 the mass may be 0 too, off an object's shape: no 0 · ∞ there.)
+  const Eigen::VectorXd scale =
+      (free_mask.array() > 0).select(dof_mass.cwiseSqrt().cwiseInverse(), 0.0);
   Eigen::VectorXd full(n);
   auto apply_a = [&](const Eigen::VectorXd& x, Eigen::VectorXd& scratch, Eigen::VectorXd& ax) {
     scratch = scale.cwiseProduct(x);

@@ -25,7 +25,9 @@ StaticSolution SolveStatic(const ElasticModel& model, std::span<const double> dr
   Eigen::VectorXd ku(n);
   k.Apply(u, ku);
   Eigen::VectorXd r = -ku.cwiseProduct(free);
-  const Eigen::VectorXd inv_diagonal = k.Diagonal().cwiseInverse().cwiseProduct(free);
+  // (Off an object's shape the diagonal is 0 and the DOF is not free: no 0 · ∞ there.)
+  const Eigen::VectorXd inv_diagonal =
+      (free.array() > 0).select(k.Diagonal().cwiseInverse(), 0.0);
   const double b_norm = r.norm();
 
   Eigen::VectorXd z = inv_diagonal.cwiseProduct(r);

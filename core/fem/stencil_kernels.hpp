@@ -129,4 +129,19 @@ HAPTICSIM_KERNEL_INLINE void ApplyStencilRun(const NodeStencil& stencil, const d
   if (k < length) AccumulateNodes<4>(stencil, u, ku, first + length - 4, n);
 }
 
+// fe = k · ue for one hexahedron, k a 24 × 24 element stiffness (column-major, node-major local
+// DOFs): its columns scaled by ue and summed, in six 4-wide vectors. Written out rather than left
+// to Eigen, whose vector width is fixed when a file is compiled (the baseline's, in the portable
+// build), while this is compiled with the kernel that calls it, for each instruction set. The
+// regions' element loop and the element-by-element operator of any shape both run on it.
+HAPTICSIM_KERNEL_INLINE void MultiplyElement24(const double* k, const double* ue, double* fe) {
+  using stencil_detail::AddScaled4;
+  using stencil_detail::Vec4;
+  Vec4 sum[6] = {};
+  for (int j = 0; j < 24; ++j) {
+    for (int v = 0; v < 6; ++v) AddScaled4(sum[v], ue[j], k + 24 * j + 4 * v);
+  }
+  std::memcpy(fe, sum, sizeof sum);
+}
+
 }  // namespace hapticsim

@@ -39,24 +39,6 @@ ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material&
   }
 }
 
-namespace {
-
-// fe = k · ue for one element, k the 24 × 24 unit stiffness (column-major): its columns scaled by
-// ue and summed, in six 4-wide vectors. Written out rather than left to Eigen, whose vector width
-// is fixed when a file is compiled (the baseline's, in the portable build), while this is
-// compiled with the kernel that calls it, for each instruction set.
-HAPTICSIM_KERNEL_INLINE void MultiplyElement(const double* k, const double* ue, double* fe) {
-  using stencil_detail::AddScaled4;
-  using stencil_detail::Vec4;
-  Vec4 sum[6] = {};
-  for (int j = 0; j < 24; ++j) {
-    for (int v = 0; v < 6; ++v) AddScaled4(sum[v], ue[j], k + 24 * j + 4 * v);
-  }
-  std::memcpy(fe, sum, sizeof sum);
-}
-
-}  // namespace
-
 HAPTICSIM_KERNEL_CLONES
 void ElementSetStiffness::ApplyElements(const double* u, double* ku) const {
   static_assert(!Hex8Element::Matrix24::IsRowMajor, "MultiplyElement reads columns");
@@ -85,7 +67,7 @@ void ElementSetStiffness::ApplyElements(const double* u, double* ku) const {
         ue[3 * local + 2] = z;
       }
     }
-    MultiplyElement(unit_stiffness_.data(), ue, fe);
+    MultiplyElement24(unit_stiffness_.data(), ue, fe);
     const double scale = e.size_factor * h;
     for (double& f : fe) f *= scale;
     if (direct[0] >= 0) {

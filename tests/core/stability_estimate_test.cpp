@@ -20,7 +20,7 @@ Scene SmallCube(int nodes, double nu = 0.45) {
 // ω_max² from a dense symmetric eigen-solve of M^(-1/2) K M^(-1/2) on the free DOFs: the
 // independent oracle for the Lanczos estimate.
 double DenseOmegaMax(const ElasticModel& model) {
-  const AssembledStiffness k(model.grid(), model.material());
+  const AssembledStiffness k(model.grid(), model.field());
   const Eigen::MatrixXd dense = Eigen::MatrixXd(k.matrix());
   std::vector<int> free;
   for (int i = 0; i < model.grid().num_dofs(); ++i) {

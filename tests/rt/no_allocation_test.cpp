@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "core/fem/central_difference_integrator.hpp"
+#include "core/fem/material_field.hpp"
+#include "core/fem/stencil_stiffness.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/scene/cube_scene.hpp"
 #include "tests/support/allocation_counter.hpp"
@@ -222,6 +224,34 @@ TEST(PortGuardPeriod, NeverAllocatesWhileDissipating) {
   EXPECT_EQ(count.count(), 0u);
   EXPECT_GT(dissipating, 0);
   EXPECT_GT(limited, 0);
+}
+
+// Any shape and several materials: the time step on the element-by-element operator, an L of
+// two materials held on its back face and pressed on its front.
+TEST(TimeStepOnAnyShape, NeverAllocates) {
+  const HexGrid grid(7, 7, 4, 0.02);
+  Material stiff;
+  stiff.youngs_modulus_pa *= 8;
+  std::vector<std::int16_t> elements(static_cast<size_t>(grid.num_elements()));
+  for (int e = 0; e < grid.num_elements(); ++e) {
+    const int ex = e % 6, ey = (e / 6) % 6;
+    elements[static_cast<size_t>(e)] = ex >= 3 && ey >= 3 ? -1 : static_cast<std::int16_t>(ex < 2);
+  }
+  DofConstraints constraints;
+  for (int ix = 0; ix < 3; ++ix) {
+    for (int c = 0; c < 3; ++c) constraints.fixed_dofs.push_back(grid.Dof(grid.Node(ix, 0, 3), c));
+  }
+  for (int c = 0; c < 3; ++c) constraints.driven_dofs.push_back(grid.Dof(grid.Node(1, 1, 0), c));
+  const ElasticModel model(grid, MaterialField(grid, {Material{}, stiff}, elements), constraints);
+  ASSERT_EQ(dynamic_cast<const StencilStiffness*>(&model.stiffness()), nullptr);
+  CentralDifferenceIntegrator dut(model, 1e-4);
+  std::array<double, 3> next{};
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 500; ++n) {
+    next[2] = 1e-6 * n;
+    ASSERT_EQ(dut.Step(next), StepStatus::kOk);
+  }
+  EXPECT_EQ(count.count(), 0u);
 }
 
 }  // namespace

@@ -9,9 +9,14 @@
 // since it stores the zero couplings the stencil drops).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "core/fem/assembled_stiffness.hpp"
 #include "core/regions/box_stiffness.hpp"
 #include "core/fem/central_difference_integrator.hpp"
+#include "core/fem/elementwise_stiffness.hpp"
+#include "core/fem/material_field.hpp"
 #include "core/scene/cube_scene.hpp"
 #include "core/regions/element_set_stiffness.hpp"
 #include "core/regions/hybrid_mesh.hpp"
@@ -108,6 +113,34 @@ void BM_RegionApply(benchmark::State& state) {
   state.counters["direct_nodes"] = box->direct_nodes();
 }
 
+// Any shape, any materials: the element-by-element operator (ElementwiseStiffness) on the same
+// grids, filled whole (range 1 = 100) or to a half (50: the lower half in z, the object a slab of
+// half the cube; two materials, so nothing is uniform). "active_nodes" counts the nodes an
+// occupied element touches: compare time per active node with the stencil's per node.
+void BM_ElementwiseApply(benchmark::State& state) {
+  const HexGrid grid = Grid(static_cast<int>(state.range(0)));
+  const int percent = static_cast<int>(state.range(1));
+  Material stiff;
+  stiff.youngs_modulus_pa *= 8;
+  std::vector<std::int16_t> elements(static_cast<size_t>(grid.num_elements()));
+  const int layers = (grid.nz() - 1) * percent / 100;
+  for (int e = 0; e < grid.num_elements(); ++e) {
+    const int ez = e / ((grid.nx() - 1) * (grid.ny() - 1));
+    elements[static_cast<size_t>(e)] = ez < layers ? static_cast<std::int16_t>(e % 2) : -1;
+  }
+  const MaterialField field(grid, {Material{}, stiff}, elements);
+  const ElementwiseStiffness k(grid, field);
+  const Eigen::VectorXd u = Field(grid.num_dofs());
+  Eigen::VectorXd ku(grid.num_dofs());
+  for (auto _ : state) {
+    k.Apply(u, ku);
+    benchmark::DoNotOptimize(ku.data());
+  }
+  const std::vector<bool> active = field.ActiveNodes(grid);
+  state.counters["active_nodes"] =
+      static_cast<double>(std::count(active.begin(), active.end(), true));
+}
+
 void BM_TimeStep(benchmark::State& state) {
   Scene scene;
   scene.mesh.nodes = static_cast<int>(state.range(0));
@@ -123,6 +156,12 @@ void BM_TimeStep(benchmark::State& state) {
 
 BENCHMARK(BM_StencilApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssembledApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ElementwiseApply)
+    ->Args({13, 100})
+    ->Args({13, 50})
+    ->Args({25, 100})
+    ->Args({25, 50})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ElementLoopApply)->Arg(13)->Arg(25)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RegionApply)
     ->ArgNames({"primary_size", "spacing", "region", "use_box"})
