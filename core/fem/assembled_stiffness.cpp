@@ -11,6 +11,7 @@ AssembledStiffness::AssembledStiffness(const HexGrid& grid, const Material& mate
 
 AssembledStiffness::AssembledStiffness(const HexGrid& grid, const MaterialField& field)
     : StiffnessOperator(grid.num_dofs()), matrix_(grid.num_dofs(), grid.num_dofs()) {
+  field.CheckFits(grid);
   std::vector<Hex8Element::Matrix24> ke;
   for (const Material& material : field.materials()) {
     ke.push_back(Hex8Element::Stiffness(grid.spacing(), material));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -56,6 +57,11 @@ void CentralDifferenceIntegrator::SetState(const Eigen::VectorXd& u,
                                            const Eigen::VectorXd& u_previous) {
   HAPTICSIM_THROW_UNLESS(u.size() == region_.u().size() && u_previous.size() == u.size(),
                          "state vectors must have one entry per DOF");
+  // Off the object a DOF is never stepped: it must be at rest, or its value would stay there.
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    HAPTICSIM_THROW_UNLESS(model_.dof_mass()[i] > 0 || (u[i] == 0 && u_previous[i] == 0),
+                           "DOF " + std::to_string(i) + " is off the object: its state must be 0");
+  }
   Reset();
   region_.SetState(u, u_previous);
 }

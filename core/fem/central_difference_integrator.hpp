@@ -19,7 +19,8 @@ enum class StepStatus {
 /**
  * Explicit central difference for the whole object, M ü + d·M u̇ + K u = f with lumped M: the
  * one integrator (RegionIntegrator) with the object as one region — every DOF but the fixed and
- * the driven ones owned, those two prescribed, no load — per DOF
+ * the driven ones owned, those two prescribed, no load; a DOF off an object's shape (no mass) is
+ * neither and stays at rest — per DOF
  *
  *   u⁺ = [dt²/m·(f − (K u)) + 2u − (1 − d·dt/2)·u⁻] / (1 + d·dt/2).
  *

@@ -1,5 +1,6 @@
 #include "core/fem/elastic_model.hpp"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,14 +20,21 @@ ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstrai
       constraints_(std::move(constraints)),
       dof_mass_(Eigen::VectorXd::Zero(grid.num_dofs())),
       free_mask_(Eigen::VectorXd::Ones(grid.num_dofs())) {
-  for (const Material& m : field_.materials()) {
-    HAPTICSIM_THROW_UNLESS(m.damping_per_s == damping_per_s(),
-                           "the materials' damping differs (" + std::to_string(m.damping_per_s) +
-                               " and " + std::to_string(damping_per_s()) +
+  field_.CheckFits(grid);
+  const std::vector<bool> used = field_.UsedMaterials();
+  damping_per_s_ = -1;
+  for (size_t i = 0; i < used.size(); ++i) {
+    if (!used[i]) continue;
+    const double d = field_.materials()[i].damping_per_s;
+    if (damping_per_s_ < 0) damping_per_s_ = d;
+    HAPTICSIM_THROW_UNLESS(d == damping_per_s_,
+                           "the materials' damping differs (" + std::to_string(d) + " and " +
+                               std::to_string(damping_per_s_) +
                                " 1/s): C = d·M takes one d for the whole object");
   }
-  if (field_.uniform_and_full()) {
-    stiffness_ = std::make_unique<StencilStiffness>(grid, field_.materials().front());
+  if (const int uniform = field_.uniform_material(); uniform >= 0) {
+    stiffness_ = std::make_unique<StencilStiffness>(
+        grid, field_.materials()[static_cast<size_t>(uniform)]);
   } else {
     stiffness_ = std::make_unique<ElementwiseStiffness>(grid, field_);
   }
@@ -40,7 +48,7 @@ void ElasticModel::LumpMass() {
   const double h = grid_.spacing();
   const int n = grid_.num_nodes();
   const size_t materials = field_.materials().size();
-  std::vector<int> count(static_cast<size_t>(n) * materials, 0);
+  std::vector<std::uint8_t> count(static_cast<size_t>(n) * materials, 0);  // at most 8
   for (int ez = 0; ez + 1 < grid_.nz(); ++ez) {
     for (int ey = 0; ey + 1 < grid_.ny(); ++ey) {
       for (int ex = 0; ex + 1 < grid_.nx(); ++ex) {
@@ -56,7 +64,7 @@ void ElasticModel::LumpMass() {
     double mass = 0;
     for (size_t m = 0; m < materials; ++m) {
       const double share = field_.materials()[m].density_kg_m3 * h * h * h / 8.0;
-      mass += count[static_cast<size_t>(node) * materials + m] * share;
+      mass += static_cast<int>(count[static_cast<size_t>(node) * materials + m]) * share;
     }
     for (int c = 0; c < 3; ++c) dof_mass_[grid_.Dof(node, c)] = mass;
   }
@@ -68,6 +76,8 @@ void ElasticModel::Constrain() {
                            "constrained DOF " + std::to_string(dof) + " is outside the grid");
     HAPTICSIM_THROW_UNLESS(free_mask_[dof] == 1.0,
                            "DOF " + std::to_string(dof) + " is constrained twice");
+    HAPTICSIM_THROW_UNLESS(dof_mass_[dof] > 0.0, "constrained DOF " + std::to_string(dof) +
+                                                     " is off the object: no element touches it");
     free_mask_[dof] = 0.0;
   };
   for (int dof : constraints_.fixed_dofs) constrain(dof);

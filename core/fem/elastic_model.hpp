@@ -34,15 +34,16 @@ class ElasticModel {
   /**
    * Any shape and materials on the grid: the element-by-element operator, unless the field is
    * one material in every element (then as above, to the bit).
-   * @throws Error when a constrained DOF index is out of range or listed twice, or when the
-   *         materials' damping differs (C = d·M takes one d for the whole object).
+   * @throws Error when the field was made for another grid, a constrained DOF is out of range,
+   *         listed twice or off the object, or when the damping of the materials used differs
+   *         (C = d·M takes one d for the whole object).
    */
   ElasticModel(const HexGrid& grid, MaterialField field, DofConstraints constraints);
 
   const HexGrid& grid() const { return grid_; }
   const MaterialField& field() const { return field_; }
-  /** d in C = d·M, 1/s: the same for every material of the field. */
-  double damping_per_s() const { return field_.materials().front().damping_per_s; }
+  /** d in C = d·M, 1/s: the same for every material the field uses. */
+  double damping_per_s() const { return damping_per_s_; }
   const StiffnessOperator& stiffness() const { return *stiffness_; }
   const DofConstraints& constraints() const { return constraints_; }
   /** Lumped mass of every DOF, kg (component-blocked like the displacements); 0 off the object. */
@@ -56,6 +57,7 @@ class ElasticModel {
 
   HexGrid grid_;
   MaterialField field_;
+  double damping_per_s_ = 0;
   std::unique_ptr<StiffnessOperator> stiffness_;
   DofConstraints constraints_;
   Eigen::VectorXd dof_mass_;

@@ -1,5 +1,7 @@
 #include "core/fem/elementwise_stiffness.hpp"
 
+#include <algorithm>
+
 #include "core/fem/cpu_dispatch.hpp"
 #include "core/fem/stencil_kernels.hpp"
 
@@ -7,6 +9,7 @@ namespace hapticsim {
 
 ElementwiseStiffness::ElementwiseStiffness(const HexGrid& grid, const MaterialField& field)
     : StiffnessOperator(grid.num_dofs()), num_nodes_(grid.num_nodes()) {
+  field.CheckFits(grid);
   for (const Material& material : field.materials()) {
     stiffness_.push_back(Hex8Element::Stiffness(grid.spacing(), material));
   }

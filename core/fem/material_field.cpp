@@ -15,6 +15,7 @@ MaterialField::MaterialField(const HexGrid& grid, std::vector<Material> material
                              std::vector<std::int16_t> element_material)
     : ex_count_(grid.nx() - 1),
       ey_count_(grid.ny() - 1),
+      ez_count_(grid.nz() - 1),
       materials_(std::move(materials)),
       element_material_(std::move(element_material)) {
   HAPTICSIM_THROW_UNLESS(static_cast<int>(element_material_.size()) == grid.num_elements(),
@@ -51,14 +52,34 @@ int MaterialField::ValidateAndCountOccupied() const {
   return occupied;
 }
 
-bool MaterialField::uniform_and_full() const {
+int MaterialField::uniform_material() const {
+  const std::int16_t first = element_material_.front();
   for (std::int16_t m : element_material_) {
-    if (m != 0) return false;
+    if (m != first) return -1;
   }
-  return materials_.size() == 1;
+  return first;  // kEmpty never: a field fills at least one element
+}
+
+std::vector<bool> MaterialField::UsedMaterials() const {
+  std::vector<bool> used(materials_.size(), false);
+  for (std::int16_t m : element_material_) {
+    if (m != kEmpty) used[static_cast<size_t>(m)] = true;
+  }
+  return used;
+}
+
+void MaterialField::CheckFits(const HexGrid& grid) const {
+  HAPTICSIM_THROW_UNLESS(grid.nx() - 1 == ex_count_ && grid.ny() - 1 == ey_count_ &&
+                             grid.nz() - 1 == ez_count_,
+                         "the material field was made for " + std::to_string(ex_count_) + " × " +
+                             std::to_string(ey_count_) + " × " + std::to_string(ez_count_) +
+                             " elements; the grid has " + std::to_string(grid.nx() - 1) + " × " +
+                             std::to_string(grid.ny() - 1) + " × " +
+                             std::to_string(grid.nz() - 1));
 }
 
 std::vector<bool> MaterialField::ActiveNodes(const HexGrid& grid) const {
+  CheckFits(grid);
   std::vector<bool> active(static_cast<size_t>(grid.num_nodes()), false);
   for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
     for (int ey = 0; ey + 1 < grid.ny(); ++ey) {

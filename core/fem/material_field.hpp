@@ -37,8 +37,12 @@ class MaterialField {
   bool occupied(int element) const { return element_material_[element] != kEmpty; }
   int num_occupied() const { return num_occupied_; }
   const std::vector<Material>& materials() const { return materials_; }
-  /** One material in every element: the operators and kernels of the uniform cube apply. */
-  bool uniform_and_full() const;
+  /** One material in every element (which one, else −1): the uniform cube's operator applies. */
+  int uniform_material() const;
+  /** Per material: whether an element is made of it (an unused one bounds nothing). */
+  std::vector<bool> UsedMaterials() const;
+  /** @throws Error unless this field was made for a grid of `grid`'s node counts. */
+  void CheckFits(const HexGrid& grid) const;
 
   /** Per node: whether an occupied element touches it. */
   std::vector<bool> ActiveNodes(const HexGrid& grid) const;
@@ -47,7 +51,7 @@ class MaterialField {
   /** @throws Error naming what is wrong; returns the occupied elements. */
   int ValidateAndCountOccupied() const;
 
-  int ex_count_, ey_count_;
+  int ex_count_, ey_count_, ez_count_;
   std::vector<Material> materials_;
   std::vector<std::int16_t> element_material_;
   int num_occupied_ = 0;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 #include <cstdint>
 
 #include "core/fem/hex8_element.hpp"
@@ -11,10 +12,13 @@
 namespace hapticsim {
 
 double ElementBoundCriticalDt(const ElasticModel& model) {
-  // The bound of every material; the smallest holds for all (the stiffest, lightest one's).
+  // The bound of every material used; the smallest holds for all (the stiffest, lightest one's).
   const double h = model.grid().spacing();
   double critical_dt = std::numeric_limits<double>::infinity();
-  for (const Material& material : model.field().materials()) {
+  const std::vector<bool> used = model.field().UsedMaterials();
+  for (size_t i = 0; i < used.size(); ++i) {
+    if (!used[i]) continue;
+    const Material& material = model.field().materials()[i];
     const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(h, material);
     const double lambda_ke =
         Eigen::SelfAdjointEigenSolver<Hex8Element::Matrix24>(ke, Eigen::EigenvaluesOnly)

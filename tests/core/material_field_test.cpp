@@ -249,11 +249,28 @@ TEST(ElasticModel, LumpsEachElementsOwnMass) {
   }
   const double total = model.dof_mass().head(grid.num_nodes()).sum();
   EXPECT_NEAR(total, expected, 1e-12 * expected);
-  // One material everywhere: the cube's model, to the bit.
-  const ElasticModel cube(grid, Soft(), {});
-  const ElasticModel field(grid, MaterialField(grid, Soft()), {});
-  EXPECT_EQ(cube.dof_mass(), field.dof_mass());
-  EXPECT_NE(dynamic_cast<const StencilStiffness*>(&field.stiffness()), nullptr);
+  // One material everywhere: the cube's closed form, to the bit — ρh³/8 times the elements
+  // around a node (1, 2, 4 or 8) — and the stencil operator.
+  const ElasticModel cube(grid, MaterialField(grid, Soft()), {});
+  const double share = Soft().density_kg_m3 * kH * kH * kH / 8.0;
+  for (int node = 0; node < grid.num_nodes(); ++node) {
+    const auto idx = grid.NodeIndices(node);
+    const std::array<int, 3> counts{grid.nx(), grid.ny(), grid.nz()};
+    int adjacent = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+      adjacent *= idx[axis] == 0 || idx[axis] == counts[axis] - 1 ? 1 : 2;
+    }
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(cube.dof_mass()[grid.Dof(node, c)], adjacent * share);
+  }
+  EXPECT_NE(dynamic_cast<const StencilStiffness*>(&cube.stiffness()), nullptr);
+  // A second material listed but used nowhere changes nothing: still the stencil, and its
+  // stiffness does not bound the time step.
+  const ElasticModel listed(grid, MaterialField(grid, {Soft(), Stiff()},
+                                                std::vector<std::int16_t>(
+                                                    static_cast<size_t>(grid.num_elements()), 0)),
+                            {});
+  EXPECT_NE(dynamic_cast<const StencilStiffness*>(&listed.stiffness()), nullptr);
+  EXPECT_EQ(ElementBoundCriticalDt(listed), ElementBoundCriticalDt(cube));
 }
 
 // A quarter of a square bar (symmetry planes y = 0 and z = 0, rollers at x = 0), 8 × 2 × 2 units
@@ -412,6 +429,18 @@ TEST(MaterialField, RefusesWhatIsNotAnObjectSayingWhy) {
   two[3] = 1;
   EXPECT_NE(message([&] { ElasticModel(grid, MaterialField(grid, {Soft(), damped}, two), {}); })
                 .find("the materials' damping differs"),
+            std::string::npos);
+  const HexGrid other(3, 5, 2, kH);  // as many elements, in another shape
+  EXPECT_NE(message([&] { ElasticModel(other, MaterialField(grid, Soft()), {}); })
+                .find("the material field was made for 2 × 2 × 2 elements; the grid has 2 × 4 × 1"),
+            std::string::npos);
+  // A support or a contact where no element is: refused, not silently without a reaction.
+  std::vector<std::int16_t> corner = all;
+  corner[7] = MaterialField::kEmpty;  // the element at (1, 1, 1): node (2, 2, 2) is off it
+  DofConstraints off;
+  off.driven_dofs = {grid.Dof(grid.Node(2, 2, 2), 2)};
+  EXPECT_NE(message([&] { ElasticModel(grid, MaterialField(grid, {Soft()}, corner), off); })
+                .find("is off the object: no element touches it"),
             std::string::npos);
 }
 

@@ -251,9 +251,11 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
       "between %.3f N and %.3f N (it pressed with %.3f N before); %d answers held, %d of them "
       "while the regions were replaced\n",
       largest_step, strongest, weakest, pressing_n, held_answers, switching_answers);
-  // The 1.5 s held at 8 mm were answered (a lost LCM message now and then aside), and the
-  // switch happened among them: the step and the force below are measured across it.
-  EXPECT_GT(held_answers, 1300) << daemon_->Log();
+  // The switch happened among the answers measured, so the step and the force below are
+  // measured across it. (The window ends at the first stale answer: after the last input, or
+  // where a stall of the test over 50 ms stopped the input. The switch comes within tens of ms
+  // of the command; measured: 1,702 and 1,720 answers held, 6 while replaced.)
+  EXPECT_GT(held_answers, 100) << daemon_->Log();
   EXPECT_GT(switching_answers, 0) << "no answer in contact came while the regions were replaced";
   EXPECT_LE(largest_step, 0.1);
   // It relaxes from the press's overshoot towards the static 0.7–0.75 N; a force dropped and
@@ -769,12 +771,14 @@ TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeco
   ASSERT_TRUE(daemon.running()) << daemon.Log();
   EXPECT_EQ(most_threads, threads_before) << "a command made a thread";
   EXPECT_GT(client.Forces().size(), 1800u) << "device input went unanswered during the flood";
-  // 2,000 commands in 2 s against 10 a second: all but the burst and 10 a second (about 35)
-  // refused, and counted. Those UDP lost on the way never arrived to be refused; as many device
-  // inputs, sent beside them, were lost too, so the inputs received stand for what arrived.
+  // 2,000 commands in 2 s against 10 a second: all but the burst and 10 a second (about 30)
+  // refused, and counted. UDP may lose some on the way, which never arrive to be refused: the
+  // device inputs sent beside them stand for what arrives, with 5 % of room for the commands'
+  // larger packets (measured: 1,988 refused, 2,000 inputs received; with the rate limit's
+  // refusals uncounted, 1,744).
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a status after the flood
   const status_t flooded = *client.LastStatus();
-  EXPECT_GE(flooded.commands_refused, flooded.inputs_received - 40)
+  EXPECT_GE(flooded.commands_refused, 0.95 * static_cast<double>(flooded.inputs_received) - 30)
       << flooded.commands_refused << " commands refused of about " << flooded.inputs_received
       << " that arrived\n"
       << daemon.Log();

@@ -320,8 +320,9 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
         busy, switched.largest_jump_n, held, plain.largest_jump_n, switched.largest_jump_any_n,
         plain.largest_jump_any_n, switched.near_late_wakes, plain.near_late_wakes,
         switched.forces.size());
-    EXPECT_EQ(windows.size(), 3u) << "each switch in the press is a hold of its own";
     if (kSanitized) continue;
+    // (Under a sanitizer a switch may come after the press, out of contact: no hold.)
+    EXPECT_EQ(windows.size(), 3u) << "each switch in the press is a hold of its own";
     // Beside two busy threads 1–31 % of the answers were near a late wake (with or without
     // switches): half, and what is left still covers the press.
     EXPECT_LT(switched.near_late_wakes, switched.forces.size() / 2);

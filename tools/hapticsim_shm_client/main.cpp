@@ -98,8 +98,11 @@ int main(int argc, char** argv) {
       if (force.flags & 8) ++stale;
       max_push_back = std::max(max_push_back, -force.force_n[2]);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the last input's period
-    mark_answered();
+    // The last input's answer: the daemon's next period, or later if it was held up (up to 1 s).
+    for (int wait_ms = 0; wait_ms < 1000 && !answered.back(); wait_ms += 5) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      mark_answered();
+    }
     const auto inputs_answered = std::count(answered.begin() + 1, answered.end(), true);
     std::printf(
         "{\"periods\": %lld, \"inputs_answered\": %lld, \"answered_same_period\": %lld, "
