@@ -1,5 +1,6 @@
 #include "core/fem/assembled_stiffness.hpp"
 
+#include <array>
 #include <vector>
 
 #include "core/fem/hex8_element.hpp"
@@ -11,29 +12,21 @@ AssembledStiffness::AssembledStiffness(const HexGrid& grid, const Material& mate
 
 AssembledStiffness::AssembledStiffness(const HexGrid& grid, const MaterialField& field)
     : StiffnessOperator(grid.num_dofs()), matrix_(grid.num_dofs(), grid.num_dofs()) {
-  field.CheckFits(grid);
   std::vector<Hex8Element::Matrix24> ke;
   for (const Material& material : field.materials()) {
     ke.push_back(Hex8Element::Stiffness(grid.spacing(), material));
   }
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<size_t>(field.num_occupied()) * 24 * 24);
-  for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
-    for (int ey = 0; ey + 1 < grid.ny(); ++ey) {
-      for (int ex = 0; ex + 1 < grid.nx(); ++ex) {
-        const std::int16_t m = field.material_of(field.Element(ex, ey, ez));
-        if (m == MaterialField::kEmpty) continue;
-        const Hex8Element::Matrix24& k = ke[static_cast<size_t>(m)];
-        const auto nodes = grid.ElementNodes(ex, ey, ez);
-        for (int i = 0; i < 24; ++i) {
-          const int row = grid.Dof(nodes[i / 3], i % 3);
-          for (int j = 0; j < 24; ++j) {
-            triplets.emplace_back(row, grid.Dof(nodes[j / 3], j % 3), k(i, j));
-          }
-        }
+  field.ForEachOccupied(grid, [&](const std::array<int, 8>& nodes, int material) {
+    const Hex8Element::Matrix24& k = ke[static_cast<size_t>(material)];
+    for (int i = 0; i < 24; ++i) {
+      const int row = grid.Dof(nodes[i / 3], i % 3);
+      for (int j = 0; j < 24; ++j) {
+        triplets.emplace_back(row, grid.Dof(nodes[j / 3], j % 3), k(i, j));
       }
     }
-  }
+  });
   matrix_.setFromTriplets(triplets.begin(), triplets.end());
   matrix_.makeCompressed();
 }

@@ -1,5 +1,6 @@
 #include "core/fem/elastic_model.hpp"
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,8 +34,8 @@ ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstrai
                                " 1/s): C = d·M takes one d for the whole object");
   }
   if (const int uniform = field_.uniform_material(); uniform >= 0) {
-    stiffness_ = std::make_unique<StencilStiffness>(
-        grid, field_.materials()[static_cast<size_t>(uniform)]);
+    stiffness_ =
+        std::make_unique<StencilStiffness>(grid, field_.materials()[static_cast<size_t>(uniform)]);
   } else {
     stiffness_ = std::make_unique<ElementwiseStiffness>(grid, field_);
   }
@@ -49,17 +50,10 @@ void ElasticModel::LumpMass() {
   const int n = grid_.num_nodes();
   const size_t materials = field_.materials().size();
   std::vector<std::uint8_t> count(static_cast<size_t>(n) * materials, 0);  // at most 8
-  for (int ez = 0; ez + 1 < grid_.nz(); ++ez) {
-    for (int ey = 0; ey + 1 < grid_.ny(); ++ey) {
-      for (int ex = 0; ex + 1 < grid_.nx(); ++ex) {
-        const std::int16_t m = field_.material_of(field_.Element(ex, ey, ez));
-        if (m == MaterialField::kEmpty) continue;
-        for (int node : grid_.ElementNodes(ex, ey, ez)) {
-          ++count[static_cast<size_t>(node) * materials + static_cast<size_t>(m)];
-        }
-      }
-    }
-  }
+  field_.ForEachOccupied(grid_, [&](const std::array<int, 8>& nodes, int material) {
+    for (int node : nodes)
+      ++count[static_cast<size_t>(node) * materials + static_cast<size_t>(material)];
+  });
   for (int node = 0; node < n; ++node) {
     double mass = 0;
     for (size_t m = 0; m < materials; ++m) {

@@ -9,19 +9,13 @@ namespace hapticsim {
 
 ElementwiseStiffness::ElementwiseStiffness(const HexGrid& grid, const MaterialField& field)
     : StiffnessOperator(grid.num_dofs()), num_nodes_(grid.num_nodes()) {
-  field.CheckFits(grid);
   for (const Material& material : field.materials()) {
     stiffness_.push_back(Hex8Element::Stiffness(grid.spacing(), material));
   }
   elements_.reserve(static_cast<size_t>(field.num_occupied()));
-  for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
-    for (int ey = 0; ey + 1 < grid.ny(); ++ey) {
-      for (int ex = 0; ex + 1 < grid.nx(); ++ex) {
-        const std::int16_t m = field.material_of(field.Element(ex, ey, ez));
-        if (m != MaterialField::kEmpty) elements_.push_back({grid.ElementNodes(ex, ey, ez), m});
-      }
-    }
-  }
+  field.ForEachOccupied(grid, [&](const std::array<int, 8>& nodes, int material) {
+    elements_.push_back({nodes, material});
+  });
 }
 
 HAPTICSIM_KERNEL_CLONES

@@ -1,5 +1,6 @@
 #include "core/fem/material_field.hpp"
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -28,9 +29,9 @@ int MaterialField::ValidateAndCountOccupied() const {
   for (size_t m = 0; m < materials_.size(); ++m) {
     const Material& material = materials_[m];
     const std::string which = "material " + std::to_string(m) + ": ";
-    HAPTICSIM_THROW_UNLESS(std::isfinite(material.youngs_modulus_pa) &&
-                               material.youngs_modulus_pa > 0,
-                           which + "Young's modulus must be a positive number of Pa");
+    HAPTICSIM_THROW_UNLESS(
+        std::isfinite(material.youngs_modulus_pa) && material.youngs_modulus_pa > 0,
+        which + "Young's modulus must be a positive number of Pa");
     HAPTICSIM_THROW_UNLESS(std::isfinite(material.poisson_ratio) && material.poisson_ratio > -1 &&
                                material.poisson_ratio < 0.5,
                            which + "Poisson's ratio must be in (-1, 0.5)");
@@ -43,9 +44,8 @@ int MaterialField::ValidateAndCountOccupied() const {
   for (size_t e = 0; e < element_material_.size(); ++e) {
     const std::int16_t m = element_material_[e];
     HAPTICSIM_THROW_UNLESS(m == kEmpty || (m >= 0 && m < static_cast<int>(materials_.size())),
-                           "element " + std::to_string(e) + " names material " +
-                               std::to_string(m) + "; there are " +
-                               std::to_string(materials_.size()));
+                           "element " + std::to_string(e) + " names material " + std::to_string(m) +
+                               "; there are " + std::to_string(materials_.size()));
     occupied += m != kEmpty;
   }
   HAPTICSIM_THROW_UNLESS(occupied > 0, "the material field fills no element");
@@ -69,26 +69,19 @@ std::vector<bool> MaterialField::UsedMaterials() const {
 }
 
 void MaterialField::CheckFits(const HexGrid& grid) const {
-  HAPTICSIM_THROW_UNLESS(grid.nx() - 1 == ex_count_ && grid.ny() - 1 == ey_count_ &&
-                             grid.nz() - 1 == ez_count_,
-                         "the material field was made for " + std::to_string(ex_count_) + " × " +
-                             std::to_string(ey_count_) + " × " + std::to_string(ez_count_) +
-                             " elements; the grid has " + std::to_string(grid.nx() - 1) + " × " +
-                             std::to_string(grid.ny() - 1) + " × " +
-                             std::to_string(grid.nz() - 1));
+  HAPTICSIM_THROW_UNLESS(
+      grid.nx() - 1 == ex_count_ && grid.ny() - 1 == ey_count_ && grid.nz() - 1 == ez_count_,
+      "the material field was made for " + std::to_string(ex_count_) + " × " +
+          std::to_string(ey_count_) + " × " + std::to_string(ez_count_) +
+          " elements; the grid has " + std::to_string(grid.nx() - 1) + " × " +
+          std::to_string(grid.ny() - 1) + " × " + std::to_string(grid.nz() - 1));
 }
 
 std::vector<bool> MaterialField::ActiveNodes(const HexGrid& grid) const {
-  CheckFits(grid);
   std::vector<bool> active(static_cast<size_t>(grid.num_nodes()), false);
-  for (int ez = 0; ez + 1 < grid.nz(); ++ez) {
-    for (int ey = 0; ey + 1 < grid.ny(); ++ey) {
-      for (int ex = 0; ex + 1 < grid.nx(); ++ex) {
-        if (!occupied(Element(ex, ey, ez))) continue;
-        for (int node : grid.ElementNodes(ex, ey, ez)) active[static_cast<size_t>(node)] = true;
-      }
-    }
-  }
+  ForEachOccupied(grid, [&](const std::array<int, 8>& nodes, int) {
+    for (int node : nodes) active[static_cast<size_t>(node)] = true;
+  });
   return active;
 }
 

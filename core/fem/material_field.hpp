@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,23 @@ class MaterialField {
   std::vector<bool> UsedMaterials() const;
   /** @throws Error unless this field was made for a grid of `grid`'s node counts. */
   void CheckFits(const HexGrid& grid) const;
+
+  /**
+   * `each(nodes, material)` for every occupied element of `grid`, in element order (x fastest):
+   * its 8 nodes (HexGrid::ElementNodes) and its material index.
+   */
+  template <typename Each>
+  void ForEachOccupied(const HexGrid& grid, Each&& each) const {
+    CheckFits(grid);
+    for (int ez = 0; ez < ez_count_; ++ez) {
+      for (int ey = 0; ey < ey_count_; ++ey) {
+        for (int ex = 0; ex < ex_count_; ++ex) {
+          const std::int16_t m = element_material_[static_cast<std::size_t>(Element(ex, ey, ez))];
+          if (m != kEmpty) each(grid.ElementNodes(ex, ey, ez), static_cast<int>(m));
+        }
+      }
+    }
+  }
 
   /** Per node: whether an occupied element touches it. */
   std::vector<bool> ActiveNodes(const HexGrid& grid) const;
