@@ -16,7 +16,8 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(scene_toml daemon_config error_map lcm_messages shm_segment service_handshake control_line)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_toml daemon_config error_map lcm_messages shm_segment service_handshake control_line
+                                      nifti surface_mesh)
 
 "$root/scripts/setup.sh"
 CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -G Ninja -DHAPTICSIM_FUZZ=ON -DHAPTICSIM_NATIVE=ON \

@@ -19,6 +19,7 @@ packages=(
   chromium chromium-driver python3-selenium python3-pil
   xvfb
   clang libclang-rt-14-dev
+  libnifti2-dev libassimp-dev
 )
 
 missing=()
