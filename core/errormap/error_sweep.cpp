@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/regions/async_regions.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/error.hpp"
 #include "core/trial/force_error.hpp"
 #include "core/errormap/parallel_for.hpp"
@@ -86,7 +86,7 @@ References RunReferences(const Scene& base, const std::vector<SweepTask>& tasks,
         TrialOptions trial_options;
         trial_options.substep_to_stability = true;
         const auto t0 = Clock::now();
-        reference.trial = RunReferenceTrial(CubeScene(scene), trial_options);
+        reference.trial = RunReferenceTrial(SceneModel(scene), trial_options);
         reference.ok = reference.trial.outcome == TrialOutcome::kCompleted;
         std::lock_guard lock(stats_mutex);
         stats->reference_seconds += SecondsSince(t0);

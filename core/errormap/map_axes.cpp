@@ -50,7 +50,8 @@ Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
           point[a] == std::round(point[a]) && std::abs(point[a]) < 1e9,
           std::string(info.scene_key) + " = " + FormatReal(point[a]) + " is not a whole number");
       if (info.node_component >= 0) {
-        node += (node.empty() ? "" : ",") + std::to_string(static_cast<long>(point[a]));
+        if (!node.empty()) node += ',';
+        node += std::to_string(static_cast<long>(point[a]));
         continue;
       }
       SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));

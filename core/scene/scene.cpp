@@ -4,259 +4,14 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <functional>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/scene/label_materials.hpp"
+#include "core/scene/support_regions.hpp"
 
 namespace hapticsim {
 namespace {
-
-// Reading and writing one key: a pointer-like accessor plus the range check.
-struct KeyAccess {
-  SceneKeyInfo info;
-  std::function<std::string(const Scene&)> get;
-  std::function<void(Scene*, std::string_view)> set;
-};
-
-[[noreturn]] void Reject(std::string_view key, std::string_view value, std::string_view allowed,
-                         std::string_view unit) {
-  std::string message = std::string(key) + " = " + std::string(value) +
-                        " is not allowed: " + std::string(key) + " must be " + std::string(allowed);
-  if (!unit.empty()) message += " (in " + std::string(unit) + ")";
-  throw Error(message);
-}
-
-double ParseReal(std::string_view key, std::string_view text) {
-  double value = 0.0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc() || ptr != end || text.empty()) {
-    throw Error(std::string(key) + " = '" + std::string(text) + "' is not a number");
-  }
-  return value;
-}
-
-long ParseInteger(std::string_view key, std::string_view text) {
-  long value = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc() || ptr != end || text.empty()) {
-    throw Error(std::string(key) + " = '" + std::string(text) + "' is not a whole number");
-  }
-  return value;
-}
-
-// A real-valued key: `ref` selects the field, `allowed` is the range check.
-template <typename Ref>
-KeyAccess Real(SceneKeyInfo info, Ref ref, std::function<bool(double)> allowed) {
-  return KeyAccess{info,
-                   [ref](const Scene& scene) { return FormatReal(ref(const_cast<Scene&>(scene))); },
-                   [info, ref, allowed](Scene* scene, std::string_view text) {
-                     const double value = ParseReal(info.name, text);
-                     if (!std::isfinite(value) || !allowed(value)) {
-                       Reject(info.name, text, info.allowed, info.unit);
-                     }
-                     ref(*scene) = value;
-                   }};
-}
-
-// A whole-number key in [lo, hi].
-template <typename Ref>
-KeyAccess Integer(SceneKeyInfo info, Ref ref, long lo, long hi) {
-  return KeyAccess{
-      info, [ref](const Scene& scene) { return std::to_string(ref(const_cast<Scene&>(scene))); },
-      [info, ref, lo, hi](Scene* scene, std::string_view text) {
-        const long value = ParseInteger(info.name, text);
-        if (value < lo || value > hi) Reject(info.name, text, info.allowed, info.unit);
-        ref(*scene) = static_cast<int>(value);
-      }};
-}
-
-// A key with a fixed set of names, written quoted ("press"); `get` and `set` map the scene
-// field to and from the name's index.
-template <typename Get, typename Set>
-KeyAccess Choice(SceneKeyInfo info, std::vector<std::string_view> names, Get get, Set set) {
-  return KeyAccess{info,
-                   [names, get](const Scene& scene) {
-                     // Built piecewise: g++ 12 misreports "\"" + string + "\"" under -Wrestrict
-                     // (PR 105651).
-                     std::string text(1, '"');
-                     text += names[static_cast<size_t>(get(scene))];
-                     text += '"';
-                     return text;
-                   },
-                   [info, names, set](Scene* scene, std::string_view text) {
-                     std::string_view bare = text;
-                     if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
-                       bare = bare.substr(1, bare.size() - 2);
-                     }
-                     for (size_t i = 0; i < names.size(); ++i) {
-                       if (bare == names[i]) return set(*scene, static_cast<int>(i));
-                     }
-                     Reject(info.name, text, info.allowed, info.unit);
-                   }};
-}
-
-// input.contact_node: "middle" (the paper's node) or "ix,iy,iz". Whether the node is on the
-// surface of this mesh is checked by ValidateScene, which knows mesh.nodes.
-KeyAccess ContactNodeKey() {
-  const SceneKeyInfo info{
-      "input.contact_node", "",
-      "\"middle\" or \"ix,iy,iz\" (lattice indices from 0 to mesh.nodes - 1 of a surface node "
-      "that is not a fixed back corner)",
-      "the driven node; \"middle\" is the paper's, the middle of the front face z = 0"};
-  return KeyAccess{info,
-                   [](const Scene& scene) {
-                     const auto& node = scene.input.contact_node;
-                     std::string text = "\"";
-                     text += node ? std::to_string((*node)[0]) + "," + std::to_string((*node)[1]) +
-                                        "," + std::to_string((*node)[2])
-                                  : std::string("middle");
-                     text += '"';
-                     return text;
-                   },
-                   [info](Scene* scene, std::string_view text) {
-                     std::string_view bare = text;
-                     if (bare.size() >= 2 && bare.front() == '"' && bare.back() == '"') {
-                       bare = bare.substr(1, bare.size() - 2);
-                     }
-                     if (bare == "middle") {
-                       scene->input.contact_node.reset();
-                       return;
-                     }
-                     LatticeIndex node{};
-                     const char* p = bare.data();
-                     const char* end = bare.data() + bare.size();
-                     for (int c = 0; c < 3; ++c) {
-                       const auto [next, ec] = std::from_chars(p, end, node[c]);
-                       const bool separator_ok = c < 2 ? (next < end && *next == ',') : next == end;
-                       if (ec != std::errc() || !separator_ok || node[c] < 0) {
-                         Reject(info.name, text, info.allowed, info.unit);
-                       }
-                       p = next + 1;
-                     }
-                     scene->input.contact_node = node;
-                   }};
-}
-
-// The object: its mesh and its material.
-void AddObjectKeys(std::vector<KeyAccess>& keys) {
-  keys.push_back(Integer(
-      {"mesh.nodes", "", "a whole number from 2 to 401", "nodes per axis of the cube"},
-      [](Scene& s) -> int& { return s.mesh.nodes; }, 2, 401));
-  keys.push_back(Real(
-      {"mesh.edge", "m", "finite and > 0", "edge length of the cube"},
-      [](Scene& s) -> double& { return s.mesh.edge_m; }, [](double v) { return v > 0; }));
-  keys.push_back(Real(
-      {"material.youngs_modulus", "Pa", "finite and > 0", "Young's modulus E"},
-      [](Scene& s) -> double& { return s.material.youngs_modulus_pa; },
-      [](double v) { return v > 0; }));
-  keys.push_back(Real(
-      {"material.poisson_ratio", "", "in the open interval (-1, 0.5)", "Poisson's ratio ν"},
-      [](Scene& s) -> double& { return s.material.poisson_ratio; },
-      [](double v) { return v > -1.0 && v < 0.5; }));
-  keys.push_back(Real(
-      {"material.density", "kg/m^3", "finite and > 0", "mass density ρ"},
-      [](Scene& s) -> double& { return s.material.density_kg_m3; },
-      [](double v) { return v > 0; }));
-  keys.push_back(Real(
-      {"material.damping", "1/s", "finite and >= 0", "mass-proportional damping d in C = d·M"},
-      [](Scene& s) -> double& { return s.material.damping_per_s; },
-      [](double v) { return v >= 0; }));
-}
-
-// The device's input and the time step.
-void AddInputKeys(std::vector<KeyAccess>& keys) {
-  keys.push_back(Real(
-      {"input.amplitude", "m", "finite and >= 0 (and below mesh.edge)",
-       "amplitude s of the contact node's motion along its face's inward normal"},
-      [](Scene& s) -> double& { return s.input.amplitude_m; }, [](double v) { return v >= 0; }));
-  keys.push_back(Real(
-      {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
-      [](Scene& s) -> double& { return s.input.frequency_hz; }, [](double v) { return v > 0; }));
-  keys.push_back(Choice(
-      {"input.waveform", "", "\"press\" or \"sine\"",
-       "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-      {"press", "sine"},
-      [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
-      [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
-  keys.push_back(ContactNodeKey());
-  keys.push_back(Real(
-      {"input.periods", "", "finite and > 0", "trial length in input periods"},
-      [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
-  keys.push_back(Real(
-      {"solver.dt", "s", "finite and > 0", "time step of the simulation"},
-      [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
-}
-
-// The asynchronous regions.
-void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
-  keys.push_back(Integer(
-      {"adaptivity.primary_size", "", "a whole number from 0 to 1000 (0 = no adaptivity)",
-       "primary region: nodes from the contact in every direction (0 = off)"},
-      [](Scene& s) -> int& { return s.adaptivity.primary_size; }, 0, 1000));
-  keys.push_back(Integer(
-      {"adaptivity.secondary_lod", "", "a whole number from 1 to 100",
-       "secondary spacing factor k (× the finest spacing)"},
-      [](Scene& s) -> int& { return s.adaptivity.secondary_lod; }, 1, 100));
-  keys.push_back(Real(
-      {"adaptivity.secondary_rate", "Hz",
-       "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-       "update rate of the secondary region"},
-      [](Scene& s) -> double& { return s.adaptivity.secondary_rate_hz; },
-      [](double v) { return v >= 1 && v == std::floor(v); }));
-  keys.push_back(Integer(
-      {"adaptivity.support_layers", "", "a whole number from 0 to 100",
-       "coarse cells refined around each fixed node (the supports are "
-       "singular: a coarse cell there is far too stiff)"},
-      [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
-  keys.push_back(Integer(
-      {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
-       "secondary regions: nested shells around the primary, each with its "
-       "own thread"},
-      [](Scene& s) -> int& { return s.adaptivity.secondary_regions; }, 1, 8));
-  keys.push_back(Integer(
-      {"adaptivity.shell_cells", "", "a whole number from 1 to 100",
-       "thickness of each secondary shell but the last, in coarse cells"},
-      [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
-  keys.push_back(Real(
-      {"adaptivity.outer_rate", "Hz",
-       "a whole number of Hz from 1 to the primary rate 1/solver.dt",
-       "update rate of the secondary shells beyond the first"},
-      [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
-      [](double v) { return v >= 1 && v == std::floor(v); }));
-  keys.push_back(Choice(
-      {"adaptivity.coupling", "", "\"displacement\" or \"force\"",
-       "what an inner region sends the outer one: its displacements next to "
-       "the interface (displacement) or its interface forces (force); see "
-       "docs/regions.md"},
-      {"displacement", "force"},
-      [](const Scene& s) { return s.adaptivity.displacement_coupling ? 0 : 1; },
-      [](Scene& s, int i) { s.adaptivity.displacement_coupling = i == 0; }));
-}
-
-const std::vector<KeyAccess>& KeyTable() {
-  static const std::vector<KeyAccess> table = [] {
-    std::vector<KeyAccess> keys;
-    AddObjectKeys(keys);
-    AddInputKeys(keys);
-    AddAdaptivityKeys(keys);
-    return keys;
-  }();
-  return table;
-}
-
-const KeyAccess& FindKey(std::string_view key) {
-  for (const KeyAccess& access : KeyTable()) {
-    if (access.info.name == key) return access;
-  }
-  std::string known;
-  for (const KeyAccess& access : KeyTable()) {
-    known += (known.empty() ? "" : ", ") + std::string(access.info.name);
-  }
-  throw Error("unknown scene key '" + std::string(key) + "'; known keys: " + known);
-}
 
 void ValidateAdaptivity(const Scene& scene) {
   const AdaptivitySettings& a = scene.adaptivity;
@@ -294,6 +49,42 @@ void ValidateAdaptivity(const Scene& scene) {
   }
 }
 
+void ValidateCubeScene(const Scene& scene) {
+  if (scene.input.amplitude_m >= scene.mesh.edge_m) {
+    throw Error("input.amplitude = " + FormatReal(scene.input.amplitude_m) +
+                " m is not allowed: input.amplitude must be below mesh.edge = " +
+                FormatReal(scene.mesh.edge_m) + " m");
+  }
+  if (const auto& node = scene.input.contact_node) {
+    const std::string problem = ContactNodeProblem(scene.mesh, *node);
+    if (!problem.empty()) {
+      throw Error("input.contact_node = " + GetSceneValue(scene, "input.contact_node") + " " +
+                  problem);
+    }
+  }
+}
+
+// What the geometry's lattice decides (the contact node, the labels) is checked where the model
+// is built (SceneModel) and where the file is read; here, what the keys alone decide.
+void ValidateGeometryScene(const Scene& scene) {
+  if (scene.adaptivity.enabled()) {
+    throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
+                " is not available with geometry.file yet: the asynchronous regions run on the "
+                "built-in cube only; set adaptivity.primary_size = 0 for the full-resolution "
+                "reference");
+  }
+  if (const auto& loaded = scene.loaded_geometry; loaded && loaded->source == scene.geometry) {
+    const LabelVolume& voxels = loaded->voxels;
+    const double smallest =
+        voxels.spacing_m * std::min({voxels.voxels[0], voxels.voxels[1], voxels.voxels[2]});
+    if (scene.input.amplitude_m >= smallest) {
+      throw Error("input.amplitude = " + FormatReal(scene.input.amplitude_m) +
+                  " m is not allowed: it must be below the object's smallest extent, " +
+                  FormatReal(smallest) + " m");
+    }
+  }
+}
+
 }  // namespace
 
 std::string FormatReal(double value) {
@@ -305,39 +96,35 @@ std::string FormatReal(double value) {
   return text;
 }
 
+std::string FormatTriple(const std::array<double, 3>& values) {
+  // Built piecewise: g++ 12 misreports "[" + string + … under -Wrestrict (PR 105651).
+  std::string text(1, '[');
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) text += ", ";
+    text += FormatReal(values[i]);
+  }
+  text += ']';
+  return text;
+}
+
 long Scene::num_steps() const { return std::lround(duration_s() / solver.dt_s); }
 
 std::string_view WaveformName(Waveform waveform) {
   return waveform == Waveform::kPress ? "press" : "sine";
 }
 
-const std::vector<SceneKeyInfo>& SceneKeys() {
-  static const std::vector<SceneKeyInfo> infos = [] {
-    std::vector<SceneKeyInfo> out;
-    for (const KeyAccess& access : KeyTable()) out.push_back(access.info);
-    return out;
-  }();
-  return infos;
-}
-
-void SetSceneValue(Scene* scene, std::string_view key, std::string_view value_text) {
-  FindKey(key).set(scene, value_text);
-}
-
-std::string GetSceneValue(const Scene& scene, std::string_view key) {
-  return FindKey(key).get(scene);
-}
-
 void ValidateScene(const Scene& scene) {
   // Each key alone: re-set it from its own value, which runs the key's range check.
   Scene copy = scene;
-  for (const KeyAccess& access : KeyTable()) access.set(&copy, access.get(scene));
+  for (const SceneKeyInfo& key : SceneKeys()) SetSceneValue(&copy, key.name, GetSceneValue(scene, key.name));
 
-  if (scene.input.amplitude_m >= scene.mesh.edge_m) {
-    throw Error("input.amplitude = " + FormatReal(scene.input.amplitude_m) +
-                " m is not allowed: input.amplitude must be below mesh.edge = " +
-                FormatReal(scene.mesh.edge_m) + " m");
+  if (scene.geometry.from_file()) {
+    ValidateGeometryScene(scene);
+  } else {
+    ValidateCubeScene(scene);
   }
+  ValidateLabelMaterials(scene);
+  ValidateSupportRegions(scene.supports);
   // A trial must have at least one step and must finish: cap it at 10⁸ steps.
   const double steps = scene.duration_s() / scene.solver.dt_s;
   if (!(steps >= 1.0 && steps <= 1e8)) {
@@ -346,14 +133,15 @@ void ValidateScene(const Scene& scene) {
                 " steps for the trial of input.periods / input.frequency = " +
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
-  if (const auto& node = scene.input.contact_node) {
-    const std::string problem = ContactNodeProblem(scene.mesh, *node);
-    if (!problem.empty()) {
-      throw Error("input.contact_node = " + GetSceneValue(scene, "input.contact_node") + " " +
-                  problem);
+  if (scene.adaptivity.enabled()) {
+    if (!scene.materials.empty() || !scene.supports.empty()) {
+      throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
+                  " is not available with [[material]] or [[support]] tables yet: the "
+                  "asynchronous regions run on the paper's cube, [material] and its four back "
+                  "corners; set adaptivity.primary_size = 0 for the full-resolution reference");
     }
+    ValidateAdaptivity(scene);
   }
-  if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 
 std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node) {

@@ -1,12 +1,14 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/fem/material.hpp"
+#include "core/geometry/label_volume.hpp"
 
 namespace hapticsim {
 
@@ -22,6 +24,47 @@ using LatticeIndex = std::array<int, 3>;
 struct MeshSettings {
   int nodes = 13;        ///< nodes per axis of the cube (mesh.nodes)
   double edge_m = 0.25;  ///< cube edge length, m (mesh.edge)
+};
+
+/**
+ * Where the object's shape comes from (geometry.*): the paper's cube of mesh.*, or a file — a
+ * labelled NIfTI volume or a closed STL/OBJ surface — voxelised on a lattice of spacing_m.
+ */
+struct GeometrySettings {
+  std::string file;         ///< geometry.file; "" = the built-in cube
+  double spacing_m = 0;     ///< geometry.spacing_m, m; 0 = a NIfTI volume's own voxel edge
+  double mesh_unit_m = 1;   ///< geometry.mesh_unit: metres per unit of an STL/OBJ file
+
+  bool from_file() const { return !file.empty(); }
+  bool operator==(const GeometrySettings&) const = default;
+};
+
+/** A [[material]] table: the material of every voxel labelled `label` (the cube is label 1). */
+struct LabelMaterial {
+  int label = 1;
+  Material material;
+};
+
+/**
+ * A [[support]] table: the object's nodes it holds fixed, chosen by one of three selectors in
+ * the geometry's own frame (a file's coordinates; the cube's, front face z = 0), metres.
+ */
+struct SupportRegion {
+  enum class Kind {
+    kLabel,  ///< every node of the voxels labelled `label` (a bone, a frame the tissue is glued to)
+    kBox,    ///< every node inside the box [box_min_m, box_max_m]
+    kPlane,  ///< every node within half a voxel of the plane through point_m, normal to `normal`
+  };
+  Kind kind = Kind::kLabel;
+  int label = 0;
+  std::array<double, 3> box_min_m{}, box_max_m{};
+  std::array<double, 3> point_m{}, normal{};
+};
+
+/** A geometry file read and voxelised, with the settings it was made from. */
+struct LoadedGeometry {
+  GeometrySettings source;
+  LabelVolume voxels;  ///< cropped to the labelled voxels
 };
 
 struct InputSettings {
@@ -66,8 +109,13 @@ struct AdaptivitySettings {
  * ρ = 1000 kg/m³, d = 10 1/s, dt = 1 ms.
  */
 struct Scene {
+  GeometrySettings geometry;
+  /// The geometry file's voxels once read (scene files do it; LoadSceneGeometry); null for the cube.
+  std::shared_ptr<const LoadedGeometry> loaded_geometry;
   MeshSettings mesh;
-  Material material;
+  Material material;  ///< every voxel's, unless `materials` names them per label
+  std::vector<LabelMaterial> materials;  ///< [[material]] tables
+  std::vector<SupportRegion> supports;   ///< [[support]] tables; none: the cube's four back corners
   InputSettings input;
   SolverSettings solver;
   AdaptivitySettings adaptivity;
@@ -82,6 +130,9 @@ std::string_view WaveformName(Waveform waveform);
 
 /** The shortest text that reads back to exactly `value` ("10000.0", "0.45", "1e-05"). */
 std::string FormatReal(double value);
+
+/** Three reals as a TOML array that reads back to them: "[0.0, 0.125, 1e-05]". */
+std::string FormatTriple(const std::array<double, 3>& values);
 
 /**
  * One settable scene key ("section.key"). The table of keys is the single source of truth for
@@ -108,10 +159,12 @@ void SetSceneValue(Scene* scene, std::string_view key, std::string_view value_te
 std::string GetSceneValue(const Scene& scene, std::string_view key);
 
 /**
- * Checks every key's range and the relations between keys.
+ * Checks every key's range and the relations between keys, and each [[material]] and [[support]]
+ * table; with the geometry loaded, that its labels and the tables' agree.
  * @throws Error with one message naming the key and its allowed range.
  */
 void ValidateScene(const Scene& scene);
+
 
 /**
  * The paper's contact: the middle node of the front face (z = 0); with an even node count, the

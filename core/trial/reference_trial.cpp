@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/fem/central_difference_integrator.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/trial/trial_recorder.hpp"
@@ -45,9 +46,12 @@ std::string_view TrialOutcomeName(TrialOutcome outcome) {
   return "unknown";
 }
 
-TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options) {
+TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& options) {
   const Scene& scene = cube.scene();
   const ElasticModel& model = cube.model();
+  // ObjectState, the frames' form, is the cube's lattice.
+  HAPTICSIM_THROW_UNLESS(options.frames.every_periods == 0 || !scene.geometry.from_file(),
+                         "frames of a trial are drawn for the built-in cube only for now");
   TrialResult result;
   result.stability = EstimateStability(model);
   const double dt = scene.solver.dt_s;
@@ -60,7 +64,7 @@ TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options
   const double h = dt / result.substeps;
 
   CentralDifferenceIntegrator integrator(model, h);
-  const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
+  const ContactTrajectory trajectory(scene.input, cube.contact_normal());
   const long steps = scene.num_steps();
   TrialRecorder recorder(trajectory, dt, steps, &result);
   // Period n goes from tₙ to tₙ₊₁; its first step yields the reaction at tₙ, so periods 0…N give

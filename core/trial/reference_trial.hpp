@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/fem/object_state.hpp"
 #include "core/fem/stability_estimate.hpp"
 
@@ -74,6 +74,6 @@ struct TrialOptions {
  * stepped by central difference over the trial, with the stability limit predicted before the
  * first step and divergence detected during the run.
  */
-TrialResult RunReferenceTrial(const CubeScene& cube, const TrialOptions& options = {});
+TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& options = {});
 
 }  // namespace hapticsim

@@ -5,7 +5,7 @@
 #include <string>
 #include <utility>
 
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/trial/force_error.hpp"
 #include "tests/support/adaptive_scene.hpp"
 
@@ -17,7 +17,7 @@ Scene Adaptive(int r, int k, double rate_hz, double nu = 0.45) {
 }
 
 const TrialResult& DefaultReference() {
-  static const TrialResult reference = RunReferenceTrial(CubeScene(Scene{}));
+  static const TrialResult reference = RunReferenceTrial(SceneModel(Scene{}));
   return reference;
 }
 
@@ -57,7 +57,7 @@ TEST(AsyncRegions, RegionsAtOneRateStepTogetherWhateverSubstepsEachNeedsAlone) {
   base.material.density_kg_m3 = 800;
   TrialOptions substepped;  // the reference needs 2 substeps too
   substepped.substep_to_stability = true;
-  const TrialResult reference = RunReferenceTrial(CubeScene(base), substepped);
+  const TrialResult reference = RunReferenceTrial(SceneModel(base), substepped);
   ASSERT_EQ(reference.substeps, 2);
   for (const auto& [r, shells] :
        {std::pair{1, 1}, std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}}) {
@@ -89,7 +89,7 @@ TEST(AsyncRegions, EqualRatesReproduceTheReferenceUnderFastInputs) {
     base.input.frequency_hz = frequency;
     base.input.amplitude_m = 0.02;
     base.input.periods = 2;
-    const TrialResult reference = RunReferenceTrial(CubeScene(base));
+    const TrialResult reference = RunReferenceTrial(SceneModel(base));
     for (int shells : {1, 2}) {
       for (int r : {1, 2}) {
         for (bool displacement : {true, false}) {

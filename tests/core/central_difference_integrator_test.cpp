@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/scene/contact_trajectory.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/trial/reference_trial.hpp"
 #include "core/fem/stability_estimate.hpp"
 #include "core/fem/static_solver.hpp"
@@ -36,7 +36,7 @@ double ShadowEnergy(const ElasticModel& model, const Eigen::VectorXd& u,
 TEST(CentralDifference, UndampedFreeVibrationConservesEnergyOver10kSteps) {
   Scene scene = SmallCube(7);
   scene.material.damping_per_s = 0;
-  const CubeScene cube(scene);
+  const SceneModel cube(scene);
   const double dt = 0.9 * EstimateStability(cube.model()).critical_dt_s;
   CentralDifferenceIntegrator dut(cube.model(), dt);
   const Eigen::VectorXd u0 = RandomFreeState(cube.model(), 3);
@@ -62,7 +62,7 @@ TEST(CentralDifference, StableJustBelowThePredictedLimitDivergentJustAbove) {
   for (double damping : {0.0, 40.0}) {
     Scene scene = SmallCube(7);
     scene.material.damping_per_s = damping;
-    const CubeScene cube(scene);
+    const SceneModel cube(scene);
     const double critical = EstimateStability(cube.model()).critical_dt_s;
     const std::array<double, 3> held{0, 0, 0};
     const Eigen::VectorXd u0 = RandomFreeState(cube.model(), 5);
@@ -94,15 +94,15 @@ TEST(CentralDifference, RunPastTheLimitFromRestIsDetected) {
   // From rest only round-off seeds the unstable mode; detection must still come within a
   // bounded number of steps, long before the trial ends.
   Scene scene = SmallCube(9);
-  const CubeScene probe(scene);
+  const SceneModel probe(scene);
   scene.solver.dt_s = 1.02 * EstimateStability(probe.model()).critical_dt_s;
   TrialOptions options;
   options.run_if_predicted_unstable = true;
-  const TrialResult result = RunReferenceTrial(CubeScene(scene), options);
+  const TrialResult result = RunReferenceTrial(SceneModel(scene), options);
   EXPECT_TRUE(result.diverged());
   EXPECT_LT(result.steps, 600);
 
-  const TrialResult refused = RunReferenceTrial(CubeScene(scene));
+  const TrialResult refused = RunReferenceTrial(SceneModel(scene));
   EXPECT_EQ(refused.outcome, TrialOutcome::kPredictedUnstable);
   EXPECT_EQ(refused.steps, 0);
 }
@@ -117,12 +117,12 @@ TEST(CentralDifference, ReferenceSubstepsPastTheLimitEqualAFinerTimeStep) {
   stiff.material.density_kg_m3 = 800;
   TrialOptions options;
   options.substep_to_stability = true;
-  const TrialResult substepped = RunReferenceTrial(CubeScene(stiff), options);
+  const TrialResult substepped = RunReferenceTrial(SceneModel(stiff), options);
   ASSERT_EQ(substepped.outcome, TrialOutcome::kCompleted);
   ASSERT_EQ(substepped.substeps, 2);
   Scene fine = stiff;
   fine.solver.dt_s = 0.5e-3;
-  const TrialResult direct = RunReferenceTrial(CubeScene(fine));
+  const TrialResult direct = RunReferenceTrial(SceneModel(fine));
   ASSERT_EQ(direct.outcome, TrialOutcome::kCompleted);
   ASSERT_EQ(direct.samples.size(), 2 * substepped.samples.size() - 1);
   // Equal up to the rounding of the sample times (n·dt + h against (2n + 1)·h).
@@ -133,7 +133,7 @@ TEST(CentralDifference, ReferenceSubstepsPastTheLimitEqualAFinerTimeStep) {
   }
   EXPECT_LT(worst, 1e-12 * direct.peak_force_n);
   // Without the option the same scene is refused, as before.
-  EXPECT_EQ(RunReferenceTrial(CubeScene(stiff)).outcome, TrialOutcome::kPredictedUnstable);
+  EXPECT_EQ(RunReferenceTrial(SceneModel(stiff)).outcome, TrialOutcome::kPredictedUnstable);
 }
 
 TEST(CentralDifference, ResponseIsExactlyLinearInTheInputAmplitude) {
@@ -141,8 +141,8 @@ TEST(CentralDifference, ResponseIsExactlyLinearInTheInputAmplitude) {
   small.input.amplitude_m = 0.005;
   Scene large = small;
   large.input.amplitude_m = 0.015;
-  const TrialResult a = RunReferenceTrial(CubeScene(small));
-  const TrialResult b = RunReferenceTrial(CubeScene(large));
+  const TrialResult a = RunReferenceTrial(SceneModel(small));
+  const TrialResult b = RunReferenceTrial(SceneModel(large));
   ASSERT_EQ(a.samples.size(), b.samples.size());
   double worst = 0;
   for (size_t i = 0; i < a.samples.size(); ++i) {
@@ -162,17 +162,17 @@ TEST(CentralDifference, SlowUndampedPressConvergesToTheStaticSolve) {
   scene.material.damping_per_s = 0;
   scene.input.frequency_hz = 0.05;
   scene.input.periods = 0.5;  // end at full depth
-  const TrialResult dynamic = RunReferenceTrial(CubeScene(scene));
+  const TrialResult dynamic = RunReferenceTrial(SceneModel(scene));
   ASSERT_EQ(dynamic.outcome, TrialOutcome::kCompleted);
   const std::array<double, 3> depth{0, 0, scene.input.amplitude_m};
   const double static_reaction =
-      SolveStatic(CubeScene(scene).model(), depth, 1e-12).driven_reaction[2];
+      SolveStatic(SceneModel(scene).model(), depth, 1e-12).driven_reaction[2];
   const double dynamic_reaction = -dynamic.samples.back().feedback_force_n[2];
   EXPECT_NEAR(dynamic_reaction, static_reaction, 0.005 * static_reaction);
 }
 
 TEST(CentralDifference, ReactionOpposesThePress) {
-  const TrialResult result = RunReferenceTrial(CubeScene(SmallCube(7)));
+  const TrialResult result = RunReferenceTrial(SceneModel(SmallCube(7)));
   ASSERT_EQ(result.outcome, TrialOutcome::kCompleted);
   // Half way through the press the contact is at full depth: the user is pushed back out (−z).
   const ForceSample& mid = result.samples[result.samples.size() / 2];

@@ -81,16 +81,16 @@ TEST(ContactNode, EdgeNodesPressAlongTheFrontOrBackFirst) {
 
 TEST(ContactNode, ReferenceForcesMirrorWithTheCube) {
   // x → L − x: the off-centre front node 1 ↔ 5; the force's x component flips.
-  const TrialResult left = RunReferenceTrial(CubeScene(Pressed("1,3,0")));
-  const TrialResult right = RunReferenceTrial(CubeScene(Pressed("5,3,0")));
+  const TrialResult left = RunReferenceTrial(SceneModel(Pressed("1,3,0")));
+  const TrialResult right = RunReferenceTrial(SceneModel(Pressed("5,3,0")));
   ASSERT_EQ(left.outcome, TrialOutcome::kCompleted);
   EXPECT_GT(std::abs(left.samples[200].feedback_force_n[0]), 1e-3 * left.peak_force_n)
       << "an off-centre press must pull sideways, or the test shows nothing";
   EXPECT_LT(MirroredDifference(left, right, {0, 1, 2}, {-1, 1, 1}), 1e-10);
 
   // x ↔ y: the left face (normal +x) and the bottom face (normal +y).
-  const TrialResult side = RunReferenceTrial(CubeScene(Pressed("0,3,2")));
-  const TrialResult bottom = RunReferenceTrial(CubeScene(Pressed("3,0,2")));
+  const TrialResult side = RunReferenceTrial(SceneModel(Pressed("0,3,2")));
+  const TrialResult bottom = RunReferenceTrial(SceneModel(Pressed("3,0,2")));
   EXPECT_LT(MirroredDifference(side, bottom, {1, 0, 2}, {1, 1, 1}), 1e-10);
   // Pressing along +x: the user feels a force along −x.
   EXPECT_LT(side.samples[250].feedback_force_n[0], 0.0);
@@ -102,7 +102,7 @@ TEST(ContactNode, RegionsAtEqualRatesReproduceTheReferenceOffCentre) {
   // k = 1 and equal rates the regions are exactly monolithic central difference.
   for (const std::string node : {"0,3,2", "1,1,0", "3,6,6"}) {
     Scene scene = Pressed(node);
-    const TrialResult reference = RunReferenceTrial(CubeScene(scene));
+    const TrialResult reference = RunReferenceTrial(SceneModel(scene));
     scene.adaptivity.primary_size = 1;
     scene.adaptivity.secondary_lod = 1;
     scene.adaptivity.secondary_rate_hz = 1000;

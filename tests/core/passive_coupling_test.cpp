@@ -162,7 +162,7 @@ TEST(PassiveCoupling, FreeDecayFromARandomStateOnlyLosesEnergy) {
 TEST(PassiveCoupling, EveryPaperConfigurationRunsAtNu049) {
   Scene base;
   base.material.poisson_ratio = 0.49;
-  const TrialResult reference = RunReferenceTrial(CubeScene(base));
+  const TrialResult reference = RunReferenceTrial(SceneModel(base));
   double best_k2 = INFINITY;
   for (int k : {1, 2, 3}) {
     for (int r : {1, 2, 3, 4}) {
@@ -184,7 +184,7 @@ TEST(PassiveCoupling, EveryPaperConfigurationRunsAtNu049) {
 // What the controllers cost where the bare exchange is stable: the default material, every paper
 // configuration, side by side. Measured: at most 0.014 points (k 1 r 1 900 Hz, 0.001 → 0.015 %).
 TEST(PassiveCoupling, OnTheDefaultMaterialTheControllersCostAtMostATenthOfAPoint) {
-  const TrialResult reference = RunReferenceTrial(CubeScene(Scene{}));
+  const TrialResult reference = RunReferenceTrial(SceneModel(Scene{}));
   for (int k : {1, 2, 3}) {
     for (int r : {1, 2, 3, 4}) {
       for (double rate : {900.0, 800.0, 700.0, 600.0}) {

@@ -5,7 +5,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/fem/assembled_stiffness.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 namespace {
@@ -41,7 +41,7 @@ double DenseOmegaMax(const ElasticModel& model) {
 
 TEST(StabilityEstimate, LanczosMatchesDenseEigenSolve) {
   for (double nu : {0.40, 0.45, 0.49}) {
-    const CubeScene cube(SmallCube(6, nu));
+    const SceneModel cube(SmallCube(6, nu));
     const StabilityEstimate dut = EstimateStability(cube.model());
     EXPECT_TRUE(dut.converged);
     EXPECT_NEAR(dut.omega_max_rad_s, DenseOmegaMax(cube.model()), 1e-7 * dut.omega_max_rad_s)
@@ -51,7 +51,7 @@ TEST(StabilityEstimate, LanczosMatchesDenseEigenSolve) {
 
 TEST(StabilityEstimate, ElementBoundIsNeverAboveTheLimit) {
   for (int nodes : {3, 7, 13}) {
-    const CubeScene cube(SmallCube(nodes));
+    const SceneModel cube(SmallCube(nodes));
     const StabilityEstimate dut = EstimateStability(cube.model());
     EXPECT_LE(dut.element_bound_dt_s, dut.critical_dt_s) << nodes << " nodes";
     // …and not uselessly far below it.
@@ -65,8 +65,8 @@ TEST(StabilityEstimate, ScalesWithTheWaveSpeed) {
   Scene stiff = base;
   stiff.material.youngs_modulus_pa *= 4;
   stiff.material.density_kg_m3 *= 2;
-  const double dt_base = EstimateStability(CubeScene(base).model()).critical_dt_s;
-  const double dt_stiff = EstimateStability(CubeScene(stiff).model()).critical_dt_s;
+  const double dt_base = EstimateStability(SceneModel(base).model()).critical_dt_s;
+  const double dt_stiff = EstimateStability(SceneModel(stiff).model()).critical_dt_s;
   EXPECT_NEAR(dt_stiff / dt_base, std::sqrt(0.5), 1e-6);
 }
 

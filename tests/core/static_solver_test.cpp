@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 namespace {
@@ -46,7 +46,7 @@ TEST(StaticSolver, UniaxialBlockMatchesAnalyticalStiffness) {
 }
 
 TEST(StaticSolver, CubeReactionIsAlongThePressBySymmetry) {
-  const CubeScene cube(Scene{});
+  const SceneModel cube(Scene{});
   const std::array<double, 3> driven{0, 0, 0.01};
   const StaticSolution solution = SolveStatic(cube.model(), driven);
   ASSERT_TRUE(solution.converged);
@@ -57,7 +57,7 @@ TEST(StaticSolver, CubeReactionIsAlongThePressBySymmetry) {
 }
 
 TEST(StaticSolver, ReactionIsLinearInTheDisplacement) {
-  const CubeScene cube(Scene{});
+  const SceneModel cube(Scene{});
   const std::array<double, 3> small{0, 0, 0.005}, large{0, 0, 0.015};
   const double r_small = SolveStatic(cube.model(), small, 1e-12).driven_reaction[2];
   const double r_large = SolveStatic(cube.model(), large, 1e-12).driven_reaction[2];

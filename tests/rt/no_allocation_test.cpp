@@ -9,7 +9,7 @@
 #include "core/fem/material_field.hpp"
 #include "core/fem/stencil_stiffness.hpp"
 #include "core/scene/contact_trajectory.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "tests/support/allocation_counter.hpp"
 
 namespace hapticsim {
@@ -25,7 +25,7 @@ TEST(AllocationCounter, SeesOperatorNewAndMalloc) {
 }
 
 TEST(TimeStep, NeverAllocates) {
-  const CubeScene cube(Scene{});
+  const SceneModel cube(Scene{});
   CentralDifferenceIntegrator dut(cube.model(), cube.scene().solver.dt_s);
   const ContactTrajectory trajectory(cube.scene().input);
   std::array<double, 3> next{};

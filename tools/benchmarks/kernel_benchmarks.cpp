@@ -17,7 +17,7 @@
 #include "core/fem/central_difference_integrator.hpp"
 #include "core/fem/elementwise_stiffness.hpp"
 #include "core/fem/material_field.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/regions/element_set_stiffness.hpp"
 #include "core/regions/hybrid_mesh.hpp"
 #include "core/regions/region_partition.hpp"
@@ -145,7 +145,7 @@ void BM_TimeStep(benchmark::State& state) {
   Scene scene;
   scene.mesh.nodes = static_cast<int>(state.range(0));
   scene.solver.dt_s = 1e-4;  // below the limit at every size benchmarked
-  const CubeScene cube(scene);
+  const SceneModel cube(scene);
   CentralDifferenceIntegrator integrator(cube.model(), scene.solver.dt_s);
   const std::array<double, 3> next{0, 0, 1e-3};
   for (auto _ : state) {

@@ -15,7 +15,7 @@
 #include "core/fem/assembled_stiffness.hpp"
 #include "core/regions/async_regions.hpp"
 #include "core/fem/cpu_dispatch.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/error.hpp"
 #include "core/errormap/error_sweep.hpp"
 #include "core/fem/hex_grid.hpp"
@@ -183,7 +183,7 @@ struct ConfigurationResult {
 double ReferenceCostUsPerMs(const Scene& scene, int* substeps) {
   Scene full = scene;
   full.adaptivity.primary_size = 0;
-  const CubeScene cube(full);
+  const SceneModel cube(full);
   TrialOptions options;
   options.substep_to_stability = true;
   std::vector<double> costs;

@@ -49,13 +49,16 @@ TrialFrames FramesInto(VtkSeries& series, const Scene& scene, double rate_hz) {
 // The full-resolution reference, with frames into `vtk` ("reference") when asked.
 TrialResult RunReference(const Scene& scene, TrialOptions options, VtkOutput* vtk) {
   std::optional<VtkSeries> series;
+  HAPTICSIM_THROW_UNLESS(!vtk || !scene.geometry.from_file(),
+                         "--vtk draws the built-in cube only for now: leave it out with "
+                         "geometry.file");
   if (vtk) {
     const int n = scene.mesh.nodes;
     series.emplace(vtk->dir, "reference", scene,
                    std::vector<RegionIndex>(static_cast<size_t>(n - 1) * (n - 1) * (n - 1), 0));
     options.frames = FramesInto(*series, scene, vtk->rate_hz);
   }
-  TrialResult result = RunReferenceTrial(CubeScene(scene), options);
+  TrialResult result = RunReferenceTrial(SceneModel(scene), options);
   if (series) {
     series->Finish();
     vtk->written.push_back(series->collection());
@@ -265,8 +268,7 @@ int Run(const SimulateOptions& options) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << (adaptive ? "Adaptive simulation" : "Reference simulation") << ": "
-              << scene.mesh.nodes << "³-node cube, edge " << Quantity(scene.mesh.edge_m, "m")
-              << "; " << WaveformName(scene.input.waveform) << " of "
+              << ObjectDescription(scene) << "; " << WaveformName(scene.input.waveform) << " of "
               << Quantity(scene.input.amplitude_m, "m") << " at "
               << Quantity(scene.input.frequency_hz, "Hz") << " for " << Duration(scene.duration_s())
               << ", dt " << Duration(scene.solver.dt_s) << "\n";

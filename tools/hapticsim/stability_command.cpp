@@ -4,7 +4,7 @@
 #include <optional>
 
 #include "core/regions/async_regions.hpp"
-#include "core/scene/cube_scene.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/error.hpp"
 #include "core/fem/stability_estimate.hpp"
 #include "tools/hapticsim/command.hpp"
@@ -145,7 +145,7 @@ int Run(const SceneOptions& options, bool all_configurations, bool estimate_coup
   const Scene scene = options.Resolve();
   if (all_configurations) return RunAllConfigurations(options, scene);
   if (scene.adaptivity.enabled()) return RunAdaptive(options, scene, estimate_coupled);
-  const CubeScene cube(scene);
+  const SceneModel cube(scene);
   const StabilityEstimate estimate = EstimateStability(cube.model());
   const double dt = scene.solver.dt_s;
   const bool stable = estimate.IsStable(dt);
@@ -162,7 +162,7 @@ int Run(const SceneOptions& options, bool all_configurations, bool estimate_coup
     out["dt_fraction_of_critical"] = dt / estimate.critical_dt_s;
     std::cout << out.dump(2) << "\n";
   } else {
-    std::cout << "Stability of central difference: " << scene.mesh.nodes << "³-node cube\n"
+    std::cout << "Stability of central difference: " << ObjectDescription(scene) << "\n"
               << "  critical dt (2/ω_max, Lanczos on M⁻¹K): " << Duration(estimate.critical_dt_s)
               << "  (ω_max " << Quantity(estimate.omega_max_rad_s, "rad/s") << ", "
               << estimate.iterations << " iterations"
