@@ -23,11 +23,24 @@ struct StencilTerm {
 using NodeStencil = std::array<std::vector<StencilTerm>, 3>;
 
 /**
- * The stencil of a node from the cells around it that are present: bit c of `cell_mask` stands
- * for the cell on the node's low side along every axis j whose bit j of c is set (high side
- * where clear). The sum of those cells' element-matrix blocks, couplings below 10⁻¹³ of the
- * largest entry dropped; on a grid of n nodes with node strides sy (y) and sz (z),
- * component-blocked.
+ * The element matrices of the 8 cells around a node: cell c lies on the node's low side along
+ * every axis j whose bit j of c is set (high side where clear); null where no element is (an
+ * empty cell, or one outside the grid).
+ */
+using CellMatrices = std::array<const Hex8Element::Matrix24*, 8>;
+
+/**
+ * The stencil of a node from the cells around it that are present: the sum of their
+ * element-matrix blocks (in cell order), couplings below 10⁻¹³ of the largest entry of those
+ * matrices dropped; on a grid of n nodes with node strides sy (y) and sz (z), component-blocked.
+ * No cell present: an empty stencil (ApplyStencilAt/Run write ku = 0).
+ */
+NodeStencil MakeNodeStencil(const CellMatrices& cells, std::ptrdiff_t n, std::ptrdiff_t sy,
+                            std::ptrdiff_t sz);
+
+/**
+ * The same with one element matrix `ke` in every cell present: bit c of `cell_mask` set for
+ * cell c present.
  */
 NodeStencil MakeNodeStencil(const Hex8Element::Matrix24& ke, unsigned cell_mask, std::ptrdiff_t n,
                             std::ptrdiff_t sy, std::ptrdiff_t sz);
@@ -127,6 +140,57 @@ HAPTICSIM_KERNEL_INLINE void ApplyStencilRun(const NodeStencil& stencil, const d
     k += 4;
   }
   if (k < length) AccumulateNodes<4>(stencil, u, ku, first + length - 4, n);
+}
+
+/**
+ * The stencils of 4 consecutive nodes along x that do not share one, merged lane by lane: lane k
+ * is node k's stencil, ku_a[i+k] += coefficient[k] · u[i + k + offset], 0 where node k has no
+ * such coupling. Where a node's stencil changes every node or two (materials changing along x,
+ * the faces of an object), this keeps the vector kernel instead of the scalar one.
+ */
+struct LaneTerm {
+  std::ptrdiff_t offset;
+  std::array<double, 4> coefficient;
+};
+using LaneStencil = std::array<std::vector<LaneTerm>, 3>;
+
+/** The lane stencil of the 4 nodes whose stencils are `nodes` (lane k: nodes[k]), by offset. */
+LaneStencil MergeNodeStencils(const std::array<const NodeStencil*, 4>& nodes);
+
+/**
+ * Whether every lane's reads, u[first + k + offset] for all terms, fall inside u[0, 3n): a lane
+ * also reads the neighbours of the other lanes' couplings (times 0), up to 3 nodes further.
+ */
+bool LaneReadsInside(const LaneStencil& stencil, std::ptrdiff_t first, std::ptrdiff_t n);
+
+/**
+ * ku at the 4 nodes from `first` by their merged stencil. A lane multiplies u where its node has
+ * no coupling by 0, so u must be finite (an infinite u gives NaN in nodes it does not touch).
+ */
+HAPTICSIM_KERNEL_INLINE void ApplyLaneStencil(const LaneStencil& stencil, const double* u,
+                                              double* ku, std::ptrdiff_t first, std::ptrdiff_t n) {
+  using stencil_detail::Vec4;
+  for (int a = 0; a < 3; ++a) {
+    const auto& terms = stencil[a];
+    Vec4 even = {}, odd = {};  // two dependency chains, as in AccumulateChunk
+    Vec4 c, v;
+    size_t t = 0;
+    for (; t + 1 < terms.size(); t += 2) {
+      std::memcpy(&c, terms[t].coefficient.data(), sizeof c);
+      std::memcpy(&v, u + first + terms[t].offset, sizeof v);
+      even += c * v;
+      std::memcpy(&c, terms[t + 1].coefficient.data(), sizeof c);
+      std::memcpy(&v, u + first + terms[t + 1].offset, sizeof v);
+      odd += c * v;
+    }
+    if (t < terms.size()) {
+      std::memcpy(&c, terms[t].coefficient.data(), sizeof c);
+      std::memcpy(&v, u + first + terms[t].offset, sizeof v);
+      even += c * v;
+    }
+    const Vec4 sum = even + odd;
+    std::memcpy(ku + a * n + first, &sum, sizeof sum);
+  }
 }
 
 // fe = k · ue for one hexahedron, k a 24 × 24 element stiffness (column-major, node-major local

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <functional>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -100,6 +101,91 @@ TEST(ElementwiseStiffness, MatchesTheStencilOnTheUniformFullCube) {
   stencil.Apply(u, expected);
   EXPECT_LT(RelativeDifference(ku, expected), 1e-13);
   EXPECT_LT(RelativeDifference(dut.Diagonal(), stencil.Diagonal()), 1e-14);
+}
+
+// Three materials on a masked grid, with long runs of one stencil along x (a soft slab, a stiff
+// block), short ones (a layer of materials drawn at random) and nodes no element touches (an
+// empty corner above): every segment kind of the node-stencil kernel, at the grid's faces too.
+MaterialField MixedMaskedField(const HexGrid& grid) {
+  std::uint64_t state = 777;
+  return FieldOf(
+      grid,
+      [&](int ex, int ey, int ez) -> std::int16_t {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        const int draw = static_cast<int>((state >> 33) % 4);
+        if (ez == grid.nz() - 2) {
+          return ey >= 2 ? MaterialField::kEmpty : static_cast<std::int16_t>(draw == 3 ? -1 : draw);
+        }
+        if (ez == 1) return static_cast<std::int16_t>(draw == 3 ? -1 : draw);  // short runs
+        return ex >= 3 && ex <= 8 && ey >= 1 ? 1 : 0;
+      },
+      {Soft(), Stiff(), Material{2e4, 0.35, 1100, 0}});
+}
+
+// Both kernels, and the one chosen, against the matrix assembled from the same field. ku starts
+// as NaN: Apply must assign every entry, 0 exactly where no element touches the node.
+TEST(ElementwiseStiffness, EveryKernelMatchesTheAssembledMatrixOnAMixedMaskedField) {
+  using Kernel = ElementwiseStiffness::Kernel;
+  for (const HexGrid& grid : {HexGrid(12, 5, 5, kH), HexGrid(3, 4, 4, kH), HexGrid(5, 3, 4, kH)}) {
+    const MaterialField field = MixedMaskedField(grid);
+    const AssembledStiffness oracle(grid, field);
+    const std::vector<bool> active = field.ActiveNodes(grid);
+    ASSERT_LT(std::count(active.begin(), active.end(), true), grid.num_nodes());
+    for (const Kernel kernel : {Kernel::kNodeStencils, Kernel::kElements, Kernel::kAuto}) {
+      const ElementwiseStiffness dut(grid, field, kernel);
+      if (kernel != Kernel::kAuto) {
+        ASSERT_EQ(dut.kernel(), kernel);
+      }
+      const std::string label = "grid " + std::to_string(grid.nx()) + ", kernel " +
+                                std::to_string(static_cast<int>(dut.kernel()));
+      for (int seed = 1; seed <= 3; ++seed) {
+        const Eigen::VectorXd u = testing::RandomField(grid.num_dofs(), seed, 1e-3);
+        Eigen::VectorXd ku = Eigen::VectorXd::Constant(grid.num_dofs(), std::nan("")),
+                        expected(grid.num_dofs());
+        dut.Apply(u, ku);
+        oracle.Apply(u, expected);
+        ASSERT_TRUE(ku.allFinite()) << label;
+        EXPECT_LT(RelativeDifference(ku, expected), 1e-13) << label << ", seed " << seed;
+        for (int node = 0; node < grid.num_nodes(); ++node) {
+          if (active[static_cast<size_t>(node)]) continue;
+          for (int c = 0; c < 3; ++c) EXPECT_EQ(ku[grid.Dof(node, c)], 0.0) << label;
+        }
+      }
+      EXPECT_LT(RelativeDifference(dut.Diagonal(), oracle.Diagonal()), 1e-14) << label;
+    }
+  }
+}
+
+// The field above does give the node-stencil kernel merged windows (short runs) besides its
+// stencils, so the test above went through both of its paths.
+TEST(ElementwiseStiffness, TheMixedFieldExercisesWindowsAndLongRuns) {
+  const HexGrid grid(12, 5, 5, kH);
+  const ElementwiseStiffness dut(grid, MixedMaskedField(grid),
+                                 ElementwiseStiffness::Kernel::kNodeStencils);
+  EXPECT_GT(dut.num_lane_stencils(), 0);
+  EXPECT_GT(dut.num_stencils(), 10);
+}
+
+// The choice: one material in a masked slab runs the node stencils (long runs); a field drawn at
+// random element by element from three materials and empty, on 25³, has more distinct cell
+// tuples than stay in cache (nearly one per node), and runs the elements.
+TEST(ElementwiseStiffness, ChoosesNodeStencilsOnASlabAndElementsOnAFieldMixedAtRandom) {
+  const HexGrid grid(13, 13, 13, kH);
+  const MaterialField slab = FieldOf(grid, [](int, int, int ez) -> std::int16_t {
+    return ez < 6 ? 0 : MaterialField::kEmpty;
+  });
+  EXPECT_EQ(ElementwiseStiffness(grid, slab).kernel(),
+            ElementwiseStiffness::Kernel::kNodeStencils);
+  const HexGrid large(25, 25, 25, kH);
+  std::uint64_t state = 99;
+  const MaterialField random = FieldOf(
+      large,
+      [&](int, int, int) -> std::int16_t {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return static_cast<std::int16_t>((state >> 33) % 4 - 1);
+      },
+      {Soft(), Stiff(), Material{2e4, 0.35, 1100, 0}});
+  EXPECT_EQ(ElementwiseStiffness(large, random).kernel(), ElementwiseStiffness::Kernel::kElements);
 }
 
 TEST(ElementwiseStiffness, IsSymmetricAndHasTheSixRigidBodyModesOnAnLShape) {

@@ -113,23 +113,51 @@ void BM_RegionApply(benchmark::State& state) {
   state.counters["direct_nodes"] = box->direct_nodes();
 }
 
-// Any shape, any materials: the element-by-element operator (ElementwiseStiffness) on the same
-// grids, filled whole (range 1 = 100) or to a half (50: the lower half in z, the object a slab of
-// half the cube; two materials, so nothing is uniform). "active_nodes" counts the nodes an
-// occupied element touches: compare time per active node with the stencil's per node.
-void BM_ElementwiseApply(benchmark::State& state) {
-  const HexGrid grid = Grid(static_cast<int>(state.range(0)));
-  const int percent = static_cast<int>(state.range(1));
+// The fields of BM_ElementwiseApply, on a grid filled to `percent` of its depth (the lower layers
+// in z):
+enum class AnyShapeField {
+  kAlternating = 0,  // two materials alternating element by element (along x too): the worst case
+                     // for node stencils, every run one node long
+  kOneMaterial = 1,  // one material: a masked grid
+  kInclusion = 2,    // soft, with a sphere 8× stiffer in the middle of the slab (a palpation
+                     // phantom): two materials in contiguous regions
+  kRandom = 3,       // two materials drawn at random per element: where the kernel choice matters
+};
+
+MaterialField AnyShape(const HexGrid& grid, int percent, AnyShapeField layout) {
+  const int ex_count = grid.nx() - 1, ey_count = grid.ny() - 1;
+  const int layers = (grid.nz() - 1) * percent / 100;
+  std::vector<std::int16_t> elements(static_cast<size_t>(grid.num_elements()), -1);
+  for (int e = 0; e < ex_count * ey_count * layers; ++e) {
+    const int ex = e % ex_count, ey = (e / ex_count) % ey_count, ez = e / (ex_count * ey_count);
+    // Element centre in units of the grid's edge; the sphere's radius is a fifth of the edge.
+    const double x = (ex + 0.5) / ex_count - 0.5, y = (ey + 0.5) / ey_count - 0.5,
+                 z = (ez + 0.5 - 0.5 * layers) / ex_count;
+    const bool in_sphere = x * x + y * y + z * z < 0.2 * 0.2;
+    switch (layout) {
+      case AnyShapeField::kAlternating: elements[static_cast<size_t>(e)] = e % 2; break;
+      case AnyShapeField::kOneMaterial: elements[static_cast<size_t>(e)] = 0; break;
+      case AnyShapeField::kInclusion: elements[static_cast<size_t>(e)] = in_sphere; break;
+      case AnyShapeField::kRandom:  // a multiplicative hash's bit
+        elements[static_cast<size_t>(e)] = static_cast<std::int16_t>((e * 2654435761u >> 7) % 2);
+    }
+  }
   Material stiff;
   stiff.youngs_modulus_pa *= 8;
-  std::vector<std::int16_t> elements(static_cast<size_t>(grid.num_elements()));
-  const int layers = (grid.nz() - 1) * percent / 100;
-  for (int e = 0; e < grid.num_elements(); ++e) {
-    const int ez = e / ((grid.nx() - 1) * (grid.ny() - 1));
-    elements[static_cast<size_t>(e)] = ez < layers ? static_cast<std::int16_t>(e % 2) : -1;
-  }
-  const MaterialField field(grid, {Material{}, stiff}, elements);
-  const ElementwiseStiffness k(grid, field);
+  return MaterialField(grid, {Material{}, stiff}, elements);
+}
+
+// Any shape, any materials: ElementwiseStiffness on the same grids as the stencil, a field of
+// AnyShape (nodes, percent, field as arguments) with the kernel it chooses (kernel 0) or one
+// forced (1 node stencils, 2 elements). "active_nodes" counts the nodes an occupied element
+// touches: compare time per active node with the stencil's per node. "node_stencils" says which
+// kernel ran.
+void BM_ElementwiseApply(benchmark::State& state) {
+  const HexGrid grid = Grid(static_cast<int>(state.range(0)));
+  const MaterialField field = AnyShape(grid, static_cast<int>(state.range(1)),
+                                       static_cast<AnyShapeField>(state.range(2)));
+  const ElementwiseStiffness k(grid, field,
+                               static_cast<ElementwiseStiffness::Kernel>(state.range(3)));
   const Eigen::VectorXd u = Field(grid.num_dofs());
   Eigen::VectorXd ku(grid.num_dofs());
   for (auto _ : state) {
@@ -139,6 +167,9 @@ void BM_ElementwiseApply(benchmark::State& state) {
   const std::vector<bool> active = field.ActiveNodes(grid);
   state.counters["active_nodes"] =
       static_cast<double>(std::count(active.begin(), active.end(), true));
+  state.counters["node_stencils"] = k.kernel() == ElementwiseStiffness::Kernel::kNodeStencils;
+  state.counters["stencils"] = k.num_stencils();
+  state.counters["windows"] = k.num_lane_stencils();
 }
 
 void BM_TimeStep(benchmark::State& state) {
@@ -157,10 +188,9 @@ void BM_TimeStep(benchmark::State& state) {
 BENCHMARK(BM_StencilApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssembledApply)->Arg(13)->Arg(25)->Arg(49)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ElementwiseApply)
-    ->Args({13, 100})
-    ->Args({13, 50})
-    ->Args({25, 100})
-    ->Args({25, 50})
+    ->ArgNames({"nodes", "percent", "field", "kernel"})
+    ->ArgsProduct({{13, 25}, {100}, {0}, {0}})
+    ->ArgsProduct({{13, 25}, {50}, {0, 1, 2, 3}, {0, 1, 2}})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ElementLoopApply)->Arg(13)->Arg(25)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RegionApply)
