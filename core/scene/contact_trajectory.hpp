@@ -10,6 +10,10 @@ namespace hapticsim {
  * The prescribed displacement of the contact node along its face's inward normal, m:
  *   press: s·(1 − cos 2πft)/2,   sine: s·sin 2πft,   both 0 for t < 0 (at rest before the trial).
  * Linear in the amplitude s by construction.
+ *
+ * A stroke moves the tool, not a node: s deep by half a cosine over the first quarter of the
+ * trial (input.periods / f), then input.stroke_length along input.stroke_direction over the rest,
+ * as L·(x − sin 2πx / 2π), x from 0 to 1: at rest at both ends, no acceleration jump.
  */
 class ContactTrajectory {
  public:
@@ -20,14 +24,17 @@ class ContactTrajectory {
 
   /** Displacement into the object at time t (s), m. */
   double DepthAt(double t_s) const;
-  /** The node's displacement vector at time t (s): DepthAt(t) × the inward normal, m. */
-  std::array<double, 3> DisplacementAt(double t_s) const {
-    const double depth = DepthAt(t_s);
-    return {depth * normal_[0], depth * normal_[1], depth * normal_[2]};
-  }
+  /** How far a stroke has moved along the surface at time t (s), m (0 for the others). */
+  double LateralAt(double t_s) const;
+  /** The displacement vector at time t (s): DepthAt(t) × the inward normal, plus a stroke's
+   *  LateralAt(t) along its direction, m. */
+  std::array<double, 3> DisplacementAt(double t_s) const;
   const std::array<double, 3>& inward_normal() const { return normal_; }
 
  private:
+  // The share of a stroke's trial gone at time t (s): 0 … 1.
+  double StrokePhase(double t_s) const;
+
   InputSettings input_;
   std::array<double, 3> normal_;
 };

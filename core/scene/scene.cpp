@@ -85,6 +85,19 @@ void ValidateGeometryScene(const Scene& scene) {
   }
 }
 
+void ValidateStroke(const Scene& scene) {
+  if (scene.adaptivity.enabled()) {
+    throw Error("input.waveform = \"stroke\" is not available with the asynchronous regions yet: "
+                "set adaptivity.primary_size = 0 for the full-resolution reference");
+  }
+  if (scene.contact.kinetic_friction > scene.contact.static_friction) {
+    throw Error("contact.kinetic_friction = " + FormatReal(scene.contact.kinetic_friction) +
+                " is above contact.static_friction = " +
+                FormatReal(scene.contact.static_friction) +
+                ": the kinetic friction must not exceed the static");
+  }
+}
+
 }  // namespace
 
 std::string FormatReal(double value) {
@@ -110,7 +123,15 @@ std::string FormatTriple(const std::array<double, 3>& values) {
 long Scene::num_steps() const { return std::lround(duration_s() / solver.dt_s); }
 
 std::string_view WaveformName(Waveform waveform) {
-  return waveform == Waveform::kPress ? "press" : "sine";
+  switch (waveform) {
+    case Waveform::kPress:
+      return "press";
+    case Waveform::kSine:
+      return "sine";
+    case Waveform::kStroke:
+      return "stroke";
+  }
+  return "unknown";
 }
 
 void ValidateScene(const Scene& scene) {
@@ -133,6 +154,7 @@ void ValidateScene(const Scene& scene) {
                 " steps for the trial of input.periods / input.frequency = " +
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
+  if (scene.input.waveform == Waveform::kStroke) ValidateStroke(scene);
   if (scene.adaptivity.enabled()) {
     if (!scene.materials.empty() || !scene.supports.empty()) {
       throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +

@@ -16,6 +16,10 @@ namespace hapticsim {
 enum class Waveform {
   kPress,  ///< s·(1 − cos 2πft)/2: a smooth press into the object and back, no velocity jump
   kSine,   ///< s·sin 2πft: in and out of the object around the rest position
+  /// A tool stroked across the surface: pressed s deep in the first quarter of the trial, then
+  /// moved input.stroke_length along input.stroke_direction, touching through a sliding
+  /// (god-object) contact with friction ([contact]) instead of a node it sticks to.
+  kStroke,
 };
 
 /** Lattice indices (ix, iy, iz) of a node of the cube. */
@@ -75,6 +79,21 @@ struct InputSettings {
   /// The driven surface node (input.contact_node); none: the paper's, the middle node of the
   /// front face. It moves along the inward normal of its face (see InwardNormal).
   std::optional<LatticeIndex> contact_node;
+  double stroke_length_m = 0.03;  ///< how far a stroke moves along the surface (input.stroke_length)
+  /// The lattice axis a stroke moves along, 0 x, 1 y, 2 z, and its sign (input.stroke_direction)
+  int stroke_axis = 0;
+  int stroke_sign = 1;
+};
+
+/**
+ * The sliding contact of a stroke (contact.*): the tool touches the surface through a proxy that
+ * stays on it, joined to the tool by a spring; the proxy sticks until the spring's tangential
+ * pull exceeds static_friction × its normal push, then slides keeping it at kinetic_friction ×.
+ */
+struct ContactSettings {
+  double static_friction = 0.5;      ///< μ_s (contact.static_friction)
+  double kinetic_friction = 0.4;     ///< μ_k ≤ μ_s (contact.kinetic_friction)
+  double stiffness_n_per_m = 1000;   ///< the proxy spring (contact.stiffness), N/m
 };
 
 struct SolverSettings {
@@ -117,6 +136,7 @@ struct Scene {
   std::vector<LabelMaterial> materials;  ///< [[material]] tables
   std::vector<SupportRegion> supports;   ///< [[support]] tables; none: the cube's four back corners
   InputSettings input;
+  ContactSettings contact;
   SolverSettings solver;
   AdaptivitySettings adaptivity;
 

@@ -218,18 +218,52 @@ void AddInputKeys(std::vector<KeyAccess>& keys) {
       {"input.frequency", "Hz", "finite and > 0", "input frequency f"},
       [](Scene& s) -> double& { return s.input.frequency_hz; }, [](double v) { return v > 0; }));
   keys.push_back(Choice(
-      {"input.waveform", "", "\"press\" or \"sine\"",
-       "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft"},
-      {"press", "sine"},
-      [](const Scene& s) { return s.input.waveform == Waveform::kPress ? 0 : 1; },
-      [](Scene& s, int i) { s.input.waveform = i == 0 ? Waveform::kPress : Waveform::kSine; }));
+      {"input.waveform", "", "\"press\", \"sine\" or \"stroke\"",
+       "press: s(1-cos 2πft)/2 into the object; sine: s·sin 2πft; stroke: pressed s deep, then "
+       "moved across the surface through a sliding contact"},
+      {"press", "sine", "stroke"},
+      [](const Scene& s) { return static_cast<int>(s.input.waveform); },
+      [](Scene& s, int i) { s.input.waveform = static_cast<Waveform>(i); }));
   keys.push_back(ContactNodeKey());
+  keys.push_back(Real(
+      {"input.stroke_length", "m", "finite and >= 0",
+       "how far a stroke moves the tool along the surface (input.waveform = \"stroke\")"},
+      [](Scene& s) -> double& { return s.input.stroke_length_m; }, [](double v) { return v >= 0; }));
+  keys.push_back(Choice(
+      {"input.stroke_direction", "",
+       "\"x\", \"-x\", \"y\", \"-y\", \"z\" or \"-z\", along the contact's face",
+       "the lattice axis a stroke moves along"},
+      {"x", "-x", "y", "-y", "z", "-z"},
+      [](const Scene& s) { return 2 * s.input.stroke_axis + (s.input.stroke_sign < 0 ? 1 : 0); },
+      [](Scene& s, int i) {
+        s.input.stroke_axis = i / 2;
+        s.input.stroke_sign = i % 2 == 0 ? 1 : -1;
+      }));
   keys.push_back(Real(
       {"input.periods", "", "finite and > 0", "trial length in input periods"},
       [](Scene& s) -> double& { return s.input.periods; }, [](double v) { return v > 0; }));
   keys.push_back(Real(
       {"solver.dt", "s", "finite and > 0", "time step of the simulation"},
       [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
+}
+
+// The sliding contact of a stroke.
+void AddContactKeys(std::vector<KeyAccess>& keys) {
+  keys.push_back(Real(
+      {"contact.static_friction", "", "finite and >= 0",
+       "μ_s: the proxy sticks until the tangential force exceeds μ_s × the normal force"},
+      [](Scene& s) -> double& { return s.contact.static_friction; },
+      [](double v) { return v >= 0; }));
+  keys.push_back(Real(
+      {"contact.kinetic_friction", "", "finite, >= 0 and <= contact.static_friction",
+       "μ_k: a sliding proxy keeps the tangential force at μ_k × the normal force"},
+      [](Scene& s) -> double& { return s.contact.kinetic_friction; },
+      [](double v) { return v >= 0; }));
+  keys.push_back(Real(
+      {"contact.stiffness", "N/m", "finite and > 0 (and within the step's limit)",
+       "the spring joining the tool to the proxy on the surface"},
+      [](Scene& s) -> double& { return s.contact.stiffness_n_per_m; },
+      [](double v) { return v > 0; }));
 }
 
 // The asynchronous regions.
@@ -283,6 +317,7 @@ const std::vector<KeyAccess>& KeyTable() {
     std::vector<KeyAccess> keys;
     AddObjectKeys(keys);
     AddInputKeys(keys);
+    AddContactKeys(keys);
     AddAdaptivityKeys(keys);
     return keys;
   }();

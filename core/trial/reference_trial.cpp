@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/fem/central_difference_integrator.hpp"
 #include "core/scene/contact_trajectory.hpp"
+#include "core/trial/stroke_trial.hpp"
 #include "core/trial/trial_recorder.hpp"
 
 namespace hapticsim {
@@ -42,12 +43,15 @@ std::string_view TrialOutcomeName(TrialOutcome outcome) {
       return "diverged: non-finite values";
     case TrialOutcome::kDivergedEnergy:
       return "diverged: energy growth";
+    case TrialOutcome::kLeftSurface:
+      return "stopped: the stroke left the face it slides on";
   }
   return "unknown";
 }
 
 TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& options) {
   const Scene& scene = cube.scene();
+  if (scene.input.waveform == Waveform::kStroke) return RunStrokeTrial(cube).trial;
   const ElasticModel& model = cube.model();
   // ObjectState, the frames' form, is the cube's lattice.
   HAPTICSIM_THROW_UNLESS(options.frames.every_periods == 0 || !scene.geometry.from_file(),

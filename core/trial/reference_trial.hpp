@@ -17,6 +17,7 @@ enum class TrialOutcome {
   kPredictedUnstable,  ///< refused before the first step: dt ≥ the critical step
   kDivergedNonFinite,  ///< detected during the run: a non-finite value
   kDivergedEnergy,     ///< detected during the run: energy beyond the passivity budget
+  kLeftSurface,        ///< a stroke's proxy reached the edge of the face it slides on
 };
 
 std::string_view TrialOutcomeName(TrialOutcome outcome);

@@ -312,8 +312,15 @@ int Run(const SimulateOptions& options) {
     if (result.outcome == TrialOutcome::kPredictedUnstable) {
       std::cout << "  refused: predicted unstable. "
                 << "Lower solver.dt below " + Duration(result.stability.critical_dt_s)
-                << ", or pass --allow-unstable to watch the run diverge.\n";
+                << (scene.input.waveform == Waveform::kStroke
+                        ? " (the limit with the contact spring: or lower contact.stiffness).\n"
+                        : ", or pass --allow-unstable to watch the run diverge.\n");
     } else {
+      if (result.outcome == TrialOutcome::kLeftSurface) {
+        std::cout << "  STOPPED at t = " << Duration(result.stopped_at_s)
+                  << ": the stroke reached the edge of the face it slides on; shorten "
+                     "input.stroke_length or start it elsewhere (input.contact_node)\n";
+      }
       if (result.diverged()) {
         std::cout << "  DIVERGED at t = " << Duration(result.stopped_at_s) << " ("
                   << (result.runaway ? "the runaway watch: the state outgrew what the energy "

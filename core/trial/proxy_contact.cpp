@@ -1,0 +1,161 @@
+#include "core/trial/proxy_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+
+namespace hapticsim {
+
+ProxyContact::ProxyContact(const ElasticModel& model, int contact_node,
+                           const std::array<double, 3>& inward_normal,
+                           const ContactSettings& contact)
+    : model_(model), contact_(contact) {
+  axis_ = -1;
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(inward_normal[c]) == 1.0) {
+      axis_ = c;
+      sign_ = inward_normal[c] > 0 ? 1 : -1;
+    }
+  }
+  HAPTICSIM_THROW_UNLESS(axis_ >= 0,
+                         "a stroke starts on a flat face: choose an input.contact_node whose "
+                         "inward normal is along x, y or z (not on an edge or a corner)");
+  t1_ = (axis_ + 1) % 3;
+  t2_ = (axis_ + 2) % 3;
+  const HexGrid& grid = model.grid();
+  const std::array<int, 3> at = grid.NodeIndices(contact_node);
+  plane_ = at[axis_];
+  proxy_ = {static_cast<double>(at[t1_]), static_cast<double>(at[t2_])};
+  start_m_ = grid.NodePosition(contact_node);
+  // Every node of the face's plane on the object and not held may be loaded.
+  slot_of_node_.assign(static_cast<std::size_t>(grid.num_nodes()), -1);
+  lightest_mass_kg_ = std::numeric_limits<double>::infinity();
+  std::vector<bool> held(static_cast<std::size_t>(grid.num_dofs()), false);
+  for (int dof : model.constraints().fixed_dofs) held[static_cast<std::size_t>(dof)] = true;
+  for (int node = 0; node < grid.num_nodes(); ++node) {
+    const double mass = model.dof_mass()[grid.Dof(node, 0)];
+    if (grid.NodeIndices(node)[axis_] != plane_ || mass <= 0 ||
+        held[static_cast<std::size_t>(grid.Dof(node, 0))]) {
+      continue;
+    }
+    slot_of_node_[static_cast<std::size_t>(node)] = static_cast<int>(loaded_dofs_.size() / 3);
+    for (int c = 0; c < 3; ++c) loaded_dofs_.push_back(grid.Dof(node, c));
+    lightest_mass_kg_ = std::min(lightest_mass_kg_, mass);
+  }
+}
+
+bool ProxyContact::ExposedFace(int i1, int i2) const {
+  const HexGrid& grid = model_.grid();
+  const std::array<int, 3> counts = {grid.nx() - 1, grid.ny() - 1, grid.nz() - 1};
+  if (i1 < 0 || i2 < 0 || i1 >= counts[t1_] || i2 >= counts[t2_]) return false;
+  // The voxel inside the face must be the object's, the one outside it not.
+  auto occupied = [&](int along) {
+    if (along < 0 || along >= counts[axis_]) return false;
+    std::array<int, 3> e{};
+    e[axis_] = along;
+    e[t1_] = i1;
+    e[t2_] = i2;
+    return model_.field().occupied(model_.field().Element(e[0], e[1], e[2]));
+  };
+  const int inside = sign_ > 0 ? plane_ : plane_ - 1;
+  const int outside = sign_ > 0 ? plane_ - 1 : plane_;
+  return occupied(inside) && !occupied(outside);
+}
+
+bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corners) const {
+  const HexGrid& grid = model_.grid();
+  const std::array<int, 3> counts = {grid.nx() - 1, grid.ny() - 1, grid.nz() - 1};
+  // A proxy exactly on the lattice's last node line belongs to the cell below it.
+  const auto cell = [](double at, int count) {
+    const int i = static_cast<int>(std::floor(at));
+    return i == count && at == count ? count - 1 : i;
+  };
+  const int i1 = cell(proxy[0], counts[t1_]), i2 = cell(proxy[1], counts[t2_]);
+  if (!std::isfinite(proxy[0] + proxy[1]) || !ExposedFace(i1, i2)) return false;
+  const double a = proxy[0] - i1, b = proxy[1] - i2;
+  for (int k = 0; k < 4; ++k) {
+    std::array<int, 3> at{};
+    at[axis_] = plane_;
+    at[t1_] = i1 + (k & 1);
+    at[t2_] = i2 + (k >> 1);
+    corners->nodes[static_cast<std::size_t>(k)] = grid.Node(at[0], at[1], at[2]);
+    corners->weights[static_cast<std::size_t>(k)] = ((k & 1) ? a : 1 - a) * ((k >> 1) ? b : 1 - b);
+  }
+  return true;
+}
+
+std::array<double, 3> ProxyContact::SurfacePoint(const Corners& corners,
+                                                 const Eigen::VectorXd& u) const {
+  const HexGrid& grid = model_.grid();
+  std::array<double, 3> point = proxy_rest_m();
+  for (int k = 0; k < 4; ++k) {
+    const int node = corners.nodes[static_cast<std::size_t>(k)];
+    const double w = corners.weights[static_cast<std::size_t>(k)];
+    for (int c = 0; c < 3; ++c) point[c] += w * u[grid.Dof(node, c)];
+  }
+  return point;
+}
+
+std::array<double, 3> ProxyContact::proxy_rest_m() const {
+  const double h = model_.grid().spacing();
+  std::array<double, 3> rest{};
+  rest[axis_] = plane_ * h;
+  rest[t1_] = proxy_[0] * h;
+  rest[t2_] = proxy_[1] * h;
+  return rest;
+}
+
+ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
+                                          const Eigen::VectorXd& u, std::span<double> loads) {
+  std::fill(loads.begin(), loads.end(), 0.0);
+  Result result;
+  Corners corners;
+  const auto offset_to_tool = [&] {
+    const std::array<double, 3> s = SurfacePoint(corners, u);
+    return std::array<double, 3>{tool_m[0] - s[0], tool_m[1] - s[1], tool_m[2] - s[2]};
+  };
+  // Over no face of the object, the tool has left the surface this contact can render.
+  const double h = model_.grid().spacing();
+  if (!CornersAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !CornersAt(proxy_, &corners)) {
+    result.left_surface = true;
+    return result;
+  }
+  std::array<double, 3> d = offset_to_tool();
+  const double depth = sign_ * d[axis_];
+  if (depth <= 0) {  // out of contact: the proxy waits under the tool
+    proxy_ = {tool_m[t1_] / h, tool_m[t2_] / h};
+    sliding_ = false;
+    return result;
+  }
+  const double k = contact_.stiffness_n_per_m;
+  const double tangential = std::hypot(d[t1_], d[t2_]);
+  const double mu = sliding_ ? contact_.kinetic_friction : contact_.static_friction;
+  sliding_ = tangential > mu * depth;
+  if (sliding_) {
+    // Slide towards the tool until the pull is μ_k times the push.
+    const double move = (tangential - contact_.kinetic_friction * depth) / tangential;
+    proxy_[0] += move * d[t1_] / h;
+    proxy_[1] += move * d[t2_] / h;
+    if (!CornersAt(proxy_, &corners)) {
+      result.left_surface = true;
+      return result;
+    }
+    d = offset_to_tool();
+  }
+  result.in_contact = true;
+  result.sliding = sliding_;
+  for (int c = 0; c < 3; ++c) result.force_on_object_n[c] = k * d[c];
+  for (int j = 0; j < 4; ++j) {
+    const int slot = slot_of_node_[static_cast<std::size_t>(corners.nodes[static_cast<std::size_t>(j)])];
+    if (slot < 0) continue;  // a held node: the support takes that share
+    for (int c = 0; c < 3; ++c) {
+      loads[static_cast<std::size_t>(3 * slot + c)] =
+          corners.weights[static_cast<std::size_t>(j)] * result.force_on_object_n[c];
+    }
+  }
+  return result;
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,82 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <span>
+#include <vector>
+
+#include "core/fem/elastic_model.hpp"
+#include "core/scene/scene.hpp"
+
+namespace hapticsim {
+
+/**
+ * A sliding tool contact (god-object) on one flat face of the object: a proxy point stays on the
+ * deformed surface, joined to the tool tip by a spring of contact.stiffness k. Where the tool is
+ * inside, the spring pushes the surface at the proxy (spread over the face cell's 4 nodes with
+ * the bilinear weights of where the proxy is in it) and the user feels the opposite force.
+ *
+ * Friction (Coulomb, on the spring's pull): with g the tool's depth below the proxy along the
+ * inward normal and d_t the tangential offset, the normal force is k·g and the tangential k·|d_t|.
+ * The proxy sticks (stays at its material point of the surface) while k·|d_t| ≤ μ_s·k·g; past
+ * that it slides towards the tool until k·|d_t| = μ_k·k·g, and keeps sliding while the pull stays
+ * above μ_k·k·g. Out of contact (g ≤ 0) the proxy sits under the tool and no force is felt.
+ *
+ * The face is the plane of the contact node, normal to its inward normal's axis; the proxy moves
+ * over its cells that are faces of occupied voxels with nothing outside them. Update() never
+ * allocates.
+ */
+class ProxyContact {
+ public:
+  /**
+   * @param contact_node   where the proxy starts (a node on the face)
+   * @param inward_normal  ±e_axis: the face's inward normal
+   * @throws Error when the normal is not along a lattice axis.
+   */
+  ProxyContact(const ElasticModel& model, int contact_node,
+               const std::array<double, 3>& inward_normal, const ContactSettings& contact);
+
+  /** The DOFs the contact loads, in the order Update() writes loads: x, y, z of each node of the
+   *  face that is on the object and not held. */
+  const std::vector<int>& loaded_dofs() const { return loaded_dofs_; }
+  /** The lightest of those nodes' masses, kg: the spring's share of the step limit. */
+  double lightest_loaded_mass_kg() const { return lightest_mass_kg_; }
+  /** The rest position of the contact node, m (grid frame): where the tool starts. */
+  const std::array<double, 3>& start_m() const { return start_m_; }
+
+  struct Result {
+    std::array<double, 3> force_on_object_n{};  ///< the spring's push on the surface, N
+    bool in_contact = false;
+    bool sliding = false;       ///< the proxy slid this period
+    bool left_surface = false;  ///< the proxy reached the face's edge: no surface under it
+  };
+  /** One period: the proxy moved for the tool at `tool_m` (grid frame, m) over the state `u`,
+   *  and the loads on loaded_dofs() written to `loads`. */
+  Result Update(const std::array<double, 3>& tool_m, const Eigen::VectorXd& u,
+                std::span<double> loads);
+  /** The proxy's rest position on the face, m (grid frame). */
+  std::array<double, 3> proxy_rest_m() const;
+
+ private:
+  struct Corners {
+    std::array<int, 4> nodes{};
+    std::array<double, 4> weights{};
+  };
+  // The face cell under the proxy and its bilinear weights; false off the surface.
+  bool CornersAt(const std::array<double, 2>& proxy, Corners* corners) const;
+  // The deformed surface point at the proxy.
+  std::array<double, 3> SurfacePoint(const Corners& corners, const Eigen::VectorXd& u) const;
+  bool ExposedFace(int i1, int i2) const;
+
+  const ElasticModel& model_;
+  ContactSettings contact_;
+  int axis_ = 2, sign_ = 1, plane_ = 0, t1_ = 0, t2_ = 1;
+  std::array<double, 3> start_m_{};
+  std::array<double, 2> proxy_{};  // along t1, t2 in node spacings
+  bool sliding_ = false;
+  std::vector<int> loaded_dofs_;
+  std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded
+  double lightest_mass_kg_ = 0;
+};
+
+}  // namespace hapticsim

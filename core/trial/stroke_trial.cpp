@@ -1,0 +1,76 @@
+#include "core/trial/stroke_trial.hpp"
+
+#include <cmath>
+
+#include "core/fem/region_integrator.hpp"
+#include "core/fem/stability_estimate.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/trial/proxy_contact.hpp"
+#include "core/trial/trial_recorder.hpp"
+
+namespace hapticsim {
+namespace {
+
+// Every DOF on the object but the held ones: the contact node is free in a stroke.
+std::vector<int> OwnedDofs(const ElasticModel& model) {
+  std::vector<bool> held(static_cast<std::size_t>(model.grid().num_dofs()), false);
+  for (int dof : model.constraints().fixed_dofs) held[static_cast<std::size_t>(dof)] = true;
+  std::vector<int> owned;
+  for (int dof = 0; dof < model.grid().num_dofs(); ++dof) {
+    if (model.dof_mass()[dof] > 0 && !held[static_cast<std::size_t>(dof)]) owned.push_back(dof);
+  }
+  return owned;
+}
+
+}  // namespace
+
+StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
+  const Scene& scene = object.scene();
+  const ElasticModel& model = object.model();
+  StrokeTrialResult out;
+  TrialResult& result = out.trial;
+  ProxyContact contact(model, object.contact_node(), object.contact_normal(), scene.contact);
+  // The contact spring adds at most k/m to ω² (it is positive semi-definite, of norm ≤ k/m on
+  // its lightest node): the object's limit with it.
+  result.stability = EstimateStability(model);
+  const double omega = result.stability.omega_max_rad_s;
+  result.stability.critical_dt_s =
+      2.0 / std::sqrt(omega * omega +
+                      scene.contact.stiffness_n_per_m / contact.lightest_loaded_mass_kg());
+  const double dt = scene.solver.dt_s;
+  if (!result.stability.IsStable(dt)) {
+    result.outcome = TrialOutcome::kPredictedUnstable;
+    return out;
+  }
+  const std::vector<int>& fixed = model.constraints().fixed_dofs;
+  RegionIntegrator integrator(model.stiffness(), model.dof_mass(), model.damping_per_s(),
+                              OwnedDofs(model), fixed, contact.loaded_dofs(), dt);
+  integrator.SetEnergyTerms(false);
+  const std::vector<double> held_at_rest(fixed.size(), 0.0);
+  std::vector<double> loads(contact.loaded_dofs().size(), 0.0);
+  const ContactTrajectory trajectory(scene.input, object.contact_normal());
+  const long steps = scene.num_steps();
+  TrialRecorder recorder(trajectory, dt, steps, &result);
+  out.proxy.reserve(static_cast<std::size_t>(steps) + 1);
+  for (long n = 0; n <= steps; ++n) {
+    std::array<double, 3> tool = contact.start_m();
+    const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt);
+    for (int c = 0; c < 3; ++c) tool[c] += moved[c];
+    const ProxyContact::Result touch = contact.Update(tool, integrator.u(), loads);
+    if (touch.left_surface) {
+      recorder.Stop(TrialOutcome::kLeftSurface);
+      break;
+    }
+    if (!recorder.Record(n, touch.force_on_object_n)) break;
+    out.proxy.push_back({contact.proxy_rest_m(), touch.in_contact, touch.sliding});
+    integrator.Step(held_at_rest, loads);
+    if (!std::isfinite(integrator.OwnedStateMaxAbs())) {
+      recorder.Stop(TrialOutcome::kDivergedNonFinite);
+      break;
+    }
+  }
+  result.wall_time_s = recorder.ElapsedS();
+  return out;
+}
+
+}  // namespace hapticsim

@@ -1,0 +1,133 @@
+// A tool stroked across the surface through the sliding (god-object) contact, on the
+// full-resolution cube (RunStrokeTrial), checked against what the contact model promises and what
+// does not depend on it: once sliding, the tangential force is the kinetic friction times the
+// normal force (within 5 %); without friction there is no lateral force; the force never steps
+// by more than 0.1 N from one period to the next while the proxy moves; with friction too high
+// to break away nothing slides; and a press held still settles on the static answer of the
+// contact spring in series with the object's own stiffness (the static solve, independent of the
+// proxy).
+#include "core/trial/stroke_trial.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.hpp"
+#include "core/fem/static_solver.hpp"
+
+namespace hapticsim {
+namespace {
+
+Scene Stroke(double static_mu, double kinetic_mu) {
+  Scene scene;
+  scene.input.waveform = Waveform::kStroke;
+  scene.input.amplitude_m = 0.005;       // 5 mm deep
+  scene.input.stroke_length_m = 0.03;    // 30 mm along +x
+  scene.contact.static_friction = static_mu;
+  scene.contact.kinetic_friction = kinetic_mu;
+  return scene;
+}
+
+// The force on the user along the press (pushing out: positive) and across it.
+double Normal(const ForceSample& s) { return -s.feedback_force_n[2]; }
+double Lateral(const ForceSample& s) { return std::hypot(s.feedback_force_n[0], s.feedback_force_n[1]); }
+
+TEST(StrokeTrial, OnceSlidingTheLateralForceIsTheKineticFrictionTimesTheNormal) {
+  const StrokeTrialResult run = RunStrokeTrial(SceneModel(Stroke(0.5, 0.4)));
+  ASSERT_EQ(run.trial.outcome, TrialOutcome::kCompleted);
+  ASSERT_EQ(run.proxy.size(), run.trial.samples.size());
+  int sliding = 0;
+  double worst = 0;
+  for (std::size_t i = 1; i < run.proxy.size(); ++i) {
+    // A sample is rendered after its period's proxy update: its force is the one that slid.
+    if (!run.proxy[i].sliding) continue;
+    ++sliding;
+    const ForceSample& s = run.trial.samples[i];
+    worst = std::max(worst, Lateral(s) / Normal(s));
+    EXPECT_LE(Lateral(s), 1.05 * 0.4 * Normal(s)) << "t = " << s.t_s;
+  }
+  std::printf("sliding in %d of %zu periods; largest lateral/normal while sliding %.4f\n",
+              sliding, run.proxy.size(), worst);
+  EXPECT_GT(sliding, 300);  // most of the 750 ms stroke
+  // The proxy went most of the way with the tool: 30 mm less the spring's stretch.
+  const double travelled = run.proxy.back().rest_position_m[0] - run.proxy.front().rest_position_m[0];
+  EXPECT_GT(travelled, 0.025);
+  EXPECT_LE(travelled, 0.03);
+}
+
+TEST(StrokeTrial, WithoutFrictionThereIsNoLateralForce) {
+  const StrokeTrialResult run = RunStrokeTrial(SceneModel(Stroke(0.0, 0.0)));
+  ASSERT_EQ(run.trial.outcome, TrialOutcome::kCompleted);
+  double largest = 0, largest_normal = 0;
+  for (const ForceSample& s : run.trial.samples) {
+    largest = std::max(largest, Lateral(s));
+    largest_normal = std::max(largest_normal, Normal(s));
+  }
+  std::printf("frictionless: largest lateral %.5f N, largest normal %.4f N\n", largest,
+              largest_normal);
+  EXPECT_LT(largest, 0.05);
+  EXPECT_GT(largest_normal, 0.3);  // the tool did press
+}
+
+TEST(StrokeTrial, TheForceNeverStepsByMoreThanATenthOfANewtonWhileTheProxyMoves) {
+  for (const double mu : {0.0, 0.4}) {
+    const StrokeTrialResult run = RunStrokeTrial(SceneModel(Stroke(mu + 0.1, mu)));
+    ASSERT_EQ(run.trial.outcome, TrialOutcome::kCompleted);
+    double largest = 0;
+    for (std::size_t i = 1; i < run.trial.samples.size(); ++i) {
+      const auto& a = run.trial.samples[i - 1].feedback_force_n;
+      const auto& b = run.trial.samples[i].feedback_force_n;
+      largest = std::max(largest, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+    }
+    std::printf("mu_k %.1f: largest step between periods %.4f N\n", mu, largest);
+    EXPECT_LT(largest, 0.1) << "mu_k " << mu;
+  }
+}
+
+TEST(StrokeTrial, FrictionTooHighToBreakAwaySticksAndPullsBack) {
+  const StrokeTrialResult run = RunStrokeTrial(SceneModel(Stroke(10.0, 10.0)));
+  ASSERT_EQ(run.trial.outcome, TrialOutcome::kCompleted);
+  for (const ProxySample& p : run.proxy) EXPECT_FALSE(p.sliding);
+  EXPECT_EQ(run.proxy.back().rest_position_m, run.proxy[300].rest_position_m);
+  // The surface is dragged along: it pulls back across the stroke, against it (−x).
+  EXPECT_LT(run.trial.samples.back().feedback_force_n[0], -0.5);
+}
+
+TEST(StrokeTrial, AHeldPressSettlesOnTheSpringInSeriesWithTheObject) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.input.stroke_length_m = 0;  // press 5 mm and hold
+  scene.input.periods = 4;          // 1 s of press, 3 s of hold: the damping (10/s) settles it
+  const SceneModel object(scene);
+  const StrokeTrialResult run = RunStrokeTrial(object);
+  ASSERT_EQ(run.trial.outcome, TrialOutcome::kCompleted);
+  // The object's own stiffness at the contact node, from the static solve.
+  const std::array<double, 3> unit = {0, 0, 1e-3};
+  const double k_object = SolveStatic(object.model(), unit).driven_reaction[2] / 1e-3;
+  const double k_spring = scene.contact.stiffness_n_per_m;
+  const double expected = 0.005 * k_object * k_spring / (k_object + k_spring);
+  const double settled = Normal(run.trial.samples.back());
+  std::printf("held press: %.5f N against %.5f N (object %.2f N/m, spring %.0f N/m)\n", settled,
+              expected, k_object, k_spring);
+  EXPECT_NEAR(settled / expected, 1.0, 0.01);
+}
+
+TEST(StrokeTrial, AContactSpringTooStiffForTheStepIsRefusedAsUnstable) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.contact.stiffness_n_per_m = 1e6;
+  const StrokeTrialResult run = RunStrokeTrial(SceneModel(scene));
+  EXPECT_EQ(run.trial.outcome, TrialOutcome::kPredictedUnstable);
+  EXPECT_LT(run.trial.stability.critical_dt_s, scene.solver.dt_s);
+  EXPECT_TRUE(run.trial.samples.empty());
+}
+
+TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
+  Scene scene = Stroke(0.3, 0.4);
+  EXPECT_THROW(ValidateScene(scene), Error);
+  scene = Stroke(0.5, 0.4);
+  scene.adaptivity.primary_size = 3;
+  EXPECT_THROW(ValidateScene(scene), Error);
+}
+
+}  // namespace
+}  // namespace hapticsim
