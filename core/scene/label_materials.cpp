@@ -13,6 +13,15 @@ std::string TableName(const LabelMaterial& table, std::size_t index) {
          ")";
 }
 
+std::string LabelList(const std::vector<std::uint16_t>& labels) {
+  std::string list;
+  for (std::uint16_t label : labels) {
+    if (!list.empty()) list += ", ";
+    list += std::to_string(label);
+  }
+  return list;
+}
+
 }  // namespace
 
 const std::vector<std::string_view>& MaterialTableKeys() {
@@ -97,12 +106,7 @@ void ValidateLabelMaterials(const Scene& scene) {
         std::find(present.begin(), present.end(), tables[i].label) != present.end(),
         TableName(tables[i], i) + ": label " + std::to_string(tables[i].label) +
             " is not in " + scene.geometry.file + " at geometry.spacing_m (its labels: " +
-            [&] {
-              std::string list;
-              for (auto label : present) list += (list.empty() ? "" : ", ") + std::to_string(label);
-              return list;
-            }() +
-            ")");
+            LabelList(present) + ")");
   }
   for (std::uint16_t label : present) {
     const bool named = std::any_of(tables.begin(), tables.end(),

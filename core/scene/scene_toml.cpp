@@ -67,7 +67,8 @@ void ReadMaterialTables(Scene* scene, const toml::node& node, const std::string&
     for (const auto& [key, value] : *table) {
       const std::string where = "scene file " + Location(path, value.source());
       const std::string name(key.str());
-      At(where, [&] { SetMaterialTableValue(&material, name, ValueText(value, name, where)); });
+      const toml::node& text = value;  // a structured binding: clang 14 cannot capture one
+      At(where, [&] { SetMaterialTableValue(&material, name, ValueText(text, name, where)); });
     }
     scene->materials.push_back(material);
   }
@@ -182,7 +183,8 @@ Scene ParseScene(const std::string& path, const std::optional<std::string>& text
     for (const auto& [key, node] : *table) {
       const std::string name = section + "." + std::string(key.str());
       const std::string where = "scene file " + Location(path, node.source());
-      At(where, [&] { SetSceneValue(&scene, name, ValueText(node, name, where)); });
+      const toml::node& text = node;  // a structured binding: clang 14 cannot capture one
+      At(where, [&] { SetSceneValue(&scene, name, ValueText(text, name, where)); });
     }
   }
   if (!text) ResolveGeometryPath(&scene, path);
