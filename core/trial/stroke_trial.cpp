@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/fem/region_integrator.hpp"
 #include "core/fem/stability_estimate.hpp"
 #include "core/scene/contact_trajectory.hpp"
@@ -30,6 +31,12 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
   StrokeTrialResult out;
   TrialResult& result = out.trial;
   ProxyContact contact(model, object.contact_node(), object.contact_normal(), scene.contact);
+  const auto stroke_axis = static_cast<std::size_t>(scene.input.stroke_axis);
+  HAPTICSIM_THROW_UNLESS(object.contact_normal()[stroke_axis] == 0,
+                         "input.stroke_direction = " +
+                             GetSceneValue(scene, "input.stroke_direction") +
+                             " points into the contact's face: a stroke moves along the face, "
+                             "choose one of the other two axes");
   // The contact spring adds at most k/m to ω² (it is positive semi-definite, of norm ≤ k/m on
   // its lightest node): the object's limit with it.
   result.stability = EstimateStability(model);

@@ -121,6 +121,17 @@ TEST(StrokeTrial, AContactSpringTooStiffForTheStepIsRefusedAsUnstable) {
   EXPECT_TRUE(run.trial.samples.empty());
 }
 
+TEST(StrokeTrial, AStrokeIntoTheFaceIsRefusedSayingWhichWaysItCanGo) {
+  Scene scene = Stroke(0.5, 0.4);
+  SetSceneValue(&scene, "input.stroke_direction", "-z");
+  try {
+    RunStrokeTrial(SceneModel(scene));
+    ADD_FAILURE() << "a stroke along the face's normal ran";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("points into the contact's face"), std::string::npos);
+  }
+}
+
 TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
   Scene scene = Stroke(0.3, 0.4);
   EXPECT_THROW(ValidateScene(scene), Error);
