@@ -37,7 +37,7 @@ double CheckedStep(double dt_s) {
 CentralDifferenceIntegrator::CentralDifferenceIntegrator(const ElasticModel& model, double dt_s)
     : model_(model),
       dt_(CheckedStep(dt_s)),
-      region_(model.stiffness(), model.dof_mass(), model.damping_per_s(),
+      region_(model.stiffness(), model.dof_mass(), model.dof_damping(),
               FreeDofs(model), FixedThenDriven(model), {}, dt_s),
       prescribed_next_(region_.prescribed().size(), 0.0),
       driven_reaction_(model.constraints().driven_dofs.size(), 0.0),

@@ -1,6 +1,7 @@
 #include "core/fem/elastic_model.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@ ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstrai
       field_(std::move(field)),
       constraints_(std::move(constraints)),
       dof_mass_(Eigen::VectorXd::Zero(grid.num_dofs())),
+      dof_damping_(Eigen::VectorXd::Zero(grid.num_dofs())),
       free_mask_(Eigen::VectorXd::Ones(grid.num_dofs())) {
   field_.CheckFits(grid);
   const std::vector<bool> used = field_.UsedMaterials();
@@ -28,10 +30,7 @@ ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstrai
     if (!used[i]) continue;
     const double d = field_.materials()[i].damping_per_s;
     if (damping_per_s_ < 0) damping_per_s_ = d;
-    HAPTICSIM_THROW_UNLESS(d == damping_per_s_,
-                           "the materials' damping differs (" + std::to_string(d) + " and " +
-                               std::to_string(damping_per_s_) +
-                               " 1/s): C = d·M takes one d for the whole object");
+    if (d != damping_per_s_) uniform_damping_ = false;
   }
   if (const int uniform = field_.uniform_material(); uniform >= 0) {
     stiffness_ =
@@ -39,11 +38,18 @@ ElasticModel::ElasticModel(const HexGrid& grid, MaterialField field, DofConstrai
   } else {
     stiffness_ = std::make_unique<ElementwiseStiffness>(grid, field_);
   }
-  LumpMass();
+  LumpMassAndDamping();
   Constrain();
 }
 
-void ElasticModel::LumpMass() {
+double ElasticModel::damping_per_s() const {
+  HAPTICSIM_THROW_UNLESS(uniform_damping_,
+                         "the materials' damping differs: the object has no one damping rate "
+                         "(use the per-DOF dof_damping)");
+  return damping_per_s_;
+}
+
+void ElasticModel::LumpMassAndDamping() {
   // Counted per material, then multiplied: a node's k equal shares as k·share, as exactly as the
   // cube always had it (a sum of k equal terms can round differently).
   const double h = grid_.spacing();
@@ -55,12 +61,28 @@ void ElasticModel::LumpMass() {
       ++count[static_cast<size_t>(node) * materials + static_cast<size_t>(material)];
   });
   for (int node = 0; node < n; ++node) {
-    double mass = 0;
+    double mass = 0, damping = 0;  // Σ m_e and Σ d_e·m_e over the node's elements
+    double one_d = -1;             // the d all its elements share; NaN when they differ
     for (size_t m = 0; m < materials; ++m) {
-      const double share = field_.materials()[m].density_kg_m3 * h * h * h / 8.0;
-      mass += static_cast<int>(count[static_cast<size_t>(node) * materials + m]) * share;
+      const int k = count[static_cast<size_t>(node) * materials + m];
+      if (k == 0) continue;
+      const Material& material = field_.materials()[m];
+      const double share = material.density_kg_m3 * h * h * h / 8.0;
+      mass += k * share;
+      damping += material.damping_per_s * (k * share);
+      one_d = (one_d < 0 || one_d == material.damping_per_s) ? material.damping_per_s : NAN;
     }
-    for (int c = 0; c < 3; ++c) dof_mass_[grid_.Dof(node, c)] = mass;
+    // Elements that damp alike give their d itself: c/m would round it.
+    double d = 0;  // off the object
+    if (one_d >= 0) {
+      d = one_d;
+    } else if (mass > 0) {
+      d = damping / mass;
+    }
+    for (int c = 0; c < 3; ++c) {
+      dof_mass_[grid_.Dof(node, c)] = mass;
+      dof_damping_[grid_.Dof(node, c)] = d;
+    }
   }
 }
 

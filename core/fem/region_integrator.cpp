@@ -7,12 +7,13 @@
 namespace hapticsim {
 
 RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
-                                   const Eigen::VectorXd& dof_mass, double damping_per_s,
-                                   std::vector<int> owned, std::vector<int> prescribed,
-                                   std::vector<int> loaded, double substep_s)
+                                   const Eigen::VectorXd& dof_mass,
+                                   const Eigen::VectorXd& dof_damping, std::vector<int> owned,
+                                   std::vector<int> prescribed, std::vector<int> loaded,
+                                   double substep_s)
     : stiffness_(stiffness),
       mass_(dof_mass),
-      damping_(damping_per_s),
+      damping_(dof_damping),
       owned_(std::move(owned)),
       prescribed_(std::move(prescribed)),
       loaded_(std::move(loaded)),
@@ -21,6 +22,7 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
       prescribed_work_(prescribed_.size(), 0.0),
       controlled_(loaded_) {
   const Eigen::Index n = stiffness.num_dofs();
+  assert(damping_.size() == n && mass_.size() == n);
   for (auto& b : buffers_) b = Eigen::VectorXd::Zero(n);
   u_previous_ = &buffers_[0];
   u_ = &buffers_[1];
@@ -30,6 +32,43 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
   // h²/m per owned DOF, computed once: the same quotient Step used to divide out every step.
   step_over_mass_.reserve(owned_.size());
   for (int i : owned_) step_over_mass_.push_back(h_ * h_ / mass_[i]);
+  PrecomputeDamping();
+  SetControlledDofs(controlled_);
+}
+
+RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
+                                   const Eigen::VectorXd& dof_mass, double damping_per_s,
+                                   std::vector<int> owned, std::vector<int> prescribed,
+                                   std::vector<int> loaded, double substep_s)
+    : RegionIntegrator(stiffness, dof_mass,
+                       Eigen::VectorXd::Constant(stiffness.num_dofs(), damping_per_s),
+                       std::move(owned), std::move(prescribed), std::move(loaded), substep_s) {}
+
+// Per owned DOF, the damping factors of the update, formed by the same operations the one-rate
+// step formed its two scalars with: the same d gives the same factors, to the bit.
+void RegionIntegrator::PrecomputeDamping() {
+  minus_.reserve(owned_.size());
+  inv_plus_.reserve(owned_.size());
+  for (int i : owned_) {
+    minus_.push_back(1.0 - damping_[i] * h_ / 2.0);
+    inv_plus_.push_back(1.0 / Plus(i));
+  }
+  const double first = owned_.empty() ? 0.0 : damping_[owned_.front()];
+  uniform_damping_ = std::all_of(owned_.begin(), owned_.end(),
+                                 [&](int i) { return damping_[i] == first; });
+  if (uniform_damping_) {
+    damping_factor_ = first;
+    damping_weight_ = mass_;
+  } else {
+    damping_factor_ = 1.0;
+    damping_weight_ = damping_.cwiseProduct(mass_);
+  }
+}
+
+void RegionIntegrator::SetControlledDofs(std::vector<int> dofs) {
+  controlled_ = std::move(dofs);
+  controlled_plus_ = 1.0;
+  for (int i : controlled_) controlled_plus_ = std::max(controlled_plus_, Plus(i));
 }
 
 void RegionIntegrator::Reset() {
@@ -56,36 +95,33 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
   assert(prescribed_next.size() == prescribed_.size() && load.size() == loaded_.size());
   const Eigen::VectorXd& ku = Forces();
   for (size_t k = 0; k < loaded_.size(); ++k) external_[loaded_[k]] = load[k];
-  const double minus = 1.0 - damping_ * h_ / 2.0;
-  const double plus = 1.0 + damping_ * h_ / 2.0;
-  const double inv_plus = 1.0 / plus;
   const double h2 = h_ * h_;
   const double* u = u_->data();
   const double* up = u_previous_->data();
   double* next = u_next_->data();
-  double swept = 0;  // Σ m (u⁺ − u⁻)² over the owned DOFs
+  double swept = 0;  // Σ damping_weight_·(u⁺ − u⁻)² over the owned DOFs
   if (energy_terms_) {
     for (size_t k = 0; k < owned_.size(); ++k) {
       const int i = owned_[k];
-      next[i] =
-          (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
-      swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
+      next[i] = (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * u[i] - minus_[k] * up[i]) *
+                inv_plus_[k];
+      swept += damping_weight_[i] * (next[i] - up[i]) * (next[i] - up[i]);
     }
   } else {  // the same update, without the reduction that serialises the loop
     for (size_t k = 0; k < owned_.size(); ++k) {
       const int i = owned_[k];
-      next[i] =
-          (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * u[i] - minus * up[i]) * inv_plus;
+      next[i] = (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * u[i] - minus_[k] * up[i]) *
+                inv_plus_[k];
     }
   }
   load_scale_ = 1;
   load_work_refused_ = 0;
   if (limits.load_work_j < INFINITY && !loaded_.empty()) {
-    swept += LimitLoadWork(limits.load_work_j, load, plus, next, up);
+    swept += LimitLoadWork(limits.load_work_j, load, next, up);
   }
   controlled_dissipated_ = 0;
-  if (dissipate_j > 0 && !controlled_.empty()) swept += DampControlled(dissipate_j, plus, next, up);
-  damping_dissipated_ = damping_ * swept / (4.0 * h_);
+  if (dissipate_j > 0 && !controlled_.empty()) swept += DampControlled(dissipate_j, next, up);
+  damping_dissipated_ = damping_factor_ * swept / (4.0 * h_);
   load_work_ = 0;
   for (size_t k = 0; k < loaded_.size(); ++k) {
     const int i = loaded_[k];
@@ -100,7 +136,7 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
     const int i = prescribed_[k];
     const double m = mass_[i];
     prescribed_reaction_[k] = ku[i] + m * (next[i] - 2.0 * u[i] + up[i]) / h2 +
-                              damping_ * m * (next[i] - up[i]) / (2.0 * h_);
+                              damping_[i] * m * (next[i] - up[i]) / (2.0 * h_);
     prescribed_work_[k] = ku[i] * (next[i] - up[i]) / 2.0;
   }
   std::swap(u_previous_, u_);
@@ -112,14 +148,14 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
 // ½ Σ f·(u⁺ − u⁻) is α·B + α²·A with A = ½ Σ c f² ≥ 0 and B = W(1) − A: zero at α = 0, so the
 // largest α ∈ [0, 1] with W(α) ≤ limit always exists; it is the positive root, in whichever form
 // does not cancel. The controlled damping after this only shrinks the Γ motion, and with it a
-// positive work. Returns the change of Σ m (u⁺ − u⁻)² over the loaded DOFs.
-double RegionIntegrator::LimitLoadWork(double limit_j, std::span<const double> load, double plus,
-                                       double* next, const double* up) noexcept {
+// positive work. Returns the change of Σ damping_weight_·(u⁺ − u⁻)² over the loaded DOFs.
+double RegionIntegrator::LimitLoadWork(double limit_j, std::span<const double> load, double* next,
+                                       const double* up) noexcept {
   double work = 0, a = 0;
   for (size_t k = 0; k < loaded_.size(); ++k) {
     const int i = loaded_[k];
     work += load[k] * (next[i] - up[i]) / 2.0;
-    a += h_ * h_ / (mass_[i] * plus) * load[k] * load[k] / 2.0;
+    a += h_ * h_ / (mass_[i] * Plus(i)) * load[k] * load[k] / 2.0;
   }
   const double limit = std::max(0.0, limit_j);
   if (!(work > limit)) return 0;
@@ -136,9 +172,9 @@ double RegionIntegrator::LimitLoadWork(double limit_j, std::span<const double> l
   for (size_t k = 0; k < loaded_.size(); ++k) {
     const int i = loaded_[k];
     const double before = next[i] - up[i];
-    next[i] -= (1.0 - alpha) * h_ * h_ / (mass_[i] * plus) * load[k];
+    next[i] -= (1.0 - alpha) * h_ * h_ / (mass_[i] * Plus(i)) * load[k];
     const double after = next[i] - up[i];
-    swept_change += mass_[i] * (after * after - before * before);
+    swept_change += damping_weight_[i] * (after * after - before * before);
   }
   load_scale_ = alpha;
   load_work_refused_ = work - (alpha * b + alpha * alpha * a);
@@ -170,13 +206,16 @@ void RegionIntegrator::LimitPrescribedWork(double limit_j, const double* ku, dou
 // b/(b + qβ), b = 1 + d·h/2, q = h/2, and so takes β·S·b²/(b + qβ)² out of the step, with
 // S = Σ m (u⁺ − u⁻)²/(4h) at β = 0 over them. That rises with β up to β = b/q, where it is
 // S·b/(4q): the most one step can take. β for E is the smaller root of β·S = e·(b + qβ)² with
-// e = E/b², in the form that stays accurate as E → 0.
-// Returns the change of Σ m (u⁺ − u⁻)² over those DOFs, for the material damping's share.
-double RegionIntegrator::DampControlled(double dissipate_j, double plus, double* next,
+// e = E/b², in the form that stays accurate as E → 0. Where the controlled DOFs' d differ, β is
+// solved with the largest b: b/(b + qβ) grows with b, so each DOF then gives at most its share
+// and the step takes out no more than E (DampControlledMixed says how much).
+// Returns the change of Σ damping_weight_·(u⁺ − u⁻)² over those DOFs, for the material
+// damping's share.
+double RegionIntegrator::DampControlled(double dissipate_j, double* next,
                                         const double* up) noexcept {
   double swept = 0;
   for (int i : controlled_) swept += mass_[i] * (next[i] - up[i]) * (next[i] - up[i]);
-  const double s = swept / (4.0 * h_), b = plus, q = h_ / 2.0;
+  const double s = swept / (4.0 * h_), b = controlled_plus_, q = h_ / 2.0;
   if (!(s > 0)) return 0;
   const double e = dissipate_j / (b * b);
   // The same expression decides and goes under the root: rounding can never make it negative.
@@ -185,10 +224,28 @@ double RegionIntegrator::DampControlled(double dissipate_j, double plus, double*
   if (discriminant > 0) {
     beta = 2.0 * e * b * b / ((s - 2.0 * e * b * q) + std::sqrt(discriminant));
   }
+  if (!uniform_damping_) return DampControlledMixed(beta, q, next, up);
   const double scale = b / (b + q * beta);
   for (int i : controlled_) next[i] = up[i] + scale * (next[i] - up[i]);
   controlled_dissipated_ = beta * s * scale * scale;
   return swept * (scale * scale - 1.0);
+}
+
+// DampControlled's β applied with each DOF's own b = 1 + d·h/2.
+double RegionIntegrator::DampControlledMixed(double beta, double q, double* next,
+                                             const double* up) noexcept {
+  double taken = 0, swept_change = 0;
+  for (int i : controlled_) {
+    const double b = Plus(i);
+    const double scale = b / (b + q * beta);
+    const double before = next[i] - up[i];
+    next[i] = up[i] + scale * before;
+    const double after = next[i] - up[i];
+    taken += mass_[i] * after * after;
+    swept_change += damping_weight_[i] * (after * after - before * before);
+  }
+  controlled_dissipated_ = beta * taken / (4.0 * h_);
+  return swept_change;
 }
 
 double RegionIntegrator::DiscreteEnergy() noexcept { return BothEnergies().discrete_j; }

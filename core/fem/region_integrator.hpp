@@ -29,9 +29,11 @@ struct PortWorkLimits {
  *
  *   u⁺ = [h²/m·(f − (K_region u)) + 2u − (1 − d·h/2)·u⁻] / (1 + d·h/2),
  *
- * applied to the DOFs the region owns, with h the region's substep. Its boundary DOFs (the
- * other region's interface, the contact, supports) are prescribed by the caller; some owned DOFs
- * may carry an external load (the interface forces of the other region).
+ * applied to the DOFs the region owns, with h the region's substep and d the DOF's own
+ * mass-proportional damping rate (C = diag(d·m): an object of several materials damps each
+ * node by the mass-weighted rate of the elements around it, ElasticModel::dof_damping).
+ * Its boundary DOFs (the other region's interface, the contact, supports) are prescribed by the
+ * caller; some owned DOFs may carry an external load (the interface forces of the other region).
  *
  * The region keeps its own copy of the whole state vector, so two regions never share memory:
  * what crosses between them goes through a BoundaryChannel.
@@ -44,10 +46,17 @@ class RegionIntegrator {
    * @param stiffness  K of this region's elements (writes only the DOFs they touch)
    * @param dof_mass   lumped mass of every DOF, kg (the whole object's: interface DOFs carry the
    *                   mass of both sides)
+   * @param dof_damping d of every DOF in c = d·m, 1/s (ElasticModel::dof_damping). When every
+   *                   owned DOF has the same d, the step is the same arithmetic, to the bit, as
+   *                   the one-rate constructor's.
    * @param owned      DOFs this region updates
    * @param prescribed DOFs whose values the caller sets every substep
    * @param loaded     owned DOFs that receive an external load every substep
    */
+  RegionIntegrator(const StiffnessOperator& stiffness, const Eigen::VectorXd& dof_mass,
+                   const Eigen::VectorXd& dof_damping, std::vector<int> owned,
+                   std::vector<int> prescribed, std::vector<int> loaded, double substep_s);
+  /** One damping rate d (1/s) for every DOF (a one-material object, the uniform cube). */
   RegionIntegrator(const StiffnessOperator& stiffness, const Eigen::VectorXd& dof_mass,
                    double damping_per_s, std::vector<int> owned, std::vector<int> prescribed,
                    std::vector<int> loaded, double substep_s);
@@ -88,7 +97,7 @@ class RegionIntegrator {
   double LoadWork() const { return load_work_; }
   /** (K u)·Δ at prescribed DOF index k, J: the work moving that DOF did on the region. */
   double PrescribedWork(int k) const { return prescribed_work_[k]; }
-  /** Σ over owned DOFs of d·m·(u⁺ − u⁻)²/(4h), J (≥ 0). */
+  /** Σ over owned DOFs of d_i·m_i·(u⁺ − u⁻)²/(4h), J (≥ 0). */
   double DampingDissipated() const { return damping_dissipated_; }
   /** Work the port limits kept the load and the port prescribed DOFs from doing in the last
    *  step, J (≥ 0): what they would have done less what they did. */
@@ -103,7 +112,7 @@ class RegionIntegrator {
    */
   void SetEnergyTerms(bool keep) { energy_terms_ = keep; }
   /** The owned DOFs a dissipate_j damps (default: the loaded ones). */
-  void SetControlledDofs(std::vector<int> dofs) { controlled_ = std::move(dofs); }
+  void SetControlledDofs(std::vector<int> dofs);
   /**
    * ½ Σ_owned m ((u − u⁻)/h)² + ½ u⁻ᵀ K u, J: the energy central difference conserves without
    * damping and load (positive while the step is within the region's own limit).
@@ -126,7 +135,8 @@ class RegionIntegrator {
 
   /**
    * Residual of the equation of motion at prescribed DOF index `k` at the start of the last
-   * step: (K u) + m·a + d·m·v — the force needed to hold the prescribed motion, N.
+   * step: (K u) + m·a + d·m·v (d that DOF's rate) — the force needed to hold the prescribed
+   * motion, N.
    */
   double PrescribedReaction(int k) const { return prescribed_reaction_[k]; }
 
@@ -147,18 +157,32 @@ class RegionIntegrator {
   double OwnedStateMaxAbs() const noexcept;
 
  private:
-  double DampControlled(double dissipate_j, double plus, double* next, const double* up) noexcept;
-  double LimitLoadWork(double limit_j, std::span<const double> load, double plus, double* next,
+  void PrecomputeDamping();
+  double DampControlled(double dissipate_j, double* next, const double* up) noexcept;
+  double DampControlledMixed(double beta, double q, double* next,
+                             const double* up) noexcept;
+  double LimitLoadWork(double limit_j, std::span<const double> load, double* next,
                        const double* up) noexcept;
+  /** 1 + d·h/2 of DOF i: the factor that divides its u⁺. */
+  double Plus(int i) const noexcept { return 1.0 + damping_[i] * h_ / 2.0; }
   void LimitPrescribedWork(double limit_j, const double* ku, double* next,
                            const double* up) noexcept;
 
   const StiffnessOperator& stiffness_;
   const Eigen::VectorXd& mass_;
-  double damping_;
+  Eigen::VectorXd damping_;  // d per DOF, 1/s
   std::vector<int> owned_, prescribed_, loaded_;
   double h_ = 0;
   std::vector<double> step_over_mass_;  // h²/m per owned DOF, in owned_ order
+  std::vector<double> minus_;           // 1 − d·h/2 per owned DOF, in owned_ order
+  std::vector<double> inv_plus_;        // 1/(1 + d·h/2) per owned DOF, in owned_ order
+  // The material damping's energy is damping_factor_ · Σ damping_weight_·(u⁺ − u⁻)²/(4h).
+  // With one d over the owned DOFs: weight m, factor d, the sum the one-rate step always took
+  // (bit for bit); else weight d·m, factor 1.
+  bool uniform_damping_ = true;
+  double damping_factor_ = 0;
+  Eigen::VectorXd damping_weight_;
+  double controlled_plus_ = 1;  // the largest 1 + d·h/2 over the controlled DOFs
   Eigen::VectorXd buffers_[3];
   Eigen::VectorXd* u_previous_;
   Eigen::VectorXd* u_;

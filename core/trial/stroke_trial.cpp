@@ -50,7 +50,7 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
     return out;
   }
   const std::vector<int>& fixed = model.constraints().fixed_dofs;
-  RegionIntegrator integrator(model.stiffness(), model.dof_mass(), model.damping_per_s(),
+  RegionIntegrator integrator(model.stiffness(), model.dof_mass(), model.dof_damping(),
                               OwnedDofs(model), fixed, contact.loaded_dofs(), dt);
   integrator.SetEnergyTerms(false);
   const std::vector<double> held_at_rest(fixed.size(), 0.0);

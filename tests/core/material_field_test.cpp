@@ -509,13 +509,6 @@ TEST(MaterialField, RefusesWhatIsNotAnObjectSayingWhy) {
   EXPECT_NE(message([&] { MaterialField(grid, {Soft()}, std::vector<std::int16_t>(7, 0)); })
                 .find("the material field has 7 elements; the grid has 8"),
             std::string::npos);
-  Material damped = Soft();
-  damped.damping_per_s = 20;
-  std::vector<std::int16_t> two = all;
-  two[3] = 1;
-  EXPECT_NE(message([&] { ElasticModel(grid, MaterialField(grid, {Soft(), damped}, two), {}); })
-                .find("the materials' damping differs"),
-            std::string::npos);
   const HexGrid other(3, 5, 2, kH);  // as many elements, in another shape
   EXPECT_NE(message([&] { ElasticModel(other, MaterialField(grid, Soft()), {}); })
                 .find("the material field was made for 2 × 2 × 2 elements; the grid has 2 × 4 × 1"),

@@ -73,7 +73,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadValue{"solver.dt=0", "solver.dt must be finite and > 0"},
                       BadValue{"solver.dt=nan", "solver.dt"},
                       BadValue{"material.damping=inf", "material.damping"},
-                      BadValue{"input.waveform=square", "\"press\" or \"sine\""},
+                      BadValue{"input.waveform=square", "\"press\", \"sine\" or \"stroke\""},
                       BadValue{"input.frequency=abc", "input.frequency = 'abc' is not a number"},
                       BadValue{"input.amplitude=0.3", "below mesh.edge"},
                       BadValue{"material.stiffness=3", "unknown scene key 'material.stiffness'"},

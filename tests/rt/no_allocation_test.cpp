@@ -232,6 +232,7 @@ TEST(TimeStepOnAnyShape, NeverAllocates) {
   const HexGrid grid(7, 7, 4, 0.02);
   Material stiff;
   stiff.youngs_modulus_pa *= 8;
+  stiff.damping_per_s = 25;  // another damping than the soft one's: per-DOF rates
   std::vector<std::int16_t> elements(static_cast<size_t>(grid.num_elements()));
   for (int e = 0; e < grid.num_elements(); ++e) {
     const int ex = e % 6, ey = (e / 6) % 6;
