@@ -90,6 +90,7 @@ struct PressResult {
   double largest_jump_any_n = 0;  // and between any two periods
   int near_late_wakes = 0;        // answers from a period woken late or just after one
   double final_force_n = 0;
+  double held_mean_force_n = 0;  // over the hold's last 100 answers: the ring-down averaged out
   bool moved = false;
 };
 
@@ -117,6 +118,10 @@ void MeasureJumps(PressResult* result) {
     previous = force;
   }
   result->final_force_n = previous;
+  const size_t tail = std::min<size_t>(100, result->forces.size());
+  for (size_t i = result->forces.size() - tail; i < result->forces.size(); ++i) {
+    result->held_mean_force_n += result->forces[i].force_n[2] / static_cast<double>(tail);
+  }
 }
 
 // Above `node` for 100 ms, then in at 10 mm/s for 0.6 s, then held for 0.4 s, on a loop centred
@@ -173,9 +178,17 @@ TEST(HapticLoopReconfigure, ATouchOnAnotherNodeIsAnsweredAfterRecentringWithoutA
   if (kSanitized) return;
   EXPECT_GT(engaged, 500);
   // Pressed 6 mm at a node a quarter of the way in from the edge: the object pushes back (−z),
-  // once the ramp is over as hard as when the regions were there from the start.
+  // once the ramp is over as hard as when the regions were there from the start. Compared over
+  // the hold's last 100 ms: the stop at 10 mm/s leaves the object ringing (d = 10/s: 13 % of it
+  // is left after the 0.4 s hold), and the two runs' different histories put it in different
+  // phases, so single answers differed by 3.4 % once in a suite run.
   EXPECT_LT(moved.final_force_n, -0.3);
-  EXPECT_NEAR(moved.final_force_n, centred.final_force_n, 0.02 * std::abs(centred.final_force_n));
+  EXPECT_NEAR(moved.held_mean_force_n, centred.held_mean_force_n,
+              0.02 * std::abs(centred.held_mean_force_n));
+  std::printf("held force, last 100 ms: %.4f N re-centred, %.4f N centred; last answers %.4f and "
+              "%.4f N\n",
+              moved.held_mean_force_n, centred.held_mean_force_n, moved.final_force_n,
+              centred.final_force_n);
   // The 2 mm pressed while waiting ramps in: no force change between periods larger than the
   // ordinary press's own (its touch-down and its stop), and far below the step it would be.
   const double step_if_not_ramped = std::abs(moved.final_force_n) * 0.002 / 0.006;
