@@ -257,6 +257,8 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
+  const std::string cube_only = CubeOnlyProblem(c.scene, "hapticsimd");
+  require(cube_only.empty(), cube_only);
   ValidateScene(c.scene);
 }
 

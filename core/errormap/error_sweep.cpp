@@ -184,6 +184,8 @@ std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
 ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   SweepStats* stats_out) {
   ValidateGrid(grid);
+  const std::string cube_only = CubeOnlyProblem(base, "the error map");
+  HAPTICSIM_THROW_UNLESS(cube_only.empty(), cube_only);
   HAPTICSIM_THROW_UNLESS(options.shard_count >= 1 && options.shard_index >= 0 &&
                              options.shard_index < options.shard_count,
                          "--shard I/N needs 1 ≤ I ≤ N");

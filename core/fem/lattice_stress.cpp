@@ -6,13 +6,13 @@ namespace hapticsim {
 
 std::vector<double> VonMisesPerCell(const ObjectState& state, double spacing_m,
                                     const Material& material) {
-  const int n = state.nodes_per_axis;
+  const auto [nx, ny, nz] = state.lattice_nodes;
   const double lambda = material.lame_lambda(), mu = material.lame_mu();
   std::vector<double> out;
-  out.reserve(static_cast<size_t>(n - 1) * (n - 1) * (n - 1));
-  for (int ix = 0; ix + 1 < n; ++ix) {
-    for (int iy = 0; iy + 1 < n; ++iy) {
-      for (int iz = 0; iz + 1 < n; ++iz) {
+  out.reserve(static_cast<size_t>(nx - 1) * (ny - 1) * (nz - 1));
+  for (int ix = 0; ix + 1 < nx; ++ix) {
+    for (int iy = 0; iy + 1 < ny; ++iy) {
+      for (int iz = 0; iz + 1 < nz; ++iz) {
         // ∂u_c/∂x_d at the centre: the mean over the cell's 4 edges along d of their difference.
         double grad[3][3] = {};
         for (int corner = 0; corner < 8; ++corner) {

@@ -26,6 +26,26 @@ inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChann
   return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
 }
 
+// The material the port floor is reckoned in: the object's one material, or of several the softest
+// (the floor is an allowance, so the smaller) at the object's mean density (so mass / density is
+// its volume).
+Material FloorMaterial(const RegionPartition& p) {
+  const int uniform = p.mesh().uniform_material();
+  if (uniform >= 0) return p.materials()[uniform];
+  Material floor = p.materials().front();
+  double volume_m3 = 0, mass_kg = 0;
+  const double h = p.mesh().options().spacing_m;
+  for (const HybridElement& e : p.mesh().elements()) {
+    const Material& material = p.materials()[e.material];
+    const double volume = std::pow(e.size_factor * h, 3);
+    volume_m3 += volume;
+    mass_kg += material.density_kg_m3 * volume;
+    floor.youngs_modulus_pa = std::min(floor.youngs_modulus_pa, material.youngs_modulus_pa);
+  }
+  floor.density_kg_m3 = mass_kg / volume_m3;
+  return floor;
+}
+
 }  // namespace
 
 const RegionSchedule& AsyncRegions::schedule(RegionIndex region) const {
@@ -49,14 +69,14 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
   if (!(substep_safety > 0)) throw Error("substep safety must be positive");
   substep_safety_ = substep_safety;
   const RegionPartition& p = partition_;
-  port_floor_j_ = PortFloorJ(scene.material, p.dof_mass().sum() / 3.0);
+  port_floor_j_ = PortFloorJ(FloorMaterial(p), p.dof_mass().sum() / 3.0);
   const int n = p.mesh().num_dofs();
   const int count = p.num_regions();
   // Each region's elements next to its outer Γ: what the region outwards evaluates on its Γ.
   std::vector<std::unique_ptr<ElementSetStiffness>> bands(static_cast<size_t>(count));
   for (int a = 0; a + 1 < count; ++a) {
     bands[a] =
-        std::make_unique<ElementSetStiffness>(p.mesh(), scene.material, p.outer_band_elements(a));
+        std::make_unique<ElementSetStiffness>(p.mesh(), p.materials(), p.outer_band_elements(a));
   }
   const std::vector<RegionSchedule> schedules =
       ScheduleRegions(p, scene, bands, coupling_ == Coupling::kDisplacement, substep_safety);
@@ -84,7 +104,7 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
     prescribed.insert(prescribed.end(), dofs.outer_interface.begin(), dofs.outer_interface.end());
     region->prescribed_values.assign(prescribed.size(), 0.0);
     region->integrator = std::make_unique<RegionIntegrator>(
-        p.stiffness(a), p.dof_mass(), scene.material.damping_per_s, dofs.owned, prescribed,
+        p.stiffness(a), p.dof_mass(), p.dof_damping(), dofs.owned, prescribed,
         dofs.inner_interface, period / region->schedule.substeps);
     // The outermost region's controller damps its inner Γ; a middle shell, with links on both
     // sides, and the primary (its last resort only), all their DOFs (ObserveInwardLink).

@@ -189,8 +189,9 @@ class AsyncRegions {
 
   /**
    * The object's surface, for drawing it while the regions run (hapticsimd's deformation_t):
-   * the lattice points on the cube's faces as ids (ix · n + iy) · n + iz, ascending, in
-   * the order ReadSurface gives their displacements.
+   * the lattice points on the object's surface (touched by occupied and empty or outside cells:
+   * the cube's faces) as ids (ix · ny + iy) · nz + iz, ascending, in the order ReadSurface gives
+   * their displacements.
    */
   const std::vector<std::int32_t>& surface_ids() const { return surface_.ids; }
   /**

@@ -14,10 +14,16 @@ std::array<int, 3> Offset(int local) { return {local & 1, (local >> 1) & 1, (loc
 }  // namespace
 
 std::unique_ptr<BoxStiffness> BoxStiffness::TryMake(const HybridMesh& mesh,
-                                                    const Material& material,
+                                                    const std::vector<Material>& materials,
                                                     const std::vector<int>& element_ids,
                                                     int min_row_nodes) {
   if (element_ids.empty()) return nullptr;
+  // One material: one stencil per set of cells around a node (several would need one per
+  // 8-tuple of materials, as StencilStiffness has on the fine grid).
+  const int material = mesh.elements()[static_cast<size_t>(element_ids.front())].material;
+  for (int id : element_ids) {
+    if (mesh.elements()[static_cast<size_t>(id)].material != material) return nullptr;
+  }
   // Each element's lowest corner on the fine lattice, from one of its independent nodes (every
   // fine element has one: a refined cell's centre, or a coarse vertex).
   std::vector<std::array<int, 3>> origins;
@@ -68,18 +74,19 @@ std::unique_ptr<BoxStiffness> BoxStiffness::TryMake(const HybridMesh& mesh,
     }
   }
   return std::unique_ptr<BoxStiffness>(
-      new BoxStiffness(mesh, material, element_ids, nodes, std::move(box_mesh_nodes), cell_masks));
+      new BoxStiffness(mesh, materials, material, element_ids, nodes, std::move(box_mesh_nodes),
+                       cell_masks));
 }
 
-BoxStiffness::BoxStiffness(const HybridMesh& mesh, const Material& material,
-                           std::vector<int> element_ids, const std::array<int, 3>& box_nodes,
+BoxStiffness::BoxStiffness(const HybridMesh& mesh, const std::vector<Material>& materials,
+                           int material, std::vector<int> element_ids, const std::array<int, 3>& box_nodes,
                            std::vector<int> box_mesh_nodes, const std::vector<unsigned>& cell_masks)
     : StiffnessOperator(mesh.num_dofs()),
       mesh_(mesh),
-      elements_(mesh, material, std::move(element_ids)),
+      elements_(mesh, materials, std::move(element_ids)),
       box_nodes_(box_nodes) {
   // One stencil per distinct set of cells, and the rows cut into runs of one stencil each.
-  const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(mesh.options().spacing_m, material);
+  const Hex8Element::Matrix24 ke = Hex8Element::Stiffness(mesh.options().spacing_m, materials.at(material));
   const std::ptrdiff_t nb = static_cast<std::ptrdiff_t>(box_mesh_nodes.size());
   std::array<int, 256> stencil_of;
   stencil_of.fill(-1);

@@ -30,11 +30,12 @@ namespace hapticsim {
 class BoxStiffness final : public StiffnessOperator {
  public:
   /**
-   * The operator for `element_ids` if they are all fine elements (each once) and the box that
-   * bounds them has rows along x and y of at least `min_row_nodes` nodes; nullptr otherwise
-   * (nothing built).
+   * The operator for `element_ids` if they are all fine elements (each once) of one material
+   * (an index into `materials`) and the box that bounds them has rows along x and y of at least
+   * `min_row_nodes` nodes; nullptr otherwise (nothing built).
    */
-  static std::unique_ptr<BoxStiffness> TryMake(const HybridMesh& mesh, const Material& material,
+  static std::unique_ptr<BoxStiffness> TryMake(const HybridMesh& mesh,
+                                               const std::vector<Material>& materials,
                                                const std::vector<int>& element_ids,
                                                int min_row_nodes = 0);
 
@@ -60,7 +61,8 @@ class BoxStiffness final : public StiffnessOperator {
   // (core/fem/cpu_dispatch.hpp).
   void ApplyOnBox(const double* u, double* ku) const;
 
-  BoxStiffness(const HybridMesh& mesh, const Material& material, std::vector<int> element_ids,
+  BoxStiffness(const HybridMesh& mesh, const std::vector<Material>& materials, int material,
+               std::vector<int> element_ids,
                const std::array<int, 3>& box_nodes, std::vector<int> box_mesh_nodes,
                const std::vector<unsigned>& cell_masks);
 

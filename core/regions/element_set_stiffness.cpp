@@ -3,17 +3,23 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/error.hpp"
 #include "core/fem/cpu_dispatch.hpp"
 #include "core/fem/stencil_kernels.hpp"
 
 namespace hapticsim {
 
-ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh, const Material& material,
+ElementSetStiffness::ElementSetStiffness(const HybridMesh& mesh,
+                                         const std::vector<Material>& materials,
                                          std::vector<int> element_ids)
-    : StiffnessOperator(mesh.num_dofs()),
-      mesh_(mesh),
-      element_ids_(std::move(element_ids)),
-      unit_stiffness_(Hex8Element::Stiffness(1.0, material)) {
+    : StiffnessOperator(mesh.num_dofs()), mesh_(mesh), element_ids_(std::move(element_ids)) {
+  for (const Material& material : materials) {
+    unit_stiffness_.push_back(Hex8Element::Stiffness(1.0, material));
+  }
+  for (int id : element_ids_) {
+    HAPTICSIM_THROW_UNLESS(mesh.elements()[id].material < static_cast<int>(materials.size()),
+                           "internal: an element's material is not among the materials");
+  }
   std::vector<char> touched(static_cast<size_t>(mesh.num_independent()), 0);
   for (int id : element_ids_) {
     for (int node : mesh.elements()[id].nodes) {
@@ -67,7 +73,7 @@ void ElementSetStiffness::ApplyElements(const double* u, double* ku) const {
         ue[3 * local + 2] = z;
       }
     }
-    MultiplyElement24(unit_stiffness_.data(), ue, fe);
+    MultiplyElement24(unit_stiffness_[e.material].data(), ue, fe);
     const double scale = e.size_factor * h;
     for (double& f : fe) f *= scale;
     if (direct[0] >= 0) {
@@ -107,7 +113,7 @@ Eigen::VectorXd ElementSetStiffness::Diagonal() const {
             if (ga->independent != gb->independent) continue;
             for (int c = 0; c < 3; ++c) {
               diagonal[c * nr + ga->independent] += ga->weight * gb->weight * e.size_factor * h *
-                                                    unit_stiffness_(3 * a + c, 3 * b + c);
+                                                    unit_stiffness_[e.material](3 * a + c, 3 * b + c);
             }
           }
         }

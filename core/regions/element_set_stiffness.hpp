@@ -12,14 +12,16 @@ namespace hapticsim {
 /**
  * Matrix-free K·u over a subset of a HybridMesh's elements (one region, or all of them), on the
  * mesh's independent DOFs: gather each element's 24 displacements through the hanging-node
- * weights, multiply by its stiffness h_e·(λA + μB), scatter back with the same weights.
+ * weights, multiply by its stiffness h_e·(λA + μB) of its material, scatter back with the same
+ * weights.
  *
  * Apply() writes only the DOFs the subset touches (touched_dofs()) and leaves the rest of `ku`
  * as it was, so a region can compute its own forces without touching the other's.
  */
 class ElementSetStiffness final : public StiffnessOperator {
  public:
-  ElementSetStiffness(const HybridMesh& mesh, const Material& material,
+  /** `materials`: the object's, indexed by HybridElement::material. */
+  ElementSetStiffness(const HybridMesh& mesh, const std::vector<Material>& materials,
                       std::vector<int> element_ids);
 
   void Apply(const Eigen::Ref<const Eigen::VectorXd>& u,
@@ -35,7 +37,7 @@ class ElementSetStiffness final : public StiffnessOperator {
 
   const HybridMesh& mesh_;
   std::vector<int> element_ids_;
-  Hex8Element::Matrix24 unit_stiffness_;  // λA + μB (stiffness per metre of edge)
+  std::vector<Hex8Element::Matrix24> unit_stiffness_;  // per material: λA + μB (per metre of edge)
   std::vector<int> touched_dofs_;
   // Per element (in element_ids_ order), its 8 nodes' independent indices when none of them is
   // hanging (every gather one term of weight 1: most coarse cells), else −1 in the first: then

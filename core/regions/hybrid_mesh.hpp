@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct HybridElement {
   std::array<int, 8> nodes{};  ///< mesh nodes in Hex8Element's local order
   int size_factor = 1;         ///< edge = size_factor · h (1 fine, k coarse)
   RegionIndex region = kPrimaryRegion;
+  std::int16_t material = 0;  ///< index into the object's materials (MaterialField order)
 };
 
 /** One term of a node's displacement in terms of independent DOFs: u_node += weight·u_r. */
@@ -28,37 +30,50 @@ struct GatherTerm {
 };
 
 /**
- * A cube meshed at two resolutions: coarse cells of k × k × k fine intervals, of which some are
- * refined into k³ fine cells — those meeting the primary box around the contact, and those
- * around the fixed supports. Where a refined cell meets an unrefined one, the fine nodes that
- * are not coarse vertices ("hanging nodes") are constrained to the coarse cell's trilinear field,
- * which on the shared face is bilinear, so the displacement stays continuous (conforming).
+ * An object on a lattice meshed at two resolutions: coarse cells of k × k × k fine intervals, of
+ * which some are refined into their fine cells — those meeting the primary box around the contact,
+ * those around point supports, and those the object fills only in part or with more than one
+ * material (its surface and its material boundaries, so a coarse element is always whole and of
+ * one material). Where a refined cell meets an unrefined one, the fine nodes that are not coarse
+ * vertices ("hanging nodes") are constrained to the coarse cell's trilinear field, which on the
+ * shared face is bilinear, so the displacement stays continuous (conforming).
+ *
+ * The object is the lattice's occupied fine cells (Options::cell_material; every cell, the paper's
+ * cube, when it is empty). A refined cell contributes only its occupied fine cells. The lattice's
+ * node counts need not be k·m + 1: the coarse cells past its end are partly empty, so refined.
  *
  * The unknowns are the *independent* nodes (all nodes but the hanging ones), component-blocked
  * like HexGrid: dof(r, c) = c·N_r + r. A hanging node's displacement is gathered from its masters
  * with the interpolation weights; its forces and lumped mass are scattered back with the same
  * weights (u = T·u_r, f_r = Tᵀ·f, M_r = row sums of TᵀMT).
  *
- * Nodes live on the fine lattice of the cube ((n−1) intervals of h per axis), so a lattice index
- * names every node whatever its cell's resolution. With k = 1 there are no hanging nodes and the
- * mesh is the full-resolution grid.
+ * Nodes live on the fine lattice, so a lattice index names every node whatever its cell's
+ * resolution. With k = 1 there are no hanging nodes and the mesh is the full-resolution grid.
  */
 class HybridMesh {
  public:
   struct Options {
-    int nodes_per_axis = 13;                        ///< fine lattice points per axis (n)
+    std::array<int, 3> lattice_nodes{13, 13, 13};   ///< fine lattice points along x, y, z
     double spacing_m = 0.25 / 12;                   ///< fine spacing h, m
-    int coarse_factor = 2;                          ///< k, must divide n − 1
+    int coarse_factor = 2;                          ///< k
+    /// Per fine lattice cell, x fastest (MaterialField's element order): its material index, or
+    /// −1 where the object is not. Empty: every cell of material 0.
+    std::vector<std::int16_t> cell_material;
     std::array<int, 3> primary_lo{}, primary_hi{};  ///< primary box, lattice indices (closed)
-    std::vector<std::array<int, 3>> supports;       ///< lattice indices of fixed nodes
-    int support_layers = 1;  ///< coarse cells refined around each support, per direction
+    /// Lattice indices of the held nodes. A held node that would hang from a coarse cell whose
+    /// field it does not share (a vertex of that cell is free) refines the cell, so every support
+    /// is held exactly.
+    std::vector<std::array<int, 3>> supports;
+    /// Coarse cells refined around each point support (a held node none of whose six lattice
+    /// neighbours is held), per direction: a coarse cell at a point support is far too stiff.
+    int support_layers = 1;
     /// Secondary cells split into this many nested shells around the primary cells (regions
     /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.
     int secondary_regions = 1;
     int shell_cells = 1;
   };
 
-  /** @throws Error when k does not divide n − 1. */
+  /** @throws Error when the options are inconsistent (sizes, k < 1, an unoccupied lattice). */
   explicit HybridMesh(const Options& options);
 
   const Options& options() const { return options_; }
@@ -77,13 +92,14 @@ class HybridMesh {
    * independent node's own (one term of weight 1); elsewhere — a point inside or on an unrefined
    * coarse cell, a hanging node among them — the cell's trilinear field of its 8 vertices, which
    * are always independent (terms of weight 0 left out). A point on a face shared with a refined
-   * cell gets the same field from either: it depends on the face's vertices alone. Returns the
-   * number of terms written.
+   * cell gets the same field from either: it depends on the face's vertices alone. A point no
+   * element touches (outside the object) has no term. Returns the number of terms written.
    */
   int FieldAt(const std::array<int, 3>& point, std::array<GatherTerm, 8>* terms) const;
   /**
-   * The region of the element covering each fine lattice cell ((n − 1)³ cells, ix slowest): a
-   * coarse element gives its region to the k³ fine cells inside it.
+   * The region of the element covering each fine lattice cell ((nx−1)(ny−1)(nz−1) cells, ix
+   * slowest), −1 where the object is not: a coarse element gives its region to the k³ fine cells
+   * inside it.
    */
   std::vector<RegionIndex> RegionPerLatticeCell() const;
   /** Lattice indices of an independent node. */
@@ -91,14 +107,25 @@ class HybridMesh {
     return independent_lattice_[independent];
   }
 
+  /** How many of the 8 fine lattice cells around lattice point p the object fills (0 to 8). */
+  int OccupiedCellsAround(const std::array<int, 3>& p) const;
+
   /** The gather terms of mesh node `node` (one term of weight 1 for an independent node). */
   std::pair<const GatherTerm*, const GatherTerm*> Gather(int node) const {
     return {gather_terms_.data() + gather_start_[node],
             gather_terms_.data() + gather_start_[node + 1]};
   }
 
-  /** Lumped mass of each independent DOF for density ρ, kg (component-blocked). */
-  Eigen::VectorXd DofMass(double density_kg_m3) const;
+  /** Lumped mass of each independent DOF, kg (component-blocked): ρ of each element's material. */
+  Eigen::VectorXd DofMass(const std::vector<Material>& materials) const;
+  /**
+   * Each independent DOF's damping rate, 1/s: with C = Σ_e d_e·M_e lumped, the mass-weighted mean
+   * of the rates of the elements around it (ElasticModel::dof_damping on the fine grid); exactly
+   * the material's d when one rate is everywhere.
+   */
+  Eigen::VectorXd DofDamping(const std::vector<Material>& materials) const;
+  /** Whether the elements are all of one material (which one, else −1). */
+  int uniform_material() const;
 
   /** Number of regions that have elements (primary + secondary shells). */
   int num_regions() const { return num_regions_; }
@@ -106,15 +133,22 @@ class HybridMesh {
   const std::vector<unsigned>& region_mask() const { return region_mask_; }
 
  private:
-  std::vector<std::array<int, 3>> BuildElements(const std::vector<char>& refined,
-                                                const std::vector<RegionIndex>& region);
+  template <typename Plan>
+  std::vector<std::array<int, 3>> BuildElements(const Plan& plan);
   void BuildGather(const std::vector<std::vector<std::pair<int, double>>>& masters,
                    const std::vector<std::array<int, 3>>& node_lattice);
   void BuildRegionMasks();
 
+  int LatticePoint(int ix, int iy, int iz) const {
+    return ix + padded_[0] * (iy + padded_[1] * iz);
+  }
+
   Options options_;
+  std::array<int, 3> coarse_cells_{};  // per axis: ⌈(n − 1) / k⌉
+  std::array<int, 3> padded_{};        // lattice points the coarse cells span: coarse_cells·k + 1
+  std::vector<char> coarse_;           // per coarse cell (x fastest): one coarse element
   std::vector<HybridElement> elements_;
-  std::vector<int> node_at_lattice_;  // mesh node id per lattice point, −1 if none
+  std::vector<int> node_at_lattice_;  // mesh node id per padded lattice point, −1 if none
   std::vector<int> gather_start_;     // per mesh node, into gather_terms_ (size nodes + 1)
   std::vector<GatherTerm> gather_terms_;
   std::vector<int> independent_of_node_;  // −1 for hanging nodes

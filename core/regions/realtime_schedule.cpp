@@ -119,7 +119,7 @@ void RunSecondary(AsyncRegions& regions, const RunGrid& grid, int a, const Timin
 
 TrialResult RealTimeSchedule::RunTrial() {
   const Scene& scene = regions_.partition().scene();
-  const ContactTrajectory trajectory(scene.input, InwardNormal(scene.mesh, ContactNode(scene)));
+  const ContactTrajectory trajectory(scene.input, regions_.partition().contact_normal());
   const int count = regions_.num_regions();
   const double dt = 1.0 / regions_.schedule(kPrimaryRegion).rate_hz;
   const long steps = scene.num_steps();

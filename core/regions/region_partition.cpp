@@ -5,6 +5,7 @@
 
 #include "core/regions/box_stiffness.hpp"
 #include "core/error.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 
@@ -12,21 +13,30 @@ namespace {
 // The shortest rows (nodes along x and y) for which a box region runs on the stencil.
 constexpr int kMinBoxRowNodes = 9;
 
-// The hybrid mesh the scene's adaptivity asks for: the primary box around the contact node, the
-// supports refined, the shells.
-HybridMesh::Options MeshOptionsOf(const Scene& scene) {
-  const int n = scene.mesh.nodes, last = n - 1, r = scene.adaptivity.primary_size;
-  const LatticeIndex contact = ContactNode(scene);
+// The hybrid mesh the scene's adaptivity asks for on the scene's object: the primary box around
+// the contact node (clipped to the object by the mesh: only occupied cells), the supports, the
+// shells.
+HybridMesh::Options MeshOptionsOf(const Scene& scene, const SceneObject& object) {
+  const HexGrid& grid = object.grid;
+  const int r = scene.adaptivity.primary_size;
+  const std::array<int, 3> contact = grid.NodeIndices(object.contact_node);
+  const std::array<int, 3> last{grid.nx() - 1, grid.ny() - 1, grid.nz() - 1};
   HybridMesh::Options options;
-  options.nodes_per_axis = n;
-  options.spacing_m = scene.mesh.edge_m / last;
+  options.lattice_nodes = {grid.nx(), grid.ny(), grid.nz()};
+  options.spacing_m = grid.spacing();
   options.coarse_factor = scene.adaptivity.secondary_lod;
+  const MaterialField& field = object.field;
+  const bool whole_of_one = field.num_occupied() == field.num_elements() &&
+                            field.uniform_material() == 0;  // the cube: no list needed
+  if (!whole_of_one) {
+    options.cell_material.resize(static_cast<size_t>(field.num_elements()));
+    for (int e = 0; e < field.num_elements(); ++e) options.cell_material[e] = field.material_of(e);
+  }
   for (int a = 0; a < 3; ++a) {
     options.primary_lo[a] = std::max(0, contact[a] - r);
-    options.primary_hi[a] = std::min(last, contact[a] + r);
+    options.primary_hi[a] = std::min(last[a], contact[a] + r);
   }
-  const auto supports = CubeSupportNodes(scene.mesh);
-  options.supports.assign(supports.begin(), supports.end());
+  for (int node : object.fixed_nodes) options.supports.push_back(grid.NodeIndices(node));
   options.support_layers = scene.adaptivity.support_layers;
   options.secondary_regions = scene.adaptivity.secondary_regions;
   options.shell_cells = scene.adaptivity.shell_cells;
@@ -56,12 +66,16 @@ std::vector<std::vector<int>> ElementsByRegion(const HybridMesh& mesh, const Sce
 }  // namespace
 
 RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
-  ValidateScene(scene);
   HAPTICSIM_THROW_UNLESS(scene.adaptivity.enabled(),
                          "asynchronous regions need adaptivity.primary_size >= 1");
-  const HybridMesh::Options options = MeshOptionsOf(scene);
+  const SceneObject object = DescribeSceneObject(scene);
+  materials_ = object.field.materials();
+  contact_lattice_ = object.grid.NodeIndices(object.contact_node);
+  contact_normal_ = object.contact_normal;
+  const HybridMesh::Options options = MeshOptionsOf(scene, object);
   mesh_ = std::make_unique<HybridMesh>(options);
-  dof_mass_ = mesh_->DofMass(scene.material.density_kg_m3);
+  dof_mass_ = mesh_->DofMass(materials_);
+  dof_damping_ = mesh_->DofDamping(materials_);
   const std::vector<std::vector<int>> elements = ElementsByRegion(*mesh_, scene);
   for (const std::vector<int>& region_elements : elements) {
     // Fine elements (the primary box; at spacing factor 1 the secondary shells too, boxes with a
@@ -70,11 +84,11 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
     // 9×9×5 1.3×, 7×7×4 the same, 3×3×2 2.3× slower (face nodes, the scalar path, are nearly all
     // of a small box); a 13³ secondary with a hole 1.5–3.0× faster (docs/benchmarks.md).
     if (auto box =
-            BoxStiffness::TryMake(*mesh_, scene.material, region_elements, kMinBoxRowNodes)) {
+            BoxStiffness::TryMake(*mesh_, materials_, region_elements, kMinBoxRowNodes)) {
       stiffness_.push_back(std::move(box));
     } else {
       stiffness_.push_back(
-          std::make_unique<ElementSetStiffness>(*mesh_, scene.material, region_elements));
+          std::make_unique<ElementSetStiffness>(*mesh_, materials_, region_elements));
     }
   }
   AssignDofs(options.supports, static_cast<int>(elements.size()));
@@ -82,13 +96,15 @@ RegionPartition::RegionPartition(const Scene& scene) : scene_(scene) {
 }
 
 void RegionPartition::AssignDofs(const std::vector<std::array<int, 3>>& supports, int regions) {
-  const LatticeIndex contact = ContactNode(scene_);
+  const LatticeIndex& contact = contact_lattice_;
   const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
   HAPTICSIM_THROW_UNLESS(contact_node >= 0, "internal: the contact node is not independent");
   for (int c = 0; c < 3; ++c) contact_dofs_[c] = mesh_->Dof(contact_node, c);
   for (const auto& s : supports) {
     const int node = mesh_->IndependentAt(s[0], s[1], s[2]);
-    HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a support node is not independent");
+    // A held node that hangs hangs from held nodes only (HybridMesh refines where it would not),
+    // so it is held through them.
+    if (node < 0) continue;
     for (int c = 0; c < 3; ++c) fixed_dofs_.push_back(mesh_->Dof(node, c));
   }
   std::sort(fixed_dofs_.begin(), fixed_dofs_.end());

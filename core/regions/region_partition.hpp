@@ -22,15 +22,19 @@ struct RegionDofs {
 };
 
 /**
- * The paper's cube split into asynchronous regions (two-way linking on a hybrid mesh):
+ * The scene's object (SceneObject: the paper's cube, or a geometry file's voxels of several
+ * materials) split into asynchronous regions (two-way linking on a hybrid mesh):
  *
  * - region 0, the **primary region**: the coarse cells meeting the box of
- *   adaptivity.primary_size nodes around the contact, refined to the finest spacing h;
+ *   adaptivity.primary_size nodes around the contact, refined to the finest spacing h, only
+ *   where the object is (the box clipped to it);
  * - regions 1…n, the **secondary regions** (adaptivity.secondary_regions = n): every other cell,
  *   of spacing k·h (k = adaptivity.secondary_lod), in nested shells around the primary
  *   (adaptivity.shell_cells coarse cells thick; the outermost takes the rest) — except
- *   adaptivity.support_layers coarse cells around each fixed corner, refined to h too because a
- *   coarse cell at a point support is far too stiff (its stiffness is singular);
+ *   adaptivity.support_layers coarse cells around each point support (the cube's corners), refined
+ *   to h too because a coarse cell at a point support is far too stiff (its stiffness is
+ *   singular); and the cells the object fills only in part or with two materials (its surface,
+ *   its material boundaries), refined so each coarse element is whole and of one material;
  * - an **interface Γ** between each pair of neighbouring shells: the independent nodes touched by
  *   elements of both. The outer region owns it (integrates it with the lumped mass of both sides
  *   and receives the inner region's forces); the inner region takes Γ's displacement as a
@@ -45,7 +49,11 @@ class RegionPartition {
 
   const Scene& scene() const { return scene_; }
   const HybridMesh& mesh() const { return *mesh_; }
+  /** The object's materials, indexed by HybridElement::material. */
+  const std::vector<Material>& materials() const { return materials_; }
   const Eigen::VectorXd& dof_mass() const { return dof_mass_; }
+  /** Each DOF's damping rate, 1/s (HybridMesh::DofDamping). */
+  const Eigen::VectorXd& dof_damping() const { return dof_damping_; }
   int num_regions() const { return static_cast<int>(stiffness_.size()); }
   /** K of the region's elements: by node stencils where they are all fine (BoxStiffness). */
   const StiffnessOperator& stiffness(RegionIndex region) const { return *stiffness_[region]; }
@@ -55,6 +63,9 @@ class RegionPartition {
 
   /** The contact node's x, y, z DOFs (in the primary region). */
   const std::array<int, 3>& contact_dofs() const { return contact_dofs_; }
+  /** The contact node's lattice indices and its unit inward normal (SceneObject). */
+  const LatticeIndex& contact_node() const { return contact_lattice_; }
+  const std::array<double, 3>& contact_normal() const { return contact_normal_; }
 
   int num_elements(RegionIndex region) const;
   /** Independent nodes touched by the region's elements. */
@@ -69,7 +80,10 @@ class RegionPartition {
 
   Scene scene_;
   std::unique_ptr<HybridMesh> mesh_;
-  Eigen::VectorXd dof_mass_;
+  std::vector<Material> materials_;
+  Eigen::VectorXd dof_mass_, dof_damping_;
+  LatticeIndex contact_lattice_{};
+  std::array<double, 3> contact_normal_{};
   std::vector<std::unique_ptr<StiffnessOperator>> stiffness_;
   std::vector<RegionDofs> dofs_;
   std::vector<std::vector<int>> band_;

@@ -15,14 +15,13 @@ namespace {
 
 // Fills the lattice from the mesh's independent values (HybridMesh::FieldAt).
 void Prolong(const HybridMesh& mesh, const Eigen::VectorXd& values, std::vector<double>* lattice) {
-  const int n = mesh.options().nodes_per_axis;
-  lattice->assign(static_cast<size_t>(3) * n * n * n, 0.0);
   ObjectState index;
-  index.nodes_per_axis = n;
+  index.lattice_nodes = mesh.options().lattice_nodes;
+  lattice->assign(3 * index.num_points(), 0.0);
   std::array<GatherTerm, 8> terms;
-  for (int ix = 0; ix < n; ++ix) {
-    for (int iy = 0; iy < n; ++iy) {
-      for (int iz = 0; iz < n; ++iz) {
+  for (int ix = 0; ix < index.lattice_nodes[0]; ++ix) {
+    for (int iy = 0; iy < index.lattice_nodes[1]; ++iy) {
+      for (int iz = 0; iz < index.lattice_nodes[2]; ++iz) {
         double* out = lattice->data() + index.Index(ix, iy, iz);
         const int count = mesh.FieldAt({ix, iy, iz}, &terms);
         for (int i = 0; i < count; ++i) {
@@ -61,7 +60,7 @@ ObjectState AsyncRegions::CaptureState() const {
   // The contact is the primary's prescribed DOF; the supports stay zero.
   for (int dof : partition_.contact_dofs()) take(*regions_[kPrimaryRegion]->integrator, dof);
   ObjectState state;
-  state.nodes_per_axis = mesh.options().nodes_per_axis;
+  state.lattice_nodes = mesh.options().lattice_nodes;
   Prolong(mesh, u, &state.displacement_m);
   Prolong(mesh, v, &state.velocity_m_per_s);
   return state;
@@ -69,12 +68,15 @@ ObjectState AsyncRegions::CaptureState() const {
 
 void AsyncRegions::RestoreState(const ObjectState& state) {
   const HybridMesh& mesh = partition_.mesh();
-  const int n = mesh.options().nodes_per_axis;
-  const size_t size = static_cast<size_t>(3) * n * n * n;
-  if (state.nodes_per_axis != n || state.displacement_m.size() != size ||
+  const std::array<int, 3>& n = mesh.options().lattice_nodes;
+  const size_t size = 3 * state.num_points();
+  if (state.lattice_nodes != n || state.displacement_m.size() != size ||
       state.velocity_m_per_s.size() != size) {
-    throw Error("a state of " + std::to_string(state.nodes_per_axis) +
-                " nodes per axis cannot start regions of " + std::to_string(n));
+    auto text = [](const std::array<int, 3>& m) {
+      return std::to_string(m[0]) + " × " + std::to_string(m[1]) + " × " + std::to_string(m[2]);
+    };
+    throw Error("a state of a lattice of " + text(state.lattice_nodes) +
+                " nodes cannot start regions of " + text(n));
   }
   StartFrom(Inject(mesh, state, state.displacement_m), Inject(mesh, state, state.velocity_m_per_s));
 }

@@ -17,7 +17,7 @@ namespace hapticsim {
 // are zero, so they have no term.
 void AsyncRegions::BuildSurface() {
   const HybridMesh& mesh = partition_.mesh();
-  const int n = mesh.options().nodes_per_axis;
+  const auto [nx, ny, nz] = mesh.options().lattice_nodes;
   std::vector<RegionIndex> owner(static_cast<size_t>(mesh.num_dofs()), -1);
   for (int a = 0; a < num_regions(); ++a) {
     for (int dof : partition_.dofs(a).owned) owner[dof] = a;
@@ -35,13 +35,12 @@ void AsyncRegions::BuildSurface() {
   surface_ = SurfaceMap{};
   surface_.term_start.push_back(0);
   std::array<GatherTerm, 8> field;
-  for (int ix = 0; ix < n; ++ix) {
-    for (int iy = 0; iy < n; ++iy) {
-      for (int iz = 0; iz < n; ++iz) {
-        const bool on_face =
-            ix == 0 || iy == 0 || iz == 0 || ix == n - 1 || iy == n - 1 || iz == n - 1;
-        if (!on_face) continue;
-        surface_.ids.push_back((ix * n + iy) * n + iz);
+  for (int ix = 0; ix < nx; ++ix) {
+    for (int iy = 0; iy < ny; ++iy) {
+      for (int iz = 0; iz < nz; ++iz) {
+        const int occupied = mesh.OccupiedCellsAround({ix, iy, iz});
+        if (occupied == 0 || occupied == 8) continue;  // outside, or inside the object
+        surface_.ids.push_back((ix * ny + iy) * nz + iz);
         const int count = mesh.FieldAt({ix, iy, iz}, &field);
         for (int c = 0; c < 3; ++c) {
           for (int i = 0; i < count; ++i) {

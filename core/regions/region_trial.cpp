@@ -32,8 +32,7 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
                                                    const TrialFrames& frames) {
   TrialResult result;
   result.stability = regions_[kPrimaryRegion]->schedule.alone;
-  const Scene& scene = partition_.scene();
-  const ContactTrajectory trajectory(input, InwardNormal(scene.mesh, ContactNode(scene)));
+  const ContactTrajectory trajectory(input, partition_.contact_normal());
   const std::array<double, 3>& normal = trajectory.inward_normal();
   const double dt = 1.0 / regions_[kPrimaryRegion]->schedule.rate_hz;
   // As Scene::num_steps(), so a trial of the scene's own input matches the reference's length.

@@ -13,7 +13,9 @@
 namespace hapticsim {
 namespace {
 
-void ValidateAdaptivity(const Scene& scene) {
+// On a geometry the lattice need not be k·m + 1 nodes (the hybrid mesh refines the cells past its
+// end) and whether a secondary region is left is known once the object is built (RegionPartition).
+void ValidateCubeAdaptivity(const Scene& scene) {
   const AdaptivitySettings& a = scene.adaptivity;
   const int intervals = scene.mesh.nodes - 1;
   if (intervals % a.secondary_lod != 0) {
@@ -22,6 +24,21 @@ void ValidateAdaptivity(const Scene& scene) {
                 " node intervals of mesh.nodes = " + std::to_string(scene.mesh.nodes) +
                 ": adaptivity.secondary_lod must divide mesh.nodes - 1");
   }
+  if (PrimaryBoxCoversObject(scene, a.primary_size)) {
+    int largest = 0;
+    while (largest + 1 < a.primary_size && !PrimaryBoxCoversObject(scene, largest + 1)) ++largest;
+    throw Error("adaptivity.primary_size = " + std::to_string(a.primary_size) +
+                " covers the whole object, leaving no secondary region: adaptivity.primary_size "
+                "must be from 1 to " +
+                std::to_string(largest) +
+                " for this mesh and "
+                "adaptivity.secondary_lod, or 0 to switch adaptivity off");
+  }
+}
+
+void ValidateAdaptivity(const Scene& scene) {
+  const AdaptivitySettings& a = scene.adaptivity;
+  if (!scene.geometry.from_file()) ValidateCubeAdaptivity(scene);
   const double primary_rate = 1.0 / scene.solver.dt_s;
   if (std::abs(primary_rate - std::round(primary_rate)) > 1e-9 * primary_rate) {
     throw Error(
@@ -36,16 +53,6 @@ void ValidateAdaptivity(const Scene& scene) {
                   " must be at most the primary rate 1/solver.dt = " +
                   FormatReal(std::round(primary_rate)) + " Hz");
     }
-  }
-  if (PrimaryBoxCoversObject(scene, a.primary_size)) {
-    int largest = 0;
-    while (largest + 1 < a.primary_size && !PrimaryBoxCoversObject(scene, largest + 1)) ++largest;
-    throw Error("adaptivity.primary_size = " + std::to_string(a.primary_size) +
-                " covers the whole object, leaving no secondary region: adaptivity.primary_size "
-                "must be from 1 to " +
-                std::to_string(largest) +
-                " for this mesh and "
-                "adaptivity.secondary_lod, or 0 to switch adaptivity off");
   }
 }
 
@@ -67,12 +74,6 @@ void ValidateCubeScene(const Scene& scene) {
 // What the geometry's lattice decides (the contact node, the labels) is checked where the model
 // is built (SceneModel) and where the file is read; here, what the keys alone decide.
 void ValidateGeometryScene(const Scene& scene) {
-  if (scene.adaptivity.enabled()) {
-    throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
-                " is not available with geometry.file yet: the asynchronous regions run on the "
-                "built-in cube only; set adaptivity.primary_size = 0 for the full-resolution "
-                "reference");
-  }
   if (const auto& loaded = scene.loaded_geometry; loaded && loaded->source == scene.geometry) {
     const LabelVolume& voxels = loaded->voxels;
     const double smallest =
@@ -155,15 +156,21 @@ void ValidateScene(const Scene& scene) {
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
   if (scene.input.waveform == Waveform::kStroke) ValidateStroke(scene);
-  if (scene.adaptivity.enabled()) {
-    if (!scene.materials.empty() || !scene.supports.empty()) {
-      throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
-                  " is not available with [[material]] or [[support]] tables yet: the "
-                  "asynchronous regions run on the paper's cube, [material] and its four back "
-                  "corners; set adaptivity.primary_size = 0 for the full-resolution reference");
-    }
-    ValidateAdaptivity(scene);
+  if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
+}
+
+std::string CubeOnlyProblem(const Scene& scene, const std::string& who) {
+  std::string what;
+  if (scene.geometry.from_file()) {
+    what = "geometry.file";
+  } else if (!scene.materials.empty() || !scene.supports.empty()) {
+    what = "[[material]] or [[support]] tables";
+  } else {
+    return "";
   }
+  return who + " runs the built-in cube only so far, not a scene with " + what +
+         ": run it offline with `hapticsim simulate` (the reference, or the regions with "
+         "adaptivity.primary_size >= 1)";
 }
 
 std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node) {

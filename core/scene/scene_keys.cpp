@@ -284,8 +284,8 @@ void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
       [](double v) { return v >= 1 && v == std::floor(v); }));
   keys.push_back(Integer(
       {"adaptivity.support_layers", "", "a whole number from 0 to 100",
-       "coarse cells refined around each fixed node (the supports are "
-       "singular: a coarse cell there is far too stiff)"},
+       "coarse cells refined around each point support, a held node with no held "
+       "neighbour such as the cube's corners (singular: a coarse cell there is far too stiff)"},
       [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
   keys.push_back(Integer(
       {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",

@@ -131,23 +131,30 @@ DofConstraints Constraints(const HexGrid& grid, const std::vector<int>& fixed, i
 
 }  // namespace
 
-SceneModel::SceneModel(const Scene& scene)
-    : scene_(scene), model_([&] {
-        ValidateScene(scene);
-        ObjectLayout object = scene.geometry.from_file() ? VolumeLayout(scene) : CubeLayout(scene);
-        origin_m_ = object.origin_m;
-        fixed_nodes_ = FixedNodes(scene, object);
-        contact_node_ = ContactOf(scene, object);
-        HAPTICSIM_THROW_UNLESS(!std::binary_search(fixed_nodes_.begin(), fixed_nodes_.end(),
-                                                   contact_node_),
-                               "the contact node is held by a support: the contact node must "
-                               "be free to move (move input.contact_node or the support)");
-        contact_normal_ = NormalOf(scene, object, contact_node_);
-        const std::string rigid = RigidBodyModeProblem(object.grid, object.field, fixed_nodes_);
-        HAPTICSIM_THROW_UNLESS(rigid.empty(), "the supports do not hold the object: " + rigid);
-        return ElasticModel(object.grid, std::move(object.field),
-                            Constraints(object.grid, fixed_nodes_, contact_node_));
-      }()) {}
+SceneObject DescribeSceneObject(const Scene& scene) {
+  ValidateScene(scene);
+  ObjectLayout object = scene.geometry.from_file() ? VolumeLayout(scene) : CubeLayout(scene);
+  const std::vector<int> fixed = FixedNodes(scene, object);
+  const int contact = ContactOf(scene, object);
+  HAPTICSIM_THROW_UNLESS(!std::binary_search(fixed.begin(), fixed.end(), contact),
+                         "the contact node is held by a support: the contact node must be free "
+                         "to move (move input.contact_node or the support)");
+  const std::array<double, 3> normal = NormalOf(scene, object, contact);
+  const std::string rigid = RigidBodyModeProblem(object.grid, object.field, fixed);
+  HAPTICSIM_THROW_UNLESS(rigid.empty(), "the supports do not hold the object: " + rigid);
+  return SceneObject{object.grid, std::move(object.field), fixed, contact, normal, object.origin_m};
+}
+
+SceneModel::SceneModel(const Scene& scene) : SceneModel(scene, DescribeSceneObject(scene)) {}
+
+SceneModel::SceneModel(const Scene& scene, SceneObject object)
+    : scene_(scene),
+      contact_node_(object.contact_node),
+      contact_normal_(object.contact_normal),
+      fixed_nodes_(object.fixed_nodes),
+      origin_m_(object.origin_m),
+      model_(object.grid, std::move(object.field),
+             Constraints(object.grid, object.fixed_nodes, object.contact_node)) {}
 
 namespace {
 

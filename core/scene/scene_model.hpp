@@ -9,6 +9,26 @@
 namespace hapticsim {
 
 /**
+ * What a scene's object is, before it becomes a model: its lattice and materials, the nodes its
+ * supports hold (ascending), the contact node and its unit inward normal, and where node 0 sits in
+ * the geometry's own frame (m). What SceneModel steps and RegionPartition splits.
+ */
+struct SceneObject {
+  HexGrid grid;
+  MaterialField field;
+  std::vector<int> fixed_nodes;
+  int contact_node = 0;
+  std::array<double, 3> contact_normal{};
+  std::array<double, 3> origin_m{};
+};
+
+/**
+ * The object of a scene (see SceneModel for which): validated, its supports checked to hold it.
+ * @throws Error as SceneModel's constructor.
+ */
+SceneObject DescribeSceneObject(const Scene& scene);
+
+/**
  * A scene as a model ready to step: the object's lattice and materials, its supports fixed in
  * all three components, and the contact node driven in all three (driven DOF order x, y, z).
  *
@@ -38,6 +58,8 @@ class SceneModel {
   const std::array<double, 3>& origin_m() const { return origin_m_; }
 
  private:
+  SceneModel(const Scene& scene, SceneObject object);
+
   Scene scene_;
   int contact_node_ = 0;
   std::array<double, 3> contact_normal_{};

@@ -15,13 +15,12 @@ namespace {
 ObjectState LatticeState(const ElasticModel& model, const CentralDifferenceIntegrator& integrator) {
   const HexGrid& grid = model.grid();
   ObjectState state;
-  state.nodes_per_axis = grid.nx();
-  const int n = state.nodes_per_axis;
-  state.displacement_m.resize(static_cast<size_t>(3) * n * n * n);
+  state.lattice_nodes = {grid.nx(), grid.ny(), grid.nz()};
+  state.displacement_m.resize(3 * state.num_points());
   const Eigen::VectorXd& u = integrator.displacement();
-  for (int ix = 0; ix < n; ++ix) {
-    for (int iy = 0; iy < n; ++iy) {
-      for (int iz = 0; iz < n; ++iz) {
+  for (int ix = 0; ix < grid.nx(); ++ix) {
+    for (int iy = 0; iy < grid.ny(); ++iy) {
+      for (int iz = 0; iz < grid.nz(); ++iz) {
         const int node = grid.Node(ix, iy, iz);
         for (int c = 0; c < 3; ++c)
           state.displacement_m[state.Index(ix, iy, iz) + c] = u[grid.Dof(node, c)];

@@ -28,7 +28,7 @@ double RelativeDifference(const HybridMesh& mesh, const Material& material,
                           const std::vector<int>& ids, const BoxStiffness& box, unsigned seed) {
   std::mt19937 random(seed);
   std::normal_distribution<double> value(0, 1e-3);
-  const ElementSetStiffness elements(mesh, material, ids);
+  const ElementSetStiffness elements(mesh, {material}, ids);
   EXPECT_EQ(box.touched_dofs(), elements.touched_dofs());
   Eigen::VectorXd u(mesh.num_dofs());
   for (Eigen::Index i = 0; i < u.size(); ++i) u[i] = value(random);
@@ -57,7 +57,7 @@ TEST(BoxStiffness, GivesTheElementLoopsKuOnTheSameDofsForEveryPrimaryRegion) {
         }
         const HybridMesh& mesh = partition->mesh();
         const std::vector<int> ids = ElementsOf(mesh, kPrimaryRegion);
-        const auto box = BoxStiffness::TryMake(mesh, scene.material, ids);
+        const auto box = BoxStiffness::TryMake(mesh, {scene.material}, ids);
         ASSERT_NE(box, nullptr) << nodes << "³, lod " << lod << ", size " << size
                                 << ": the primary region is a box of fine elements";
         ++boxes;
@@ -100,7 +100,7 @@ TEST(BoxStiffness, GivesTheElementLoopsKuForSecondaryRegionsOfFineElements) {
         const HybridMesh& mesh = partition->mesh();
         for (int region = 1; region < partition->num_regions(); ++region) {
           const std::vector<int> ids = ElementsOf(mesh, region);
-          const auto box = BoxStiffness::TryMake(mesh, scene.material, ids);
+          const auto box = BoxStiffness::TryMake(mesh, {scene.material}, ids);
           ASSERT_NE(box, nullptr) << "fine elements are always accepted without a row minimum";
           ++regions;
           EXPECT_LT(RelativeDifference(mesh, scene.material, ids, *box, random()), 1e-12)
@@ -128,7 +128,7 @@ TEST(BoxStiffness, GivesTheElementLoopsKuForAnySetOfFineElements) {
     for (int e = 0; e < static_cast<int>(mesh.elements().size()); ++e) {
       if (kept(random)) ids.push_back(e);
     }
-    const auto box = BoxStiffness::TryMake(mesh, scene.material, ids);
+    const auto box = BoxStiffness::TryMake(mesh, {scene.material}, ids);
     ASSERT_NE(box, nullptr);
     EXPECT_LT(RelativeDifference(mesh, scene.material, ids, *box, random()), 1e-12)
         << "keeping " << keep << " of the cells";
@@ -142,14 +142,14 @@ TEST(BoxStiffness, RefusesCoarseElementsAnElementTwiceAndShortRows) {
   const HybridMesh& mesh = partition.mesh();
   std::vector<int> primary = ElementsOf(mesh, kPrimaryRegion);
   // Rows shorter than asked for: the 9 × 9 × 5 box is refused when rows of 10 are the minimum.
-  ASSERT_NE(BoxStiffness::TryMake(mesh, scene.material, primary, 9), nullptr);
-  EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, primary, 10), nullptr);
+  ASSERT_NE(BoxStiffness::TryMake(mesh, {scene.material}, primary, 9), nullptr);
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, {scene.material}, primary, 10), nullptr);
   primary.push_back(primary.front());
-  EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, primary), nullptr) << "an element twice";
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, {scene.material}, primary), nullptr) << "an element twice";
   // The secondary region at spacing factor 2: coarse elements.
-  EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, ElementsOf(mesh, kSecondaryRegion)),
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, {scene.material}, ElementsOf(mesh, kSecondaryRegion)),
             nullptr);
-  EXPECT_EQ(BoxStiffness::TryMake(mesh, scene.material, {}), nullptr);
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, {scene.material}, {}), nullptr);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace {
 
 HybridMesh::Options CubeOptions(int k, int r) {
   HybridMesh::Options o;
-  o.nodes_per_axis = 13;
+  o.lattice_nodes = {13, 13, 13};
   o.spacing_m = 0.25 / 12;
   o.coarse_factor = k;
   o.primary_lo = {6 - r, 6 - r, 0};
@@ -45,7 +45,7 @@ TEST(HybridMesh, WithoutCoarseningIsTheFullGrid) {
   EXPECT_EQ(dut.num_hanging(), 0);
   EXPECT_EQ(dut.elements().size(), 12u * 12 * 12);
   // …and its stiffness is the stencil's.
-  const ElementSetStiffness k(dut, Material{}, AllElements(dut));
+  const ElementSetStiffness k(dut, {Material{}}, AllElements(dut));
   const HexGrid grid(13, 13, 13, 0.25 / 12);
   const StencilStiffness oracle(grid, Material{});
   const Eigen::VectorXd u = testing::RandomField(grid.num_dofs(), 3);
@@ -74,8 +74,10 @@ TEST(HybridMesh, MassIsConservedAcrossHangingNodes) {
     const HybridMesh dut(CubeOptions(k, 2));
     EXPECT_GT(dut.num_hanging(), 0);
     const double rho = 1000, edge = 0.25;
+    Material material;
+    material.density_kg_m3 = rho;
     // Each component block carries the whole mass ρL³.
-    EXPECT_NEAR(dut.DofMass(rho).head(dut.num_independent()).sum(), rho * edge * edge * edge,
+    EXPECT_NEAR(dut.DofMass({material}).head(dut.num_independent()).sum(), rho * edge * edge * edge,
                 1e-12);
   }
 }
@@ -85,7 +87,7 @@ class PatchAcrossResolutionJumps : public ::testing::TestWithParam<int> {};
 TEST_P(PatchAcrossResolutionJumps, AffineFieldLeavesNoForceInside) {
   const HybridMesh dut(CubeOptions(GetParam(), 2));
   ASSERT_GT(dut.num_hanging(), 0);
-  const ElementSetStiffness k(dut, Material{}, AllElements(dut));
+  const ElementSetStiffness k(dut, {Material{}}, AllElements(dut));
   const Eigen::VectorXd r = testing::RandomField(12, 5, 1e-2);
   const Eigen::VectorXd u = Affine(dut, Eigen::Map<const Eigen::Matrix3d>(r.data()), r.tail<3>());
   Eigen::VectorXd ku = Eigen::VectorXd::Zero(dut.num_dofs());
@@ -108,8 +110,17 @@ TEST_P(PatchAcrossResolutionJumps, AffineFieldLeavesNoForceInside) {
 
 INSTANTIATE_TEST_SUITE_P(CoarseFactors, PatchAcrossResolutionJumps, ::testing::Values(2, 3, 4));
 
-TEST(HybridMesh, RejectsACoarseFactorThatDoesNotDivideTheGrid) {
-  EXPECT_THROW(HybridMesh(CubeOptions(5, 2)), Error);
+TEST(HybridMesh, ACoarseFactorThatDoesNotDivideTheGridRefinesTheCellsPastItsEnd) {
+  // 12 intervals, k = 5: coarse cells [0, 5], [5, 10] and [10, 15], the last partly past the end.
+  const HybridMesh mesh(CubeOptions(5, 2));
+  int covered = 0;
+  for (const HybridElement& e : mesh.elements()) {
+    covered += e.size_factor * e.size_factor * e.size_factor;
+    EXPECT_TRUE(e.size_factor == 1 || e.size_factor == 5);
+  }
+  EXPECT_EQ(covered, 12 * 12 * 12);
+  for (RegionIndex region : mesh.RegionPerLatticeCell()) EXPECT_GE(region, 0);
+  EXPECT_THROW(HybridMesh(CubeOptions(0, 2)), Error);
 }
 
 }  // namespace

@@ -15,7 +15,7 @@ constexpr double kH = 0.01;
 
 ObjectState Field(const std::function<std::array<double, 3>(double, double, double)>& u) {
   ObjectState state;
-  state.nodes_per_axis = kN;
+  state.lattice_nodes = {kN, kN, kN};
   state.displacement_m.resize(3 * kN * kN * kN);
   for (int ix = 0; ix < kN; ++ix) {
     for (int iy = 0; iy < kN; ++iy) {

@@ -39,7 +39,7 @@ Scene TwoShells() {
 
 TEST(RegionSurface, IsEveryPointOnTheCubesFacesOnce) {
   const AsyncRegions regions(TwoShells());
-  const int n = regions.partition().mesh().options().nodes_per_axis;
+  const int n = regions.partition().mesh().options().lattice_nodes[0];
   const std::vector<std::int32_t>& ids = regions.surface_ids();
   EXPECT_EQ(ids.size(), static_cast<size_t>(n * n * n - (n - 2) * (n - 2) * (n - 2)));
   for (size_t i = 0; i < ids.size(); ++i) {
@@ -58,14 +58,14 @@ TEST(RegionSurface, IsEveryPointOnTheCubesFacesOnce) {
 TEST(RegionSurface, ReproducesALinearFieldExactly) {
   for (const Scene& scene : {TwoShells(), testing::AdaptiveScene(3, 3, 1000)}) {
     AsyncRegions regions(scene);
-    const int n = regions.partition().mesh().options().nodes_per_axis;
+    const int n = regions.partition().mesh().options().lattice_nodes[0];
     const double A[3][3] = {{1e-3, 2e-4, -3e-4}, {-1e-4, 5e-4, 7e-4}, {2e-4, -6e-4, 9e-4}};
     const double b[3] = {1e-4, -2e-4, 3e-5};
     auto field = [&](const std::array<int, 3>& p, int c) {
       return A[c][0] * p[0] + A[c][1] * p[1] + A[c][2] * p[2] + b[c];
     };
     ObjectState state;
-    state.nodes_per_axis = n;
+    state.lattice_nodes = {n, n, n};
     state.displacement_m.assign(static_cast<size_t>(3) * n * n * n, 0.0);
     state.velocity_m_per_s.assign(state.displacement_m.size(), 0.0);
     for (int ix = 0; ix < n; ++ix) {

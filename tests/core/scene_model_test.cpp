@@ -20,29 +20,12 @@
 #include "core/scene/scene_toml.hpp"
 #include "core/scene/support_regions.hpp"
 #include "core/trial/reference_trial.hpp"
+#include "tests/support/voxel_scene.hpp"
 
 namespace hapticsim {
 namespace {
 
-// A scene whose object is the voxels `label(x, y, z)` of n³ voxels of edge `spacing_m`.
-Scene VoxelScene(int n, double spacing_m, const std::function<int(int, int, int)>& label) {
-  Scene scene;
-  scene.geometry.file = "voxels-made-by-the-test.nii";
-  scene.geometry.spacing_m = spacing_m;
-  auto loaded = std::make_shared<LoadedGeometry>();
-  loaded->source = scene.geometry;
-  LabelVolume& v = loaded->voxels;
-  v.voxels = {n, n, n};
-  v.spacing_m = spacing_m;
-  v.labels.resize(v.num_voxels());
-  for (int z = 0; z < n; ++z) {
-    for (int y = 0; y < n; ++y) {
-      for (int x = 0; x < n; ++x) v.labels[v.Index(x, y, z)] = static_cast<std::uint16_t>(label(x, y, z));
-    }
-  }
-  scene.loaded_geometry = loaded;
-  return scene;
-}
+using testing::VoxelScene;
 
 SupportRegion Box(std::array<double, 3> low, std::array<double, 3> high) {
   SupportRegion box;
@@ -185,11 +168,6 @@ TEST(SceneModel, RefusesWhatThePhysicsCannotRunSayingWhatToChange) {
   EXPECT_NE(MessageOf([&] { SceneModel{inside}; }).find("is not on the object's surface"),
             std::string::npos);
 
-  Scene adaptive = BlockWithInclusion(5.0);
-  adaptive.adaptivity.primary_size = 3;
-  EXPECT_NE(MessageOf([&] { SceneModel{adaptive}; }).find("not available with geometry.file"),
-            std::string::npos);
-
   Scene unread = BlockWithInclusion(5.0);
   unread.loaded_geometry.reset();
   EXPECT_NE(MessageOf([&] { SceneModel{unread}; }).find("has not been read"), std::string::npos);
@@ -251,9 +229,6 @@ TEST(SceneModel, BadTablesInASceneFileAreRefusedNamingThePlace) {
             std::string::npos);
   EXPECT_NE(message("[[support]]\nplane_point = [0, 0, 0]\nplane_normal = [0, 0, 0]\n")
                 .find("must not be zero"),
-            std::string::npos);
-  EXPECT_NE(message("[[support]]\nlabel = 1\n[adaptivity]\nprimary_size = 3\n")
-                .find("not available with [[material]] or [[support]] tables"),
             std::string::npos);
   EXPECT_NE(message("support = 3\n").find("must be tables written [[support]]"),
             std::string::npos);

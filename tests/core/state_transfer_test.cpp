@@ -102,7 +102,7 @@ TEST(StateTransfer, KeepsWhatTheFineLatticeHoldsAndInterpolatesTheCoarseCells) {
   const Scene coarse = testing::AdaptiveScene(2, 2, 600);
   ObjectState linear;
   const int n = fine.mesh.nodes;
-  linear.nodes_per_axis = n;
+  linear.lattice_nodes = {n, n, n};
   linear.displacement_m.assign(static_cast<size_t>(3 * n * n * n), 0.0);
   linear.velocity_m_per_s = linear.displacement_m;
   for (int ix = 0; ix < n; ++ix) {
@@ -180,7 +180,7 @@ TEST(StateTransfer, ALatticePointBetweenCoarseNodesTakesItsElementsField) {
   const HybridMesh& mesh = regions.partition().mesh();
   const int n = coarse.mesh.nodes;
   ObjectState random;
-  random.nodes_per_axis = n;
+  random.lattice_nodes = {n, n, n};
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
   random.displacement_m.resize(static_cast<size_t>(3 * n * n * n));
@@ -222,14 +222,14 @@ TEST(StateTransfer, ALatticePointBetweenCoarseNodesTakesItsElementsField) {
 TEST(StateTransfer, RefusesAStateOfAnotherLattice) {
   AsyncRegions regions(testing::AdaptiveScene(2, 2, 600));
   ObjectState other;
-  other.nodes_per_axis = 7;
+  other.lattice_nodes = {7, 7, 7};
   other.displacement_m.assign(3 * 7 * 7 * 7, 0.0);
   other.velocity_m_per_s = other.displacement_m;
   try {
     regions.RestoreState(other);
     FAIL() << "a state of 7 nodes per axis was taken by regions of 13";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("7 nodes per axis"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("7 × 7 × 7 nodes"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("13"), std::string::npos) << e.what();
   }
 }

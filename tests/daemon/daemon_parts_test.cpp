@@ -199,6 +199,17 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 // adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
 // main.cpp builds its HapticLoop). Without [adaptivity] the daemon starts from the default size
 // at equal rates.
+TEST(DaemonConfig, AnObjectOtherThanTheCubeIsRefusedSayingWhereItRuns) {
+  const std::string scene = ConfigTestPath() + ".scene.toml";
+  std::ofstream(scene) << "[[material]]\nlabel = 1\nyoungs_modulus = 20000.0\n";
+  const std::string error = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
+  EXPECT_NE(error.find("hapticsimd runs the built-in cube only so far, not a scene with "
+                       "[[material]] or [[support]] tables"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("hapticsim simulate"), std::string::npos) << error;
+}
+
 TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {
   const std::string scene_path = ::testing::TempDir() + "hapticsimd_outer_rate_scene.toml";
   std::ofstream(scene_path) << "[adaptivity]\nprimary_size = 2\nsecondary_lod = 2\n"

@@ -64,13 +64,13 @@ void BM_AssembledApply(benchmark::State& state) {
 void BM_ElementLoopApply(benchmark::State& state) {
   const int nodes = static_cast<int>(state.range(0));
   HybridMesh::Options options;
-  options.nodes_per_axis = nodes;
+  options.lattice_nodes = {nodes, nodes, nodes};
   options.spacing_m = 0.25 / (nodes - 1);
   options.coarse_factor = 1;
   const HybridMesh mesh(options);
   std::vector<int> all(mesh.elements().size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  const ElementSetStiffness k(mesh, Material{}, all);
+  const ElementSetStiffness k(mesh, {Material{}}, all);
   const Eigen::VectorXd u = Field(mesh.num_dofs());
   Eigen::VectorXd ku(mesh.num_dofs());
   for (auto _ : state) {
@@ -95,8 +95,8 @@ void BM_RegionApply(benchmark::State& state) {
   for (int e = 0; e < static_cast<int>(mesh.elements().size()); ++e) {
     if (mesh.elements()[static_cast<size_t>(e)].region == region) ids.push_back(e);
   }
-  const ElementSetStiffness elements(mesh, scene.material, ids);
-  const auto box = BoxStiffness::TryMake(mesh, scene.material, ids);
+  const ElementSetStiffness elements(mesh, {scene.material}, ids);
+  const auto box = BoxStiffness::TryMake(mesh, {scene.material}, ids);
   if (!box) {
     state.SkipWithError("the region's elements are not all fine");
     return;

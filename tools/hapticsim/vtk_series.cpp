@@ -20,7 +20,7 @@ VtkSeries::VtkSeries(const fs::path& dir, const std::string& name, const Scene& 
 }
 
 void VtkSeries::Write(double t_s, const ObjectState& state) {
-  const int n = state.nodes_per_axis;
+  const int n = state.lattice_nodes[0];  // the cube: --vtk is refused for other objects
   const int cells = (n - 1) * (n - 1) * (n - 1);
   HAPTICSIM_THROW_UNLESS(static_cast<int>(region_per_cell_.size()) == cells,
                          "internal: the regions are not the lattice's cells");
