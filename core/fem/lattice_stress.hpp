@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "core/fem/material.hpp"
@@ -17,5 +18,14 @@ namespace hapticsim {
  */
 std::vector<double> VonMisesPerCell(const ObjectState& state, double spacing_m,
                                     const Material& material);
+
+/**
+ * The same for an object of several materials on the lattice: `cell_material` per cell in the
+ * same order (ix slowest), an index into `materials`, or −1 where the object is not (stress 0).
+ * @throws Error when `cell_material` is not the lattice's cells.
+ */
+std::vector<double> VonMisesPerCell(const ObjectState& state, double spacing_m,
+                                    const std::vector<Material>& materials,
+                                    const std::vector<std::int16_t>& cell_material);
 
 }  // namespace hapticsim

@@ -52,9 +52,6 @@ TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& option
   const Scene& scene = cube.scene();
   if (scene.input.waveform == Waveform::kStroke) return RunStrokeTrial(cube).trial;
   const ElasticModel& model = cube.model();
-  // ObjectState, the frames' form, is the cube's lattice.
-  HAPTICSIM_THROW_UNLESS(options.frames.every_periods == 0 || !scene.geometry.from_file(),
-                         "frames of a trial are drawn for the built-in cube only for now");
   TrialResult result;
   result.stability = EstimateStability(model);
   const double dt = scene.solver.dt_s;

@@ -8,7 +8,12 @@ vtkXMLUnstructuredGridReader against what is independent of the writer: the pres
 trajectory at the touched node, the supports at zero, the von Mises stress recomputed here from
 the points and displacements read back, the primary region around the touched node, and the
 adaptive shape against the full-resolution reference's at the same times.
+
+Then the same on examples/palpation's phantom (a NIfTI volume, two materials): its cells against
+the voxels VTK's own NIfTI reader counts in the file, label by label, the held back face at zero,
+the contact on the press, von Mises of each cell's own material.
 """
+import json
 import math
 import shutil
 import subprocess
@@ -42,12 +47,12 @@ def frames_of(pvd):
     return [(float(d.get("timestep")), pvd.parent / d.get("file")) for d in root.iter("DataSet")]
 
 
-def read(vtu):
+def read(vtu, points=N ** 3, cells=(N - 1) ** 3):
     reader = vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(str(vtu))
     reader.Update()
     grid = reader.GetOutput()
-    if grid.GetNumberOfPoints() != N ** 3 or grid.GetNumberOfCells() != (N - 1) ** 3:
+    if grid.GetNumberOfPoints() != points or grid.GetNumberOfCells() != cells:
         fail(f"{vtu}: {grid.GetNumberOfPoints()} points, {grid.GetNumberOfCells()} cells")
     if any(grid.GetCellType(c) != vtk.VTK_HEXAHEDRON for c in range(grid.GetNumberOfCells())):
         fail(f"{vtu}: a cell is not a hexahedron")
@@ -56,17 +61,20 @@ def read(vtu):
         "u": vtk_to_numpy(grid.GetPointData().GetArray("displacement_m")),
         "von_mises": vtk_to_numpy(grid.GetCellData().GetArray("von_mises_pa")),
         "region": vtk_to_numpy(grid.GetCellData().GetArray("region")),
+        "material": vtk_to_numpy(grid.GetCellData().GetArray("material")),
         "cells": [[grid.GetCell(c).GetPointId(k) for k in range(8)]
                   for c in range(grid.GetNumberOfCells())],
     }
 
 
-def von_mises(frame):
-    """Recomputed here: the trilinear cell's strain at its centre from its 8 corners' values."""
-    lam = E * NU / ((1 + NU) * (1 - 2 * NU))
-    mu = E / (2 * (1 + NU))
+def von_mises(frame, youngs=None):
+    """Recomputed here: the trilinear cell's strain at its centre from its 8 corners' values;
+    `youngs[c]` the Young's modulus of cell c (default: E everywhere)."""
     out = []
-    for corners in frame["cells"]:
+    for c, corners in enumerate(frame["cells"]):
+        e = E if youngs is None else youngs[c]
+        lam = e * NU / ((1 + NU) * (1 - 2 * NU))
+        mu = e / (2 * (1 + NU))
         x = frame["points"][corners]
         u = frame["u"][corners]
         lo, hi = x.min(axis=0), x.max(axis=0)
@@ -139,5 +147,61 @@ def main():
           f"largest displacement")
 
 
+def nifti_labels(path):
+    """The label of every voxel, counted by VTK's own NIfTI reader."""
+    reader = vtk.vtkNIFTIImageReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return numpy.bincount(vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).ravel())
+
+
+def check_phantom(cli, work):
+    """The palpation phantom at 5 mm voxels: 16 x 8 x 6, an inclusion 8x stiffer (label 2)."""
+    examples = Path(__file__).resolve().parents[2] / "examples" / "palpation"
+    subprocess.run(["/usr/bin/python3", str(examples / "make_phantom.py"), str(work / "phantom.nii"),
+                    "--voxel-mm", "5"], check=True, capture_output=True)
+    shutil.copy(examples / "palpation.toml", work / "palpation.toml")
+    scene = ["--scene", str(work / "palpation.toml")]
+    static = subprocess.run([cli, "static", "--json"] + scene, capture_output=True, text=True)
+    if static.returncode != 0:
+        fail(f"static: {static.stderr}")
+    facts = json.loads(static.stdout)
+    nx, ny, nz = facts["lattice_nodes"]
+    contact = facts["contact_node"]
+    out = work / "phantom-vtk"
+    run = subprocess.run([cli, "simulate"] + scene + ["--set", "adaptivity.primary_size=2",
+                          "--set", "adaptivity.secondary_rate=1000", "--vtk", str(out),
+                          "--vtk-rate", "5"], capture_output=True, text=True)
+    if run.returncode != 0:
+        fail(f"simulate --vtk on the phantom exited {run.returncode}: {run.stderr}")
+    labels = nifti_labels(work / "phantom.nii")
+    voxels = int(labels[1:].sum())
+    for name in ("adaptive", "reference"):
+        for t, vtu in frames_of(out / f"{name}.pvd"):
+            frame = read(vtu, points=nx * ny * nz, cells=voxels)
+            # Each label's voxels are its material's cells: [[material]] label 1 is 0, 2 is 1.
+            if list(numpy.bincount(frame["material"], minlength=2)) != [labels[1], labels[2]]:
+                fail(f"phantom {name} t={t}: materials {numpy.bincount(frame['material'])}, "
+                     f"labels in the file {labels}")
+            used = numpy.unique(numpy.array(frame["cells"]).ravel())
+            back = used[numpy.isclose(frame["points"][used][:, 2], 0.03)]
+            if len(back) == 0 or numpy.any(frame["u"][back] != 0):
+                fail(f"phantom {name} t={t}: the held back face moved")
+            depth = 0.003 * (1 - math.cos(2 * math.pi * t)) / 2
+            touched = frame["u"][(contact[0] * ny + contact[1]) * nz + contact[2]]
+            if abs(touched[2] - depth) > 1e-12:
+                fail(f"phantom {name} t={t}: the contact at {touched}, the press at {depth}")
+            youngs = numpy.where(frame["material"] == 1, 80e3, 10e3)
+            mine = von_mises(frame, youngs)
+            if numpy.max(numpy.abs(mine - frame["von_mises"])) > 1e-9 * max(1e-9, mine.max()):
+                fail(f"phantom {name} t={t}: von Mises differs from the recomputation")
+            if name == "adaptive" and not (numpy.any(frame["region"] == 0) and
+                                           numpy.any(frame["region"] >= 1)):
+                fail(f"phantom t={t}: regions {numpy.unique(frame['region'])}")
+    print(f"vtk: the phantom's {voxels} voxels ({labels[2]} of the inclusion) read back as cells of "
+          "their materials, the back face held, the contact on the press, von Mises per material")
+
+
 if __name__ == "__main__":
     main()
+    check_phantom(sys.argv[1], Path(sys.argv[2]))

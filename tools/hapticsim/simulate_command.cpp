@@ -49,16 +49,14 @@ TrialFrames FramesInto(VtkSeries& series, const Scene& scene, double rate_hz) {
 // The full-resolution reference, with frames into `vtk` ("reference") when asked.
 TrialResult RunReference(const Scene& scene, TrialOptions options, VtkOutput* vtk) {
   std::optional<VtkSeries> series;
-  HAPTICSIM_THROW_UNLESS(!vtk || !scene.geometry.from_file(),
-                         "--vtk draws the built-in cube only for now: leave it out with "
-                         "geometry.file");
+  const SceneModel model(scene);
   if (vtk) {
-    const int n = scene.mesh.nodes;
-    series.emplace(vtk->dir, "reference", scene,
-                   std::vector<RegionIndex>(static_cast<size_t>(n - 1) * (n - 1) * (n - 1), 0));
+    VtkObject object = VtkObjectOf(DescribeSceneObject(scene));
+    std::vector<RegionIndex> one_region(object.cell_material.size(), 0);
+    series.emplace(vtk->dir, "reference", std::move(object), std::move(one_region));
     options.frames = FramesInto(*series, scene, vtk->rate_hz);
   }
-  TrialResult result = RunReferenceTrial(SceneModel(scene), options);
+  TrialResult result = RunReferenceTrial(model, options);
   if (series) {
     series->Finish();
     vtk->written.push_back(series->collection());
@@ -123,7 +121,8 @@ TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report
   std::optional<VtkSeries> series;
   TrialFrames frames;
   if (vtk) {
-    series.emplace(vtk->dir, "adaptive", scene, regions.partition().mesh().RegionPerLatticeCell());
+    series.emplace(vtk->dir, "adaptive", VtkObjectOf(DescribeSceneObject(scene)),
+                   regions.partition().mesh().RegionPerLatticeCell());
     frames = FramesInto(*series, scene, vtk->rate_hz);
   }
   TrialResult result;
@@ -384,8 +383,9 @@ Command AddSimulateCommand(CLI::App& parent) {
                 "and report deadlines and the difference from the virtual-time run");
   app->add_option("--vtk", options->vtk_dir,
                   "Write the run as a VTK time series ParaView opens: DIR/adaptive.pvd and "
-                  "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame with "
-                  "displacement (m), von Mises stress (Pa) and region id")
+                  "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame of the "
+                  "object's voxels with displacement (m), von Mises stress (Pa), region id and "
+                  "material")
       ->type_name("DIR");
   app->add_option("--vtk-rate", options->vtk_rate_hz, "Frames per simulated second of --vtk, Hz")
       ->capture_default_str()
