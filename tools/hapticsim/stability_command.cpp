@@ -53,7 +53,7 @@ int RunAdaptive(const SceneOptions& options, const Scene& scene, bool estimate) 
     std::cout << out.dump(2) << "\n";
     return kExitOk;
   }
-  std::cout << "Stability of the asynchronous regions: " << scene.mesh.nodes << "³-node cube\n";
+  std::cout << "Stability of the asynchronous regions: " << ObjectDescription(scene) << "\n";
   for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
     const RegionSchedule& s = regions.schedule(r);
     std::cout << "  " << p.RegionName(r) << ": own limit " << Duration(s.alone.critical_dt_s)
@@ -86,11 +86,14 @@ int RunAllConfigurations(const SceneOptions& options, const Scene& base) {
   nlohmann::json rows = nlohmann::json::array();
   int stable_count = 0, total = 0;
   if (!options.json) {
-    std::cout << "Coupled stability of the adaptive configurations: " << base.mesh.nodes
-              << "³-node cube, ν " << base.material.poisson_ratio << ", E "
-              << Quantity(base.material.youngs_modulus_pa, "Pa") << ", ρ "
-              << Quantity(base.material.density_kg_m3, "kg/m³") << ", d "
-              << Quantity(base.material.damping_per_s, "1/s") << "\n"
+    std::cout << "Coupled stability of the adaptive configurations: " << ObjectDescription(base);
+    if (base.materials.empty()) {  // else each label's own, in its [[material]] table
+      std::cout << ", ν " << base.material.poisson_ratio << ", E "
+                << Quantity(base.material.youngs_modulus_pa, "Pa") << ", ρ "
+                << Quantity(base.material.density_kg_m3, "kg/m³") << ", d "
+                << Quantity(base.material.damping_per_s, "1/s");
+    }
+    std::cout << "\n"
               << "  spectral radius per common period (< 1 decays); rows k, r; columns rate\n"
               << "  k r     1000 Hz     900 Hz     800 Hz     700 Hz     600 Hz\n";
   }

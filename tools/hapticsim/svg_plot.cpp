@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "tools/hapticsim/format.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -93,11 +94,14 @@ void WriteForcePlot(const std::string& path, const TrialResult& result, const Sc
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidth << "' height='" << height
       << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
          "fill='white'/>\n<text x='"
-      << kLeft << "' y='22' font-size='14'>Force on the user: " << scene.mesh.nodes
-      << "³-node cube, " << WaveformName(scene.input.waveform) << " of "
-      << Number(scene.input.amplitude_m) << " m at " << Number(scene.input.frequency_hz)
-      << " Hz, E " << Number(scene.material.youngs_modulus_pa) << " Pa, ν "
-      << Number(scene.material.poisson_ratio) << "</text>\n";
+      << kLeft << "' y='22' font-size='14'>Force on the user: " << ObjectDescription(scene) << ", "
+      << WaveformName(scene.input.waveform) << " of " << Number(scene.input.amplitude_m) << " m at "
+      << Number(scene.input.frequency_hz) << " Hz";
+  if (scene.materials.empty()) {  // else each label's own, in its [[material]] table
+    svg << ", E " << Number(scene.material.youngs_modulus_pa) << " Pa, ν "
+        << Number(scene.material.poisson_ratio);
+  }
+  svg << "</text>\n";
   Panel(svg, kTop, samples, t_end,
         {{[](const ForceSample& s) { return s.feedback_force_n[0]; }, "#1b9e77", "force x"},
          {[](const ForceSample& s) { return s.feedback_force_n[1]; }, "#7570b3", "force y"},
