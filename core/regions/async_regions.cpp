@@ -32,7 +32,7 @@ inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChann
 Material FloorMaterial(const RegionPartition& p) {
   const int uniform = p.mesh().uniform_material();
   if (uniform >= 0) return p.materials()[uniform];
-  Material floor = p.materials().front();
+  Material floor = p.materials()[p.mesh().elements().front().material];  // one in use
   double volume_m3 = 0, mass_kg = 0;
   const double h = p.mesh().options().spacing_m;
   for (const HybridElement& e : p.mesh().elements()) {

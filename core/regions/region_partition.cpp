@@ -100,14 +100,27 @@ void RegionPartition::AssignDofs(const std::vector<std::array<int, 3>>& supports
   const int contact_node = mesh_->IndependentAt(contact[0], contact[1], contact[2]);
   HAPTICSIM_THROW_UNLESS(contact_node >= 0, "internal: the contact node is not independent");
   for (int c = 0; c < 3; ++c) contact_dofs_[c] = mesh_->Dof(contact_node, c);
+  std::vector<std::array<int, 3>> not_nodes;  // held lattice points with no node of their own
   for (const auto& s : supports) {
     const int node = mesh_->IndependentAt(s[0], s[1], s[2]);
-    // A held node that hangs hangs from held nodes only (HybridMesh refines where it would not),
-    // so it is held through them.
-    if (node < 0) continue;
+    // A held node that hangs (or lies inside a coarse cell) takes the field of held nodes only
+    // (HybridMesh refines where it would not), so it is held through them: checked below.
+    if (node < 0) {
+      not_nodes.push_back(s);
+      continue;
+    }
     for (int c = 0; c < 3; ++c) fixed_dofs_.push_back(mesh_->Dof(node, c));
   }
   std::sort(fixed_dofs_.begin(), fixed_dofs_.end());
+  std::array<GatherTerm, 8> terms;
+  for (const auto& s : not_nodes) {
+    const int count = mesh_->FieldAt(s, &terms);
+    for (int i = 0; i < count; ++i) {
+      HAPTICSIM_THROW_UNLESS(std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(),
+                                                mesh_->Dof(terms[i].independent, 0)),
+                             "internal: a held node leans on a free node");
+    }
+  }
 
   const auto& mask = mesh_->region_mask();
   const int nr = mesh_->num_independent();

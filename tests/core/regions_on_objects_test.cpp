@@ -17,6 +17,7 @@
 #include "core/fem/hex_grid.hpp"
 #include "core/fem/material_field.hpp"
 #include "core/regions/async_regions.hpp"
+#include "core/regions/box_stiffness.hpp"
 #include "core/regions/element_set_stiffness.hpp"
 #include "core/regions/hybrid_mesh.hpp"
 #include "core/scene/scene_model.hpp"
@@ -202,16 +203,41 @@ TEST(HybridMeshOnAnObject, AtFactorOneItIsTheFineGridsStiffnessAndDamping) {
   EXPECT_GT(between, 0) << "no node on the material boundary";
 }
 
+TEST(HybridMeshOnAnObject, TheBoxStencilTakesOneMaterialOnlyAndThenAgreesWithTheElements) {
+  const HybridMesh mesh(NotchedOptions(1));
+  const std::vector<Material> materials = TwoMaterials();
+  EXPECT_EQ(BoxStiffness::TryMake(mesh, materials, AllElements(mesh)), nullptr)
+      << "two materials in one box: the element loop";
+  std::vector<int> tissue;
+  for (int e : AllElements(mesh))
+    if (mesh.elements()[e].material == 0) tissue.push_back(e);
+  const auto box = BoxStiffness::TryMake(mesh, materials, tissue);
+  ASSERT_NE(box, nullptr);
+  const ElementSetStiffness elements(mesh, materials, tissue);
+  Eigen::VectorXd u(mesh.num_dofs());
+  // Each writes only the DOFs its elements touch: the rest stay zero in both.
+  Eigen::VectorXd by_box = Eigen::VectorXd::Zero(mesh.num_dofs()), by_elements = by_box;
+  for (int i = 0; i < u.size(); ++i) u[i] = std::cos(0.37 * i) * 1e-3;
+  box->Apply(u, by_box);
+  elements.Apply(u, by_elements);
+  EXPECT_LT((by_box - by_elements).cwiseAbs().maxCoeff(), 1e-12 * by_elements.cwiseAbs().maxCoeff());
+}
+
 TEST(HybridMeshOnAnObject, EveryHeldNodeIsHeldExactly) {
   // The whole back face, and its part x ≤ 5 h: there a held node at x = 5 h would hang between a
-  // held coarse vertex (x = 4 h) and a free one (6 h) unless its cell is refined.
+  // held coarse vertex (x = 4 h) and a free one (6 h) unless its cell is refined (k = 2; at k = 3
+  // the back face lies in cells the block fills only in part, refined anyway).
   std::vector<std::array<int, 3>> half;
   for (const auto& s : BackFace())
     if (s[0] <= 5) half.push_back(s);
-  for (const auto& supports : {BackFace(), half}) {
+  // And one node inside a coarse cell with no refinement around it (support_layers = 0): its
+  // cell's vertices are free, so the cell is refined.
+  const std::vector<std::array<int, 3>> inside{{5, 5, 7}};
+  for (const auto& supports : {BackFace(), half, inside}) {
     for (int k : {2, 3}) {
       HybridMesh::Options options = NotchedOptions(k);
       options.supports = supports;
+      options.support_layers = 0;
       const HybridMesh mesh(options);
       std::vector<char> held(static_cast<size_t>(mesh.num_independent()), 0);
       for (const auto& s : supports) {
@@ -259,10 +285,20 @@ TEST(AsyncRegionsOnAnObject, APressOverTheInclusionFollowsTheReference) {
   const RegionPartition& partition = regions.partition();
   EXPECT_EQ(partition.contact_node(), full.model().grid().NodeIndices(full.contact_node()));
   EXPECT_EQ(partition.contact_normal(), full.contact_normal());
-  // The primary is fine and clipped to the object: every element of it is a voxel of the block.
+  // The primary is fine, holds every voxel of the block inside the box of 2 nodes around the
+  // contact, and no empty one (the box reaches past the front face).
   for (const HybridElement& e : partition.mesh().elements()) {
     if (e.region == kPrimaryRegion) EXPECT_EQ(e.size_factor, 1);
   }
+  const std::vector<RegionIndex> region = partition.mesh().RegionPerLatticeCell();
+  const LatticeIndex& c = partition.contact_node();
+  for (int x = std::max(0, c[0] - 2); x < c[0] + 2; ++x)
+    for (int y = std::max(0, c[1] - 2); y < c[1] + 2; ++y)
+      for (int z = std::max(0, c[2] - 2); z < c[2] + 2; ++z) {
+        const size_t cell = (static_cast<size_t>(x) * kVoxels[1] + y) * kVoxels[2] + z;
+        EXPECT_EQ(region[cell], NotchedBlockLabel(x, y, z) > 0 ? kPrimaryRegion : -1)
+            << "voxel " << x << ", " << y << ", " << z;
+      }
   const TrialResult run = regions.RunTrial();
   ASSERT_EQ(run.outcome, TrialOutcome::kCompleted);
   const ForceError error = CompareForces(run.samples, reference.samples);
@@ -274,6 +310,24 @@ TEST(AsyncRegionsOnAnObject, APressOverTheInclusionFollowsTheReference) {
   EXPECT_LT(error.max_magnitude_percent, 3.0) << "peak " << run.peak_force_n << " N against "
                                               << reference.peak_force_n << " N";
   EXPECT_LT(error.max_direction_deg, 5.0);
+}
+
+TEST(AsyncRegionsOnAnObject, ItsSurfaceIsThePointsBetweenTheBlockAndTheNotchOrTheOutside) {
+  const AsyncRegions regions(NotchedScene(2, 2000));
+  std::vector<std::int32_t> expected;
+  const std::array<int, 3> n{kVoxels[0] + 1, kVoxels[1] + 1, kVoxels[2] + 1};
+  for (int ix = 0; ix < n[0]; ++ix)
+    for (int iy = 0; iy < n[1]; ++iy)
+      for (int iz = 0; iz < n[2]; ++iz) {
+        int filled = 0;
+        for (int x : {ix - 1, ix})
+          for (int y : {iy - 1, iy})
+            for (int z : {iz - 1, iz})
+              filled += x >= 0 && y >= 0 && z >= 0 && x < kVoxels[0] && y < kVoxels[1] &&
+                        z < kVoxels[2] && NotchedBlockLabel(x, y, z) > 0;
+        if (filled > 0 && filled < 8) expected.push_back((ix * n[1] + iy) * n[2] + iz);
+      }
+  EXPECT_EQ(regions.surface_ids(), expected);
 }
 
 TEST(AsyncRegionsOnAnObject, ItsStateCarriesToAnotherConfigurationOfTheSameObject) {
@@ -302,6 +356,44 @@ TEST(AsyncRegionsOnAnObject, ItsStateCarriesToAnotherConfigurationOfTheSameObjec
     }
   }
   EXPECT_GT(moved, 1e-4);
+  // Where the large configuration has no node: in the notch, zero; inside a coarse cell (all its
+  // 8 corners nodes of that mesh), the trilinear field of the corners' carried values.
+  const HybridMesh& mesh = large.partition().mesh();
+  int interpolated = 0;
+  for (int ix = 0; ix <= kVoxels[0]; ++ix)
+    for (int iy = 0; iy <= kVoxels[1]; ++iy)
+      for (int iz = 0; iz <= kVoxels[2]; ++iz) {
+        const size_t i = carried.Index(ix, iy, iz);
+        if (ix >= 9 && iy >= 7) {  // touched by notch voxels only
+          for (int k = 0; k < 3; ++k) EXPECT_EQ(carried.displacement_m[i + k], 0.0);
+          continue;
+        }
+        if (mesh.IndependentAt(ix, iy, iz) >= 0) continue;
+        const std::array<int, 3> low{ix / 2 * 2, iy / 2 * 2, iz / 2 * 2};
+        if (low[0] + 2 > kVoxels[0] || low[1] + 2 > kVoxels[1] || low[2] + 2 > kVoxels[2]) {
+          continue;  // a cell past the lattice's end: refined, not a coarse cell
+        }
+        bool corners = true;
+        for (int corner = 0; corner < 8; ++corner)
+          corners = corners && mesh.IndependentAt(low[0] + 2 * (corner & 1),
+                                                  low[1] + 2 * ((corner >> 1) & 1),
+                                                  low[2] + 2 * ((corner >> 2) & 1)) >= 0;
+        if (!corners) continue;
+        for (int k = 0; k < 3; ++k) {
+          double value = 0;
+          for (int corner = 0; corner < 8; ++corner) {
+            const int b[3] = {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1};
+            double w = 1;
+            const int p[3] = {ix, iy, iz};
+            for (int a = 0; a < 3; ++a) w *= b[a] ? (p[a] - low[a]) / 2.0 : 1 - (p[a] - low[a]) / 2.0;
+            value += w * carried.displacement_m[carried.Index(low[0] + 2 * b[0], low[1] + 2 * b[1],
+                                                              low[2] + 2 * b[2]) + k];
+          }
+          EXPECT_NEAR(carried.displacement_m[i + k], value, 1e-15);
+        }
+        ++interpolated;
+      }
+  EXPECT_GT(interpolated, 0);
   ObjectState cube;
   cube.lattice_nodes = {13, 13, 13};
   cube.displacement_m.assign(3 * cube.num_points(), 0.0);

@@ -96,6 +96,20 @@ TEST(GeometrySceneCli, ThePapersCubeDrawnAsAnStlBoxIsTheBuiltInCube) {
   EXPECT_EQ(drawn["regions"][0]["elements"], cube["regions"][0]["elements"]);
 }
 
+TEST(GeometrySceneCli, EveryConfigurationOnASmallObjectHasAVerdictOrIsNotApplicable) {
+  // A 5-voxel box: a primary of 4 nodes at spacing factor 3 leaves no secondary region, which
+  // only building the regions finds: n/a, and the other configurations still get their verdict.
+  WriteBoxStl(Temp("small.stl"), 0.05);
+  std::ofstream(Temp("small.toml")) << "[geometry]\nfile = \"small.stl\"\nspacing_m = 0.01\n\n"
+                                       "[[support]]\nplane_point = [0, 0, 0.05]\n"
+                                       "plane_normal = [0, 0, 1]\n\n[input]\namplitude = 0.002\n";
+  const CommandResult all =
+      Hapticsim({"stability", "--scene", Temp("small.toml"), "--all-configurations"});
+  ASSERT_EQ(all.exit_status, 0) << all.err;
+  EXPECT_NE(all.out.find("  3 4         n/a"), std::string::npos) << all.out;
+  EXPECT_NE(all.out.find("of 55 configurations stable"), std::string::npos) << all.out;
+}
+
 TEST(GeometrySceneCli, AGeometrySceneThatCannotRunIsRefusedSayingWhatToChange) {
   WriteBoxStl(Temp("box.stl"), 0.25);
   const auto refused = [](const std::string& scene_text, std::vector<std::string> extra = {}) {

@@ -148,11 +148,13 @@ def main():
 
 
 def nifti_labels(path):
-    """The label of every voxel, counted by VTK's own NIfTI reader."""
+    """The label of every voxel as VTK's own NIfTI reader reads it, indexed [z, y, x]."""
     reader = vtk.vtkNIFTIImageReader()
     reader.SetFileName(str(path))
     reader.Update()
-    return numpy.bincount(vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).ravel())
+    image = reader.GetOutput()
+    nx, ny, nz = image.GetDimensions()
+    return vtk_to_numpy(image.GetPointData().GetScalars()).reshape(nz, ny, nx)
 
 
 def check_phantom(cli, work):
@@ -174,15 +176,23 @@ def check_phantom(cli, work):
                           "--vtk-rate", "5"], capture_output=True, text=True)
     if run.returncode != 0:
         fail(f"simulate --vtk on the phantom exited {run.returncode}: {run.stderr}")
-    labels = nifti_labels(work / "phantom.nii")
+    volume = nifti_labels(work / "phantom.nii")
+    labels = numpy.bincount(volume.ravel())
     voxels = int(labels[1:].sum())
+    spacing = 0.005
     for name in ("adaptive", "reference"):
-        for t, vtu in frames_of(out / f"{name}.pvd"):
+        frames = frames_of(out / f"{name}.pvd")
+        if [round(t, 9) for t, _ in frames] != [0.0, 0.2, 0.4, 0.6, 0.8, 1.0]:
+            fail(f"phantom {name}: frame times {[t for t, _ in frames]}")
+        for t, vtu in frames:
             frame = read(vtu, points=nx * ny * nz, cells=voxels)
-            # Each label's voxels are its material's cells: [[material]] label 1 is 0, 2 is 1.
-            if list(numpy.bincount(frame["material"], minlength=2)) != [labels[1], labels[2]]:
-                fail(f"phantom {name} t={t}: materials {numpy.bincount(frame['material'])}, "
-                     f"labels in the file {labels}")
+            # Each cell is a voxel of the file, of its label's material ([[material]] label 1 is
+            # material 0, label 2 material 1): the voxel at the cell's lowest corner.
+            for c, corners in enumerate(frame["cells"]):
+                x, y, z = numpy.rint(frame["points"][corners].min(axis=0) / spacing).astype(int)
+                if frame["material"][c] != volume[z, y, x] - 1:
+                    fail(f"phantom {name} t={t}: cell {c} at voxel {x, y, z} is material "
+                         f"{frame['material'][c]}, the file's label there {volume[z, y, x]}")
             used = numpy.unique(numpy.array(frame["cells"]).ravel())
             back = used[numpy.isclose(frame["points"][used][:, 2], 0.03)]
             if len(back) == 0 or numpy.any(frame["u"][back] != 0):
