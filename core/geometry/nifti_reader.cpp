@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/geometry/file_text.hpp"
 #include "core/geometry/voxel_resampling.hpp"
 
 // How the work is split between libnifti2 and this file, and why:
@@ -43,13 +44,6 @@ constexpr std::int64_t kMaxVoxOffsetBytes = std::int64_t{1} << 32;
 
 [[noreturn]] void Fail(const std::string& path, const std::string& what) {
   throw Error("NIfTI file '" + path + "': " + what);
-}
-
-std::string FormatNumber(double value) {
-  std::ostringstream text;
-  text.precision(9);
-  text << value;
-  return text.str();
 }
 
 struct NiftiFile {
@@ -93,17 +87,10 @@ const LabelType* FindLabelType(int datatype) {
   return nullptr;
 }
 
-bool EndsWith(std::string text, const std::string& suffix) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text.size() >= suffix.size() &&
-         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 /// Refuses what libnifti2 would misread: another extension (it would go looking for
 /// .hdr/.img pairs), a directory or FIFO, a short file, and the non-standard ASCII header.
 void CheckFileBeforeTheLibrary(const std::string& path, bool gzipped) {
-  if (!EndsWith(path, ".nii") && !gzipped) {
+  if (!EndsWithIgnoringCase(path, ".nii") && !gzipped) {
     Fail(path, "hapticsim reads single-file NIfTI volumes: name it .nii or .nii.gz");
   }
   std::error_code error;
@@ -133,7 +120,7 @@ void CheckFileBeforeTheLibrary(const std::string& path, bool gzipped) {
 
 NiftiFile ReadRawHeader(const std::string& path) {
   NiftiFile file;
-  file.gzipped = EndsWith(path, ".nii.gz");
+  file.gzipped = EndsWithIgnoringCase(path, ".nii.gz");
   CheckFileBeforeTheLibrary(path, file.gzipped);
   int version = -1;
   const std::unique_ptr<void, decltype(&std::free)> raw(
@@ -240,7 +227,7 @@ void CheckPixdims(const std::string& path, const HeaderFields& fields) {
   for (int axis = 1; axis <= 3; ++axis) {
     const double edge = fields.pixdim[axis];
     if (!std::isfinite(edge) || edge <= 0) {
-      Fail(path, "pixdim[" + std::to_string(axis) + "] is " + FormatNumber(edge) +
+      Fail(path, "pixdim[" + std::to_string(axis) + "] is " + FormatFileNumber(edge) +
                      ": voxel sizes must be finite and > 0");
     }
   }
@@ -257,8 +244,8 @@ int CheckDataType(const std::string& path, const HeaderFields& fields) {
   }
   const bool unscaled = fields.scl_slope == 0 || (fields.scl_slope == 1 && fields.scl_inter == 0);
   if (!unscaled) {
-    Fail(path, "the voxel values are scaled (scl_slope " + FormatNumber(fields.scl_slope) +
-                   ", scl_inter " + FormatNumber(fields.scl_inter) +
+    Fail(path, "the voxel values are scaled (scl_slope " + FormatFileNumber(fields.scl_slope) +
+                   ", scl_inter " + FormatFileNumber(fields.scl_inter) +
                    "); labels must be stored as they are: export without scaling "
                    "(scl_slope 0 or 1, scl_inter 0)");
   }
@@ -271,8 +258,8 @@ std::int64_t CheckVoxOffset(const std::string& path, const NiftiFile& file,
   const double offset = fields.vox_offset;
   if (!(offset >= header_bytes && offset <= static_cast<double>(kMaxVoxOffsetBytes) &&
         offset == std::floor(offset))) {
-    Fail(path, "vox_offset " + FormatNumber(offset) + " is not a whole number of bytes from " +
-                   FormatNumber(header_bytes) + " to 2^32: the header is corrupt");
+    Fail(path, "vox_offset " + FormatFileNumber(offset) + " is not a whole number of bytes from " +
+                   FormatFileNumber(header_bytes) + " to 2^32: the header is corrupt");
   }
   return static_cast<std::int64_t>(offset);
 }

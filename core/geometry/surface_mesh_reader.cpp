@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/geometry/file_text.hpp"
 
 namespace hapticsim {
 namespace {
@@ -35,18 +36,12 @@ enum class MeshFormat { kStl, kObj };
 
 std::string Quoted(const std::string& path) { return "'" + path + "'"; }
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 MeshFormat FormatOf(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension == ".stl") return MeshFormat::kStl;
-  if (extension == ".obj") return MeshFormat::kObj;
+  if (EndsWithIgnoringCase(path, ".stl")) return MeshFormat::kStl;
+  if (EndsWithIgnoringCase(path, ".obj")) return MeshFormat::kObj;
   throw Error("surface mesh " + Quoted(path) + " is not a format hapticsim reads (extension '" +
               extension + "'): export it as " + kFormatsAccepted);
 }
@@ -439,7 +434,7 @@ TriangleMesh ReadSurfaceMesh(const std::string& path, double metres_per_unit) {
   HAPTICSIM_THROW_UNLESS(std::isfinite(metres_per_unit) && metres_per_unit > 0,
                          "the metres per unit of surface mesh " + Quoted(path) +
                              " must be finite and > 0 (0.001 for a mesh in millimetres), not " +
-                             FormatNumber(metres_per_unit));
+                             FormatFileNumber(metres_per_unit));
   const MeshFormat format = FormatOf(path);
   const std::string bytes = ReadBytes(path);
   if (format == MeshFormat::kStl) CheckStlLayout(bytes, path);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/geometry/file_text.hpp"
 
 namespace hapticsim {
 namespace {
@@ -20,13 +21,6 @@ constexpr double kTieToHigherIndex = 1e-6;
 constexpr double kIsotropyTolerance = 1e-6;
 /// A box edge within this fraction of a whole number of output voxels is not rounded up.
 constexpr double kWholeVoxelTolerance = 1e-6;
-
-std::string FormatNumber(double value) {
-  std::ostringstream text;
-  text.precision(9);
-  text << value;
-  return text.str();
-}
 
 double ColumnNorm(const VoxelAffine& affine, int column) {
   return std::hypot(affine.linear[0][column], affine.linear[1][column], affine.linear[2][column]);
@@ -63,7 +57,7 @@ std::array<std::array<double, 3>, 3> InvertLinear(const VoxelAffine& affine) {
 /// The output voxel edge: `spacing_m`, or the volume's own edge when it is 0.
 double ChooseSpacing(const VoxelAffine& affine, double spacing_m) {
   if (!std::isfinite(spacing_m) || spacing_m < 0) {
-    throw Error("geometry.spacing_m " + FormatNumber(spacing_m) +
+    throw Error("geometry.spacing_m " + FormatFileNumber(spacing_m) +
                    " must be finite and > 0 (or 0 for the volume's own voxel size)");
   }
   if (spacing_m > 0) return spacing_m;
@@ -71,8 +65,8 @@ double ChooseSpacing(const VoxelAffine& affine, double spacing_m) {
                                        ColumnNorm(affine, 2)};
   const auto [shortest, longest] = std::minmax_element(edges.begin(), edges.end());
   if (*longest - *shortest > kIsotropyTolerance * *longest) {
-    throw Error("the voxels are " + FormatNumber(edges[0] * 1e3) + " x " +
-                   FormatNumber(edges[1] * 1e3) + " x " + FormatNumber(edges[2] * 1e3) +
+    throw Error("the voxels are " + FormatFileNumber(edges[0] * 1e3) + " x " +
+                   FormatFileNumber(edges[1] * 1e3) + " x " + FormatFileNumber(edges[2] * 1e3) +
                    " mm, not cubes: set geometry.spacing_m to the edge (m) to resample them to");
   }
   return edges[0];  // not an average: an exact edge keeps a same-spacing read exact
@@ -105,10 +99,10 @@ LabelVolume PlanLattice(const VoxelAffine& affine, const std::array<int, 3>& vox
     const double count = std::max(1.0, std::ceil(edges - kWholeVoxelTolerance));
     total *= count;  // a double: it may be far beyond any integer type before the check
     if (!(total <= static_cast<double>(kMaxSourceVoxels))) {
-      throw Error("at a spacing of " + FormatNumber(spacing_m) + " m the volume (" +
-                     FormatNumber((high[0] - low[0]) * 1e3) + " x " +
-                     FormatNumber((high[1] - low[1]) * 1e3) + " x " +
-                     FormatNumber((high[2] - low[2]) * 1e3) + " mm) needs more than " +
+      throw Error("at a spacing of " + FormatFileNumber(spacing_m) + " m the volume (" +
+                     FormatFileNumber((high[0] - low[0]) * 1e3) + " x " +
+                     FormatFileNumber((high[1] - low[1]) * 1e3) + " x " +
+                     FormatFileNumber((high[2] - low[2]) * 1e3) + " mm) needs more than " +
                      std::to_string(kMaxSourceVoxels) +
                      " voxels: choose a coarser geometry.spacing_m");
     }

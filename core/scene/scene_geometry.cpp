@@ -7,24 +7,18 @@
 #include "core/error.hpp"
 #include "core/geometry/nifti_reader.hpp"
 #include "core/geometry/surface_mesh_reader.hpp"
+#include "core/geometry/file_text.hpp"
 #include "core/geometry/voxelise.hpp"
 
 namespace hapticsim {
 namespace {
 
-bool EndsWith(std::string text, std::string_view suffix) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text.size() >= suffix.size() &&
-         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 LabelVolume ReadGeometry(const GeometrySettings& geometry) {
   const std::string& file = geometry.file;
-  if (EndsWith(file, ".nii") || EndsWith(file, ".nii.gz")) {
+  if (EndsWithIgnoringCase(file, ".nii") || EndsWithIgnoringCase(file, ".nii.gz")) {
     return ReadNiftiLabels(file, geometry.spacing_m);
   }
-  if (EndsWith(file, ".stl") || EndsWith(file, ".obj")) {
+  if (EndsWithIgnoringCase(file, ".stl") || EndsWithIgnoringCase(file, ".obj")) {
     HAPTICSIM_THROW_UNLESS(geometry.spacing_m > 0,
                            "a surface mesh needs geometry.spacing_m > 0, the edge of the voxels "
                            "it becomes (m), e.g. 0.005");
