@@ -54,12 +54,12 @@ int WholeMaterial(const HybridMesh::Options& o, int k, const std::array<int, 3>&
 // The candidate coarse cells whose closure holds lattice point p, the cell p's index falls in
 // first: per axis floor(p/k) (the last cell at the far end), and the one below on a cell plane.
 template <typename Each>
-void ForEachCellHolding(const std::array<int, 3>& p, const CellPlan& plan, Each&& each) {
-  const int k = plan.k;
+void ForEachCellHolding(const std::array<int, 3>& p, int k, const std::array<int, 3>& nc,
+                        Each&& each) {
   std::array<std::array<int, 2>, 3> candidates{};
   std::array<int, 3> counts{};
   for (int a = 0; a < 3; ++a) {
-    const int j = std::min(p[a] / k, plan.nc[a] - 1);
+    const int j = std::min(p[a] / k, nc[a] - 1);
     candidates[a][counts[a]++] = j;
     if (p[a] % k == 0 && p[a] / k - 1 >= 0 && p[a] / k - 1 != j)
       candidates[a][counts[a]++] = p[a] / k - 1;
@@ -149,7 +149,7 @@ void RefineAtHangingSupports(const Supports& supports, const std::vector<std::ar
   const int k = plan->k;
   for (const auto& p : held) {
     if (p[0] % k == 0 && p[1] % k == 0 && p[2] % k == 0) continue;  // a coarse vertex
-    ForEachCellHolding(p, *plan, [&](const std::array<int, 3>& c) {
+    ForEachCellHolding(p, k, plan->nc, [&](const std::array<int, 3>& c) {
       Cell& state = plan->state[plan->Index(c)];
       if (state != Cell::kCoarse) return false;
       bool all_held = true;
@@ -218,7 +218,7 @@ std::vector<std::pair<int, double>> HangingMasters(const std::array<int, 3>& p,
   const int k = plan.k;
   std::vector<std::pair<int, double>> masters;
   if (p[0] % k == 0 && p[1] % k == 0 && p[2] % k == 0) return masters;  // coarse vertex
-  ForEachCellHolding(p, plan, [&](const std::array<int, 3>& c) {
+  ForEachCellHolding(p, k, plan.nc, [&](const std::array<int, 3>& c) {
     if (plan.state[plan.Index(c)] != Cell::kCoarse) return false;
     ForEachVertexWeight(p, c, k, [&](const std::array<int, 3>& v, double w) {
       masters.push_back({node_at_lattice[v[0] + padded[0] * (v[1] + padded[1] * v[2])], w});
@@ -237,8 +237,9 @@ HybridMesh::HybridMesh(const Options& options) : options_(options) {
                          "internal: a hybrid mesh needs 2 or more lattice points per axis and a "
                          "coarse factor of 1 or more");
   const size_t fine_cells = static_cast<size_t>(n[0] - 1) * (n[1] - 1) * (n[2] - 1);
-  HAPTICSIM_THROW_UNLESS(options.cell_material.empty() || options.cell_material.size() == fine_cells,
-                         "internal: the cell materials are not the lattice's cells");
+  HAPTICSIM_THROW_UNLESS(
+      options.cell_material.empty() || options.cell_material.size() == fine_cells,
+      "internal: the cell materials are not the lattice's cells");
   for (int a = 0; a < 3; ++a) {
     coarse_cells_[a] = (n[a] - 1 + k - 1) / k;
     padded_[a] = coarse_cells_[a] * k + 1;
@@ -356,13 +357,11 @@ int HybridMesh::FieldAt(const std::array<int, 3>& p, std::array<GatherTerm, 8>* 
     (*terms)[0] = {node, 1.0};
     return 1;
   }
-  CellPlan cells;  // only what ForEachCellHolding reads
-  cells.k = options_.coarse_factor;
-  cells.nc = coarse_cells_;
+  const int k = options_.coarse_factor;
   int count = 0;
-  ForEachCellHolding(p, cells, [&](const std::array<int, 3>& c) {
-    if (!coarse_[cells.Index(c)]) return false;
-    ForEachVertexWeight(p, c, cells.k, [&](const std::array<int, 3>& v, double w) {
+  ForEachCellHolding(p, k, coarse_cells_, [&](const std::array<int, 3>& c) {
+    if (!coarse_[c[0] + coarse_cells_[0] * (c[1] + coarse_cells_[1] * c[2])]) return false;
+    ForEachVertexWeight(p, c, k, [&](const std::array<int, 3>& v, double w) {
       const int node = IndependentAt(v[0], v[1], v[2]);
       HAPTICSIM_THROW_UNLESS(node >= 0, "internal: a coarse vertex is not a mesh node");
       (*terms)[count++] = {node, w};
@@ -403,18 +402,26 @@ std::vector<RegionIndex> HybridMesh::RegionPerLatticeCell() const {
   return region;
 }
 
-Eigen::VectorXd HybridMesh::DofMass(const std::vector<Material>& materials) const {
-  const int nr = num_independent();
-  Eigen::VectorXd node_mass = Eigen::VectorXd::Zero(nr);
+Eigen::VectorXd HybridMesh::NodeMass(const std::vector<Material>& materials,
+                                     bool times_damping) const {
+  Eigen::VectorXd node_mass = Eigen::VectorXd::Zero(num_independent());
   const double h = options_.spacing_m;
   for (const HybridElement& e : elements_) {
+    const Material& material = materials.at(e.material);
     const double edge = e.size_factor * h;
-    const double share = materials.at(e.material).density_kg_m3 * edge * edge * edge / 8.0;
+    double share = material.density_kg_m3 * edge * edge * edge / 8.0;
+    if (times_damping) share *= material.damping_per_s;
     for (int node : e.nodes) {
       const auto [begin, end] = Gather(node);
       for (auto* g = begin; g != end; ++g) node_mass[g->independent] += g->weight * share;
     }
   }
+  return node_mass;
+}
+
+Eigen::VectorXd HybridMesh::DofMass(const std::vector<Material>& materials) const {
+  const int nr = num_independent();
+  const Eigen::VectorXd node_mass = NodeMass(materials, false);
   Eigen::VectorXd mass(3 * nr);
   for (int c = 0; c < 3; ++c) mass.segment(c * nr, nr) = node_mass;
   return mass;
@@ -422,28 +429,17 @@ Eigen::VectorXd HybridMesh::DofMass(const std::vector<Material>& materials) cons
 
 Eigen::VectorXd HybridMesh::DofDamping(const std::vector<Material>& materials) const {
   const double first = materials.at(elements_.front().material).damping_per_s;
-  const bool one_rate = std::all_of(elements_.begin(), elements_.end(), [&](const HybridElement& e) {
-    return materials.at(e.material).damping_per_s == first;
-  });
+  const bool one_rate =
+      std::all_of(elements_.begin(), elements_.end(), [&](const HybridElement& e) {
+        return materials.at(e.material).damping_per_s == first;
+      });
   if (one_rate) return Eigen::VectorXd::Constant(num_dofs(), first);
-  // Σ_e d_e·M_e lumped, divided by Σ_e M_e: the same shares as DofMass.
+  // Σ_e d_e·M_e lumped, divided by Σ_e M_e.
   const int nr = num_independent();
-  Eigen::VectorXd damped = Eigen::VectorXd::Zero(nr), mass = Eigen::VectorXd::Zero(nr);
-  const double h = options_.spacing_m;
-  for (const HybridElement& e : elements_) {
-    const Material& material = materials.at(e.material);
-    const double edge = e.size_factor * h;
-    const double share = material.density_kg_m3 * edge * edge * edge / 8.0;
-    for (int node : e.nodes) {
-      const auto [begin, end] = Gather(node);
-      for (auto* g = begin; g != end; ++g) {
-        mass[g->independent] += g->weight * share;
-        damped[g->independent] += g->weight * share * material.damping_per_s;
-      }
-    }
-  }
+  const Eigen::VectorXd node_rate =
+      NodeMass(materials, true).cwiseQuotient(NodeMass(materials, false));
   Eigen::VectorXd rate(3 * nr);
-  for (int c = 0; c < 3; ++c) rate.segment(c * nr, nr) = damped.cwiseQuotient(mass);
+  for (int c = 0; c < 3; ++c) rate.segment(c * nr, nr) = node_rate;
   return rate;
 }
 

@@ -139,6 +139,9 @@ class HybridMesh {
                    const std::vector<std::array<int, 3>>& node_lattice);
   void BuildRegionMasks();
 
+  // Each independent node's lumped mass, kg (its share of every element's ρ·volume, through the
+  // gathers); with times_damping each share times its element's damping rate d, kg/s.
+  Eigen::VectorXd NodeMass(const std::vector<Material>& materials, bool times_damping) const;
   int LatticePoint(int ix, int iy, int iz) const {
     return ix + padded_[0] * (iy + padded_[1] * iz);
   }

@@ -26,12 +26,8 @@ HybridMesh::Options MeshOptionsOf(const Scene& scene, const SceneObject& object)
   options.spacing_m = grid.spacing();
   options.coarse_factor = scene.adaptivity.secondary_lod;
   const MaterialField& field = object.field;
-  const bool whole_of_one = field.num_occupied() == field.num_elements() &&
-                            field.uniform_material() == 0;  // the cube: no list needed
-  if (!whole_of_one) {
-    options.cell_material.resize(static_cast<size_t>(field.num_elements()));
-    for (int e = 0; e < field.num_elements(); ++e) options.cell_material[e] = field.material_of(e);
-  }
+  options.cell_material.resize(static_cast<size_t>(field.num_elements()));
+  for (int e = 0; e < field.num_elements(); ++e) options.cell_material[e] = field.material_of(e);
   for (int a = 0; a < 3; ++a) {
     options.primary_lo[a] = std::max(0, contact[a] - r);
     options.primary_hi[a] = std::min(last[a], contact[a] + r);

@@ -12,15 +12,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The object's cells: each as its lattice cell's number (ix slowest) and its lowest corner.
-struct VtkCell {
-  size_t lattice_cell;
-  std::array<int, 3> corner;
-};
-
-std::vector<VtkCell> OccupiedCells(const VtkObject& object) {
+std::vector<VtkSeries::Cell> OccupiedCells(const VtkObject& object) {
   const auto [nx, ny, nz] = object.lattice_nodes;
-  std::vector<VtkCell> cells;
+  std::vector<VtkSeries::Cell> cells;
   size_t cell = 0;
   for (int ix = 0; ix + 1 < nx; ++ix) {
     for (int iy = 0; iy + 1 < ny; ++iy) {
@@ -45,13 +39,14 @@ void WritePoints(std::ostream& out, const VtkObject& object) {
   out << "</DataArray></Points>\n";
 }
 
-void WriteCells(std::ostream& out, const VtkObject& object, const std::vector<VtkCell>& cells) {
+void WriteCells(std::ostream& out, const VtkObject& object,
+                const std::vector<VtkSeries::Cell>& cells) {
   const int ny = object.lattice_nodes[1], nz = object.lattice_nodes[2];
   auto point = [ny, nz](int ix, int iy, int iz) {
     return (static_cast<long>(ix) * ny + iy) * nz + iz;
   };
   out << "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const VtkCell& cell : cells) {
+  for (const VtkSeries::Cell& cell : cells) {
     const auto [ix, iy, iz] = cell.corner;
     // VTK_HEXAHEDRON: the bottom face counter-clockwise, then the top face above it.
     out << point(ix, iy, iz) << ' ' << point(ix + 1, iy, iz) << ' ' << point(ix + 1, iy + 1, iz)
@@ -86,6 +81,7 @@ VtkSeries::VtkSeries(const fs::path& dir, const std::string& name, VtkObject obj
     : dir_(dir),
       name_(name),
       object_(std::move(object)),
+      cells_(OccupiedCells(object_)),
       region_per_cell_(std::move(region_per_cell)) {
   HAPTICSIM_THROW_UNLESS(region_per_cell_.size() == object_.cell_material.size(),
                          "internal: the regions are not the lattice's cells");
@@ -98,7 +94,6 @@ VtkSeries::VtkSeries(const fs::path& dir, const std::string& name, VtkObject obj
 void VtkSeries::Write(double t_s, const ObjectState& state) {
   HAPTICSIM_THROW_UNLESS(state.lattice_nodes == object_.lattice_nodes,
                          "internal: a frame of another lattice");
-  const std::vector<VtkCell> cells = OccupiedCells(object_);
   char file[32];
   std::snprintf(file, sizeof file, "frame_%05d.vtu", frames());
   const std::string relative = name_ + "/" + file;
@@ -108,10 +103,10 @@ void VtkSeries::Write(double t_s, const ObjectState& state) {
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
          "header_type=\"UInt64\">\n<UnstructuredGrid>\n"
-      << "<Piece NumberOfPoints=\"" << state.num_points() << "\" NumberOfCells=\"" << cells.size()
+      << "<Piece NumberOfPoints=\"" << state.num_points() << "\" NumberOfCells=\"" << cells_.size()
       << "\">\n";
   WritePoints(out, object_);
-  WriteCells(out, object_, cells);
+  WriteCells(out, object_, cells_);
   out << "<PointData Vectors=\"displacement_m\">\n"
       << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
          "format=\"ascii\">\n";
@@ -123,11 +118,13 @@ void VtkSeries::Write(double t_s, const ObjectState& state) {
       << "<DataArray type=\"Float64\" Name=\"von_mises_pa\" format=\"ascii\">\n";
   const std::vector<double> stress =
       VonMisesPerCell(state, object_.spacing_m, object_.materials, object_.cell_material);
-  for (const VtkCell& cell : cells) out << stress[cell.lattice_cell] << '\n';
+  for (const VtkSeries::Cell& cell : cells_) out << stress[cell.lattice_cell] << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">\n";
-  for (const VtkCell& cell : cells) out << region_per_cell_[cell.lattice_cell] << '\n';
+  for (const VtkSeries::Cell& cell : cells_) out << region_per_cell_[cell.lattice_cell] << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"material\" format=\"ascii\">\n";
-  for (const VtkCell& cell : cells) out << object_.cell_material[cell.lattice_cell] << '\n';
+  for (const VtkSeries::Cell& cell : cells_) {
+    out << object_.cell_material[cell.lattice_cell] << '\n';
+  }
   out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   HAPTICSIM_THROW_UNLESS(out.good(),
                          "writing " + (dir_ / relative).string() + " failed (disk full?)");

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -54,10 +55,17 @@ class VtkSeries {
   std::filesystem::path collection() const { return dir_ / (name_ + ".pvd"); }
   int frames() const { return static_cast<int>(written_.size()); }
 
+ /** A cell of the object: its lattice cell's number (ix slowest) and its lowest corner. */
+  struct Cell {
+    std::size_t lattice_cell;
+    std::array<int, 3> corner;
+  };
+
  private:
   std::filesystem::path dir_;
   std::string name_;
   VtkObject object_;
+  std::vector<Cell> cells_;  // the object's cells, in the order the frames list them
   std::vector<RegionIndex> region_per_cell_;
   std::vector<std::pair<double, std::string>> written_;  // time, file relative to dir_
 };
