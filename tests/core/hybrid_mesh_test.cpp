@@ -5,6 +5,7 @@
 #include "core/regions/element_set_stiffness.hpp"
 #include "core/error.hpp"
 #include "core/fem/stencil_stiffness.hpp"
+#include "tests/support/hybrid_mesh_fields.hpp"
 #include "tests/support/random_field.hpp"
 
 namespace hapticsim {
@@ -21,23 +22,8 @@ HybridMesh::Options CubeOptions(int k, int r) {
   return o;
 }
 
-std::vector<int> AllElements(const HybridMesh& mesh) {
-  std::vector<int> ids(mesh.elements().size());
-  for (size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<int>(i);
-  return ids;
-}
-
-// Affine field u = A·x + b on the independent nodes.
-Eigen::VectorXd Affine(const HybridMesh& mesh, const Eigen::Matrix3d& a, const Eigen::Vector3d& b) {
-  Eigen::VectorXd u(mesh.num_dofs());
-  const double h = mesh.options().spacing_m;
-  for (int r = 0; r < mesh.num_independent(); ++r) {
-    const auto& p = mesh.LatticeOf(r);
-    const Eigen::Vector3d value = a * (h * Eigen::Vector3d(p[0], p[1], p[2])) + b;
-    for (int c = 0; c < 3; ++c) u[mesh.Dof(r, c)] = value[c];
-  }
-  return u;
-}
+using testing::AffineField;
+using testing::AllElements;
 
 TEST(HybridMesh, WithoutCoarseningIsTheFullGrid) {
   const HybridMesh dut(CubeOptions(1, 2));
@@ -89,7 +75,7 @@ TEST_P(PatchAcrossResolutionJumps, AffineFieldLeavesNoForceInside) {
   ASSERT_GT(dut.num_hanging(), 0);
   const ElementSetStiffness k(dut, {Material{}}, AllElements(dut));
   const Eigen::VectorXd r = testing::RandomField(12, 5, 1e-2);
-  const Eigen::VectorXd u = Affine(dut, Eigen::Map<const Eigen::Matrix3d>(r.data()), r.tail<3>());
+  const Eigen::VectorXd u = AffineField(dut, Eigen::Map<const Eigen::Matrix3d>(r.data()), r.tail<3>());
   Eigen::VectorXd ku = Eigen::VectorXd::Zero(dut.num_dofs());
   k.Apply(u, ku);
   const double scale = ku.cwiseAbs().maxCoeff();

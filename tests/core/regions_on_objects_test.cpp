@@ -23,6 +23,7 @@
 #include "core/scene/scene_model.hpp"
 #include "core/trial/force_error.hpp"
 #include "core/trial/reference_trial.hpp"
+#include "tests/support/hybrid_mesh_fields.hpp"
 #include "tests/support/voxel_scene.hpp"
 
 namespace hapticsim {
@@ -84,22 +85,8 @@ HybridMesh::Options NotchedOptions(int k) {
   return o;
 }
 
-std::vector<int> AllElements(const HybridMesh& mesh) {
-  std::vector<int> ids(mesh.elements().size());
-  for (size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<int>(i);
-  return ids;
-}
-
-// A linear field u = A·x + b on the independent nodes.
-Eigen::VectorXd Linear(const HybridMesh& mesh, const Eigen::Matrix3d& a, const Eigen::Vector3d& b) {
-  Eigen::VectorXd u(mesh.num_dofs());
-  for (int r = 0; r < mesh.num_independent(); ++r) {
-    const auto& p = mesh.LatticeOf(r);
-    const Eigen::Vector3d value = a * (kH * Eigen::Vector3d(p[0], p[1], p[2])) + b;
-    for (int c = 0; c < 3; ++c) u[mesh.Dof(r, c)] = value[c];
-  }
-  return u;
-}
+using testing::AffineField;
+using testing::AllElements;
 
 TEST(HybridMeshOnAnObject, CoversEveryOccupiedVoxelOnceAndKeepsItsMass) {
   const std::vector<std::int16_t> cells = CellMaterials();
@@ -145,20 +132,20 @@ TEST(HybridMeshOnAnObject, RigidMotionsCostNoForceAndAStretchDoes) {
     Eigen::VectorXd ku(mesh.num_dofs());
     Eigen::Matrix3d stretch = Eigen::Matrix3d::Zero();
     stretch(0, 0) = 1e-3;
-    stiffness.Apply(Linear(mesh, stretch, Eigen::Vector3d::Zero()), ku);
+    stiffness.Apply(AffineField(mesh, stretch, Eigen::Vector3d::Zero()), ku);
     const double stretched = ku.norm();
     ASSERT_GT(stretched, 0);
     for (int axis = 0; axis < 3; ++axis) {
       Eigen::Vector3d shift = Eigen::Vector3d::Zero();
       shift[axis] = 1e-3 * kH * kVoxels[0];
-      stiffness.Apply(Linear(mesh, Eigen::Matrix3d::Zero(), shift), ku);
+      stiffness.Apply(AffineField(mesh, Eigen::Matrix3d::Zero(), shift), ku);
       EXPECT_LT(ku.norm(), 1e-12 * stretched) << "translation " << axis << ", k = " << k;
       // A small rotation about the axis: u = ω × x, the same size as the stretch.
       Eigen::Matrix3d spin = Eigen::Matrix3d::Zero();
       const int b = (axis + 1) % 3, c = (axis + 2) % 3;
       spin(b, c) = -1e-3;
       spin(c, b) = 1e-3;
-      stiffness.Apply(Linear(mesh, spin, Eigen::Vector3d::Zero()), ku);
+      stiffness.Apply(AffineField(mesh, spin, Eigen::Vector3d::Zero()), ku);
       EXPECT_LT(ku.norm(), 1e-12 * stretched) << "rotation " << axis << ", k = " << k;
     }
   }
