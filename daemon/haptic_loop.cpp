@@ -74,8 +74,7 @@ void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcep
 void HapticLoop::OfferInput(const DeviceSample& sample) noexcept { inputs_.Offer(sample); }
 
 std::int64_t HapticLoop::primary_alive_ns() const {
-  return std::max(monitors_[kPrimaryRegion]->last_done_ns(),
-                  counters_.alive_ns.value());
+  return std::max(monitors_[kPrimaryRegion]->last_done_ns(), counters_.alive_ns.value());
 }
 
 void HapticLoop::WaitForInput() noexcept {
@@ -226,9 +225,14 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
     case RegionRestart::kNone:
       return;
   }
-  balance_peak_stored_j_ = 0;  // the balance starts afresh with the new regions
+  RestartEnergyWatch();  // the balance starts afresh with the new regions
+}
+
+void HapticLoop::RestartEnergyWatch() noexcept {
+  balance_peak_stored_j_ = 0;
   runaway_seen_ = false;
   runaway_periods_ = 0;
+  periods_since_over_watch_line_ = kNeverOverWatchLine;
 }
 
 void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
@@ -273,6 +277,16 @@ void HapticLoop::TakeInput(const DeviceSample& sample) noexcept {
 
 void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
   if (sent.new_fault != PortGuard::Fault::kNone) {
+    // A simulated force no tissue gives while the state is, or within the watch's
+    // kRunawayPeriods periods was, above the runaway watch's line: that is the runaway the watch
+    // would count some periods later (its ratio swings across the line from period to period as
+    // it grows). Counted now, before the fault, so that the supervisor takes the regions off this
+    // configuration instead of restarting it from rest — and the watch's count with it — where it
+    // ran away.
+    if (sent.new_fault == PortGuard::Fault::kDivergence &&
+        periods_since_over_watch_line_ < AsyncRegions::kRunawayPeriods) {
+      PublishRunaway();
+    }
     counters_.last_fault.Set(static_cast<int>(sent.new_fault));
     counters_.fault_latched.Set(true);
     restarted_since_fault_ = false;
@@ -300,11 +314,20 @@ void HapticLoop::WatchEnergyBalance() noexcept {
   }
   // Once per set of regions: the supervisor takes them off this configuration (release: the
   // regions it reads with the count are the ones that ran away).
-  if (!runaway_seen_ && regions_->RunawayHeld(balance, &runaway_periods_)) {
-    runaway_seen_ = true;
-    counters_.PublishRunaway(
-        {balance.state_energy_j, std::max(balance.allowed_j, regions_->port_floor_j())});
+  const bool held = regions_->RunawayHeld(balance, &runaway_periods_);
+  if (runaway_periods_ > 0) {
+    periods_since_over_watch_line_ = 0;
+    watched_ = {balance.state_energy_j, std::max(balance.allowed_j, regions_->port_floor_j())};
+  } else if (periods_since_over_watch_line_ < kNeverOverWatchLine) {
+    ++periods_since_over_watch_line_;
   }
+  if (held) PublishRunaway();
+}
+
+void HapticLoop::PublishRunaway() noexcept {
+  if (runaway_seen_) return;
+  runaway_seen_ = true;
+  counters_.PublishRunaway(watched_);
 }
 
 void HapticLoop::PrimaryThread(std::int64_t origin_ns) {

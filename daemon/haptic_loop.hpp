@@ -316,6 +316,10 @@ class HapticLoop {
   void UpdateFaultState(const PortGuard::Output& sent) noexcept;
   // Primary thread, while the regions are its own: the coupling's energy balance watched.
   void WatchEnergyBalance() noexcept;
+  // Primary thread: these regions' runaway counted (once), with the energies watched last.
+  void PublishRunaway() noexcept;
+  // Primary thread: the watch forgets the regions before (they restart from rest).
+  void RestartEnergyWatch() noexcept;
   // Primary thread: one period's steps, the contact moved to `contact_m` over its substeps; the
   // reaction at the period's start, N.
   std::array<double, 3> StepPrimaryPeriod(const std::array<double, 3>& contact_m) noexcept;
@@ -363,6 +367,11 @@ class HapticLoop {
   double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
   bool runaway_seen_ = false;         // primary thread: these regions' runaway is counted
   int runaway_periods_ = 0;           // primary thread: periods in a row above the watch's line
+  // Primary thread: watched periods since the state was last above that line, and what the
+  // watch measured then (these regions'; kNeverOverWatchLine: not yet).
+  static constexpr int kNeverOverWatchLine = 1 << 30;
+  int periods_since_over_watch_line_ = kNeverOverWatchLine;
+  RunawayEnergies watched_;
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::thread primary_thread_;
   std::vector<std::thread> secondary_threads_;

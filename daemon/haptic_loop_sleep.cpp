@@ -12,8 +12,7 @@ void HapticLoop::ForgetSleep() {
 }
 
 bool HapticLoop::SecondaryMayStep(RegionIndex region) noexcept {
-  return parking_.MayStep(region,
-                          [&] { return regions_->RegionAtRest(region, kRestTolerance_m); });
+  return parking_.MayStep(region, [&] { return regions_->RegionAtRest(region, kRestTolerance_m); });
 }
 
 void HapticLoop::WatchForRest(bool touched) noexcept {
@@ -48,9 +47,7 @@ void HapticLoop::WatchForRest(bool touched) noexcept {
     }
     // Nothing steps any region now: rest exactly, at time 0 of a schedule that starts on waking.
     regions_->Reset();
-    balance_peak_stored_j_ = 0;  // they start again from rest
-    runaway_seen_ = false;
-    runaway_periods_ = 0;
+    RestartEnergyWatch();  // they start again from rest
     counters_.interface_backlog_j.Set(0);
     sleep_state_ = kAsleep;
     counters_.asleep.Set(true);

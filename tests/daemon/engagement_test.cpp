@@ -190,6 +190,7 @@ TEST(Engagement, AFaultReArmsOnlyOutOfContactFromRestAndThenRampsIn) {
   });
   ExpectSmooth(in, "fault");
   ASSERT_EQ(loop.force_faults(), 1);
+  EXPECT_EQ(loop.runaways(), 0) << "a fault whose state the energy balance allows is no runaway";
   EXPECT_TRUE(loop.fault_latched());
   EXPECT_EQ(in.force_z.back(), 0.0);  // latched: zero, though the tool still presses
   EXPECT_EQ(loop.rearms(), 0);
@@ -221,9 +222,10 @@ TEST(Engagement, NewRegionsWhileTheToolPressesRampInFromZero) {
   HapticLoop alone(other, HapticLoop::Options{});
   const double other_settles = Play(alone, PressTo(0.006), 3000).force_z.back();
   EXPECT_NEAR(played.force_z.back(), other_settles, 0.02 * std::abs(other_settles));
-  std::printf("new regions at 6 mm: force %.3f N before, %.4f N at its lowest %td periods later, "
-              "%.4f N at the end (those regions pressed alone: %.4f N)\n",
-              played.force_z[1199], *lowest, lowest - after, played.force_z.back(), other_settles);
+  std::printf(
+      "new regions at 6 mm: force %.3f N before, %.4f N at its lowest %td periods later, "
+      "%.4f N at the end (those regions pressed alone: %.4f N)\n",
+      played.force_z[1199], *lowest, lowest - after, played.force_z.back(), other_settles);
 }
 
 // A configuration switched while the tool presses (hapticsimd does this as soon as a better one is
@@ -389,9 +391,10 @@ TEST(Passivity, ADissipatingPeriodIsFlaggedCountedAndItsEnergySummed) {
   EXPECT_GT(loop.port_energy_dissipated_j(), 0.0);
   EXPECT_LT(strongest, -2.0) << "a 5 mm press on this tissue pushes back with several N";
   EXPECT_LE(played.most_attractive_n, 1e-12) << "a force pulling the tool in";
-  std::printf("stiff undamped tissue vibrated: %lld periods dissipating, %.3g J taken out; the "
-              "force reached %.2f N\n",
-              static_cast<long long>(flagged), loop.port_energy_dissipated_j(), strongest);
+  std::printf(
+      "stiff undamped tissue vibrated: %lld periods dissipating, %.3g J taken out; the "
+      "force reached %.2f N\n",
+      static_cast<long long>(flagged), loop.port_energy_dissipated_j(), strongest);
 }
 
 }  // namespace

@@ -532,8 +532,9 @@ TEST(HapticsimdRunaway, AStateThatOutgrowsItsBalanceTakesTheRegionsToEqualRates)
   const double h = kEdge / 6;
   auto next = Clock::now();
   std::int64_t seq = 0;
+  constexpr int kPressInputs = 1400;
   auto press = [&](double depth_m) {  // hover 50 ms, in over 200 ms, hold 750 ms, out, hover
-    for (int i = 0; i < 1400; ++i) {
+    for (int i = 0; i < kPressInputs; ++i) {
       const double in = i < 50 ? 0 : i < 250 ? (i - 50) / 200.0 : i < 1000 ? 1 : 0;
       client.Send(++seq, 3 * h, kEdge + 0.002 - (0.002 + depth_m) * in, 5 * h);
       next += std::chrono::milliseconds(1);
@@ -559,20 +560,28 @@ TEST(HapticsimdRunaway, AStateThatOutgrowsItsBalanceTakesTheRegionsToEqualRates)
   EXPECT_EQ(status->secondary_rate_hz, 1000);
   const std::vector<force_feedback_t> forces = client.Forces();
   ASSERT_GT(forces.size(), first_press + 1000);
-  double held = 0;  // the second press, held in contact
+  // The second press's hold: its inputs 600–999 (seq from kPressInputs + 1), 350 ms after the
+  // tool stopped. Not the press-in, whose tissue damping adds to the force by how fast the tool
+  // went in, and which the engage ramp hides or not by where the first period in contact fell.
+  const std::int64_t hold_from = kPressInputs + 600, hold_to = kPressInputs + 1000;
+  std::vector<double> held_n;
   for (size_t i = 0; i < forces.size(); ++i) {
     const double f = std::hypot(forces[i].force[0], forces[i].force[1], forces[i].force[2]);
     ASSERT_TRUE(std::isfinite(f)) << "seq " << forces[i].seq;
     EXPECT_LE(f, status->max_force_n + 1e-12) << "seq " << forces[i].seq;
-    if (i > first_press && (forces[i].flags & force_feedback_t::FLAG_IN_CONTACT)) {
-      held = std::max(held, f);
+    if (i > first_press && (forces[i].flags & force_feedback_t::FLAG_IN_CONTACT) &&
+        forces[i].seq > hold_from && forces[i].seq <= hold_to) {
+      held_n.push_back(f);
     }
   }
+  ASSERT_GT(held_n.size(), 300u) << "the hold answered in contact\n" << daemon.Log();
+  std::nth_element(held_n.begin(), held_n.begin() + held_n.size() / 2, held_n.end());
+  const double held = held_n[held_n.size() / 2];  // the median over the hold
   ASSERT_LT(expected_n, status->max_force_n) << "a press the envelope does not clip";
-  EXPECT_NEAR(held, expected_n, 0.1 * expected_n) << "the second press, at equal rates\n"
-                                                  << daemon.Log();
+  EXPECT_NEAR(held, expected_n, 0.03 * expected_n) << "the second press, at equal rates\n"
+                                                   << daemon.Log();
   std::printf(
-      "runaway: %lld watch firing(s); the second press at equal rates held %.3f N "
+      "runaway: %lld watch firing(s); the second press at equal rates held %.3f N (median) "
       "(offline %.3f N)\n",
       static_cast<long long>(status->runaways), held, expected_n);
   daemon.Signal(SIGTERM);
@@ -811,8 +820,8 @@ TEST(HapticsimdCommands, ASignedLcmCommandOutOfRangeIsRefusedAndCounted) {
   target.command = command_t::SET_ERROR_TARGET;
   target.error_target_percent = 0;  // must be in (0, 100] %
   client.SignedCommand(target, signing);
-  EXPECT_TRUE(client.WaitForStatus(
-      [&](const status_t& s) { return s.commands_refused == before + 1; }, 5))
+  EXPECT_TRUE(
+      client.WaitForStatus([&](const status_t& s) { return s.commands_refused == before + 1; }, 5))
       << daemon.Log();
   target.error_target_percent = 12;
   client.SignedCommand(target, signing);

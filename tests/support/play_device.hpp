@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -32,6 +33,25 @@ inline std::vector<ForceRecord> PlayDevice(
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   while (loop.forces().Pop(&record)) forces.push_back(record);
   return forces;
+}
+
+/**
+ * hapticsimd's threads played on this one, for one primary period at `release_ns`: the input
+ * (if any) arrives at the release, the secondary regions step in virtual time as far as the
+ * primary's coming step needs (unless one of them may not: parked or paused), then the primary
+ * period runs as if woken on time. Deterministic: no clock is read.
+ */
+inline void PlayPeriodInVirtualTime(HapticLoop& loop, std::int64_t release_ns,
+                                    const std::optional<DeviceSample>& input) {
+  if (input) loop.OfferInput(*input);
+  auto& regions = const_cast<AsyncRegions&>(loop.regions());
+  bool may_step = true;
+  for (int r = 1; r < regions.num_regions() && may_step; ++r) may_step &= loop.SecondaryMayStep(r);
+  if (may_step) {
+    regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
+                                 regions.period_ticks(kPrimaryRegion));
+  }
+  loop.PrimaryPeriod(release_ns, release_ns);
 }
 
 }  // namespace hapticsim::testing

@@ -127,6 +127,7 @@ TEST(RegionHandover, ThePrimaryLeavesTheRegionsAloneFromItsAcknowledgementUntilT
   std::vector<bool> holds_seen;
   std::int64_t early_periods = 0;  // kOurs before the release the supervisor resumed at
   std::atomic<std::int64_t> resume_at{origin};
+  std::atomic<int> handed_back{0};  // the times the primary has had the regions back
   std::thread primary([&] {
     bool was_ours = false;
     for (std::int64_t k = 0; !stop.load(); ++k) {
@@ -140,6 +141,7 @@ TEST(RegionHandover, ThePrimaryLeavesTheRegionsAloneFromItsAcknowledgementUntilT
         restarts.push_back(handover.TakeRestart());
         installed_seen.push_back(regions.installed);
         if (release < resume_at.load()) ++early_periods;
+        handed_back.fetch_add(1);
       }
       if (ours) ++regions.steps;
       was_ours = ours;
@@ -147,6 +149,17 @@ TEST(RegionHandover, ThePrimaryLeavesTheRegionsAloneFromItsAcknowledgementUntilT
   });
   int stepped_while_paused = 0;
   for (int r = 0; r < kReplacements; ++r) {
+    // Each replacement after the primary has had the regions back (a thread descheduled for a
+    // whole resume would see the next pause first: the protocol allows it, this test counts
+    // every hand-back), then a few of its periods.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (handed_back.load() < r + 1 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(microseconds(50));
+    }
+    if (handed_back.load() < r + 1) {
+      ADD_FAILURE() << "the primary never had the regions back after replacement " << r;
+      break;
+    }
     std::this_thread::sleep_for(milliseconds(2));
     handover.RequestPause(r % 2 == 1);
     while (!handover.Acknowledged()) std::this_thread::sleep_for(microseconds(50));
@@ -170,8 +183,8 @@ TEST(RegionHandover, ThePrimaryLeavesTheRegionsAloneFromItsAcknowledgementUntilT
   EXPECT_EQ(installed_seen[0], -1);
   ASSERT_EQ(holds_seen.size(), static_cast<size_t>(kReplacements)) << "one first period a pause";
   for (int r = 0; r < kReplacements; ++r) {
-    EXPECT_EQ(restarts[r + 1], r % 3 == 0 ? RegionRestart::kCarryingMotion
-                                          : RegionRestart::kKeepingContact);
+    EXPECT_EQ(restarts[r + 1],
+              r % 3 == 0 ? RegionRestart::kCarryingMotion : RegionRestart::kKeepingContact);
     EXPECT_EQ(installed_seen[r + 1], r) << "the primary must see the regions installed";
     EXPECT_EQ(holds_seen[r], r % 2 == 1);
   }
@@ -205,7 +218,7 @@ TEST(SecondaryParking, SecondariesParkOnlyOnceAllWereFoundAtRestAndEveryWakeRele
   constexpr int kSecondaries = 3;
   constexpr int kSleeps = 25;
   SecondaryParking<4> parking;
-  std::array<std::int64_t, kSecondaries + 1> steps{};    // plain: each secondary's own state
+  std::array<std::int64_t, kSecondaries + 1> steps{};  // plain: each secondary's own state
   std::array<std::atomic<bool>, kSecondaries + 1> at_rest{};
   std::array<std::int64_t, kSecondaries + 1> woke_at{};  // plain: the last origin each saw
   std::atomic<bool> stop{false};
