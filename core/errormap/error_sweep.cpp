@@ -7,15 +7,15 @@
 #include <utility>
 #include <vector>
 
-#include "core/regions/async_regions.hpp"
-#include "core/scene/scene_model.hpp"
 #include "core/error.hpp"
-#include "core/trial/force_error.hpp"
 #include "core/errormap/parallel_for.hpp"
-#include "core/trial/reference_trial.hpp"
-#include "core/scene/scene_toml.hpp"
 #include "core/errormap/sweep_journal.hpp"
 #include "core/errormap/sweep_plan.hpp"
+#include "core/regions/async_regions.hpp"
+#include "core/scene/scene_model.hpp"
+#include "core/scene/scene_toml.hpp"
+#include "core/trial/force_error.hpp"
+#include "core/trial/reference_trial.hpp"
 
 #ifndef HAPTICSIM_CODE_VERSION
 #define HAPTICSIM_CODE_VERSION "unknown"
@@ -172,6 +172,14 @@ std::vector<std::size_t> ShardTasks(const std::vector<SweepTask>& tasks,
   return mine;
 }
 
+// The map's material axes are material.*: the one material of a cube, or of every voxel of a
+// geometry without [[material]] tables.
+constexpr const char* kOneMaterialOnly =
+    "the error map's material axes are material.* (E, ν, ρ, d), which an object of one material "
+    "has: a scene with [[material]] tables needs the map's material-contrast axis, which it does "
+    "not have yet. Give the object one material (material.*, no [[material]] tables), or run the "
+    "scene offline with `hapticsim simulate`";
+
 }  // namespace
 
 ModelTraits CurrentModel() {
@@ -184,8 +192,7 @@ std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
 ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   SweepStats* stats_out) {
   ValidateGrid(grid);
-  const std::string cube_only = CubeOnlyProblem(base, "the error map");
-  HAPTICSIM_THROW_UNLESS(cube_only.empty(), cube_only);
+  HAPTICSIM_THROW_UNLESS(base.materials.empty(), kOneMaterialOnly);
   HAPTICSIM_THROW_UNLESS(options.shard_count >= 1 && options.shard_index >= 0 &&
                              options.shard_index < options.shard_count,
                          "--shard I/N needs 1 ≤ I ≤ N");

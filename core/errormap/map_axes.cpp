@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 namespace {
@@ -29,7 +30,7 @@ const MapAxisInfo& AxisInfo(int axis) { return kAxes.at(static_cast<size_t>(axis
 
 MapPoint PointOfScene(const Scene& scene) {
   MapPoint point{};
-  const LatticeIndex node = ContactNode(scene);
+  const LatticeIndex node = SceneContactNode(scene);
   for (int a = 0; a < kNumMapAxes; ++a) {
     const MapAxisInfo& info = AxisInfo(a);
     point[a] = info.node_component >= 0 ? node[info.node_component]

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 
@@ -59,12 +60,12 @@ SweepGrid QuickGrid(const Scene& scene) {
       {600, 1000},
   }};
   SetContactAxes(scene_point, &grid);
-  const LatticeIndex node = ContactNode(scene);
+  const LatticeIndex node = SceneContactNode(scene);
   for (int axis = 0; axis < 3; ++axis) {
     for (int step : {-1, 1}) {
       LatticeIndex neighbour = node;
       neighbour[axis] += step;
-      if (!ContactNodeProblem(scene.mesh, neighbour).empty()) continue;
+      if (!ContactNodeProblemOn(scene, neighbour).empty()) continue;
       const double a = node[axis], b = neighbour[axis];
       grid.axes[static_cast<int>(MapAxis::kContactNodeX) + axis] = {std::min(a, b), std::max(a, b)};
       return grid;

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/regions/region_partition.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 namespace {
@@ -102,7 +103,7 @@ SizeGroups GroupSizesByRegions(const Scene& base, const Axes& ax, const ErrorMap
     for (int a : kContactAxes) at_node[a] = ax[a][index[a]];
     // A node that cannot be pressed is the grid's mistake, not the configuration's: said so.
     const LatticeIndex node = *SceneAtPoint(base, at_node).input.contact_node;
-    const std::string problem = ContactNodeProblem(base.mesh, node);
+    const std::string problem = ContactNodeProblemOn(base, node);
     HAPTICSIM_THROW_UNLESS(problem.empty(), "the grid's contact node (contact_node_x, _y, _z) = (" +
                                                 std::to_string(node[0]) + ", " +
                                                 std::to_string(node[1]) + ", " +

@@ -52,9 +52,8 @@ ObjectLayout VolumeLayout(const Scene& scene) {
 
 std::vector<int> FixedNodes(const Scene& scene, const ObjectLayout& object) {
   if (!scene.supports.empty()) {
-    return SelectSupportNodes(scene.supports,
-                              ObjectLattice{object.grid, object.field, object.origin_m,
-                                            object.labels});
+    return SelectSupportNodes(
+        scene.supports, ObjectLattice{object.grid, object.field, object.origin_m, object.labels});
   }
   HAPTICSIM_THROW_UNLESS(!scene.geometry.from_file(),
                          "a scene with geometry.file needs [[support]] tables saying which "
@@ -102,12 +101,13 @@ int ContactOf(const Scene& scene, const ObjectLayout& object) {
   const std::string name = "input.contact_node = " + GetSceneValue(scene, "input.contact_node");
   HAPTICSIM_THROW_UNLESS(at[0] < grid.nx() && at[1] < grid.ny() && at[2] < grid.nz(),
                          name + " is outside the geometry's lattice of " +
-                             std::to_string(grid.nx()) + " × " + std::to_string(grid.ny()) +
-                             " × " + std::to_string(grid.nz()) + " nodes");
+                             std::to_string(grid.nx()) + " × " + std::to_string(grid.ny()) + " × " +
+                             std::to_string(grid.nz()) + " nodes");
   const int node = grid.Node(at[0], at[1], at[2]);
   HAPTICSIM_THROW_UNLESS(IsObjectSurfaceNode(grid, object.field, node),
-                         name + " is not on the object's surface: choose a node of the object "
-                                "next to an empty voxel");
+                         name +
+                             " is not on the object's surface: choose a node of the object "
+                             "next to an empty voxel");
   return node;
 }
 
@@ -143,6 +143,28 @@ SceneObject DescribeSceneObject(const Scene& scene) {
   const std::string rigid = RigidBodyModeProblem(object.grid, object.field, fixed);
   HAPTICSIM_THROW_UNLESS(rigid.empty(), "the supports do not hold the object: " + rigid);
   return SceneObject{object.grid, std::move(object.field), fixed, contact, normal, object.origin_m};
+}
+
+LatticeIndex SceneContactNode(const Scene& scene) {
+  if (!scene.geometry.from_file() || scene.input.contact_node) return ContactNode(scene);
+  const SceneObject object = DescribeSceneObject(scene);
+  return object.grid.NodeIndices(object.contact_node);
+}
+
+std::string ContactNodeProblemOn(const Scene& scene, const LatticeIndex& node) {
+  if (!scene.geometry.from_file()) return ContactNodeProblem(scene.mesh, node);
+  Scene at = scene;
+  at.input.contact_node = node;
+  try {
+    (void)DescribeSceneObject(at);
+  } catch (const Error& e) {
+    // Worded to follow the node, as ContactNodeProblem's are ("node (…) is …").
+    const std::string named =
+        "input.contact_node = " + GetSceneValue(at, "input.contact_node") + " ";
+    const std::string what = e.what();
+    return what.rfind(named, 0) == 0 ? what.substr(named.size()) : "cannot be the contact: " + what;
+  }
+  return "";
 }
 
 SceneModel::SceneModel(const Scene& scene) : SceneModel(scene, DescribeSceneObject(scene)) {}

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "core/fem/elastic_model.hpp"
@@ -27,6 +28,20 @@ struct SceneObject {
  * @throws Error as SceneModel's constructor.
  */
 SceneObject DescribeSceneObject(const Scene& scene);
+
+/**
+ * The contact node of any scene, as lattice indices: input.contact_node, or the default (the
+ * cube's middle front node; on a geometry, the one SceneModel chooses).
+ * @throws Error as DescribeSceneObject, on a geometry.
+ */
+LatticeIndex SceneContactNode(const Scene& scene);
+
+/**
+ * Why `node` cannot be `scene`'s contact node, or "" when it can: on the cube,
+ * ContactNodeProblem's rule; on a geometry, what DescribeSceneObject says of it (outside the
+ * lattice, not on the object's surface, held by a support, no inward direction).
+ */
+std::string ContactNodeProblemOn(const Scene& scene, const LatticeIndex& node);
 
 /**
  * A scene as a model ready to step: the object's lattice and materials, its supports fixed in
@@ -76,7 +91,6 @@ bool IsObjectSurfaceNode(const HexGrid& grid, const MaterialField& field, int no
  * node to the centres of the occupied elements around it. {0, 0, 0} when they balance out (an
  * inside node, or a saddle), where no direction is the surface's.
  */
-std::array<double, 3> ObjectInwardNormal(const HexGrid& grid, const MaterialField& field,
-                                         int node);
+std::array<double, 3> ObjectInwardNormal(const HexGrid& grid, const MaterialField& field, int node);
 
 }  // namespace hapticsim

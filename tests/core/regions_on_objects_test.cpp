@@ -249,11 +249,7 @@ TEST(HybridMeshOnAnObject, EveryHeldNodeIsHeldExactly) {
 // of the middle column, pressed 3 mm.
 Scene NotchedScene(int primary_size, double secondary_rate_hz) {
   Scene scene = testing::VoxelScene(kVoxels[0], kVoxels[1], kVoxels[2], kH, NotchedBlockLabel);
-  SupportRegion back;
-  back.kind = SupportRegion::Kind::kPlane;
-  back.point_m = {0, 0, kH * kVoxels[2]};
-  back.normal = {0, 0, 1};
-  scene.supports = {back};
+  testing::HoldPlaneZ(&scene, kH * kVoxels[2]);
   const std::vector<Material> materials = TwoMaterials();
   scene.materials = {{1, materials[0]}, {2, materials[1]}};
   scene.input.amplitude_m = 0.003;

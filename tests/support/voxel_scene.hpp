@@ -34,6 +34,15 @@ inline Scene VoxelScene(int nx, int ny, int nz, double spacing_m,
   return scene;
 }
 
+/** `scene` with its nodes on the plane z = `z_m` (its back face) held: one [[support]] plane. */
+inline void HoldPlaneZ(Scene* scene, double z_m) {
+  SupportRegion back;
+  back.kind = SupportRegion::Kind::kPlane;
+  back.point_m = {0, 0, z_m};
+  back.normal = {0, 0, 1};
+  scene->supports = {back};
+}
+
 /** n³ voxels. */
 inline Scene VoxelScene(int n, double spacing_m, const std::function<int(int, int, int)>& label) {
   return VoxelScene(n, n, n, spacing_m, label);

@@ -121,7 +121,7 @@ TEST(ErrorMapCli, LookupInterpolatesClampsWithAFlagAndRefusesUnknownAxes) {
   // A contact node inside the object is no node a tool can press: refused, not clamped.
   const CommandResult inner = Hapticsim({"lookup", map, "--set", "contact_node=3,3,3"});
   EXPECT_EQ(inner.exit_status, 2);
-  EXPECT_NE(inner.err.find("contact_node=3,3,3: on the map's mesh this node is inside the object"),
+  EXPECT_NE(inner.err.find("contact_node=3,3,3: on the map's object this node is inside the object"),
             std::string::npos)
       << inner.err;
 }

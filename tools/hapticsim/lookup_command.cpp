@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/errormap/error_lookup.hpp"
 #include "core/errormap/error_map_file.hpp"
+#include "core/scene/scene_model.hpp"
 #include "core/scene/scene_toml.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
@@ -49,10 +50,10 @@ int Run(const LookupCommandOptions& o) {
     if (key == "contact_node" || key == "input.contact_node") {  // the three axes at once
       Scene scene = map_scene;  // "middle" is the middle of the map's mesh
       SetSceneValue(&scene, "input.contact_node", value);  // "ix,iy,iz", refused with the format
-      const LatticeIndex node = ContactNode(scene);
-      const std::string problem = ContactNodeProblem(scene.mesh, node);
+      const LatticeIndex node = SceneContactNode(scene);
+      const std::string problem = ContactNodeProblemOn(scene, node);
       HAPTICSIM_THROW_UNLESS(problem.empty(),
-                             "--set " + assignment + ": on the map's mesh this node " + problem);
+                             "--set " + assignment + ": on the map's object this node " + problem);
       for (int c = 0; c < 3; ++c) {
         const int axis = static_cast<int>(MapAxis::kContactNodeX) + c;
         query.lo[axis] = query.hi[axis] = node[c];
