@@ -4,6 +4,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -147,6 +148,7 @@ std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,
                                                  const ContactTracker::Contact& contact,
                                                  std::int64_t release_ns,
                                                  std::int32_t* flags) noexcept {
+  watched_this_period_ = false;  // until WatchEnergyBalance runs on these regions below
   if (!usable) return holding ? held_reaction_ : std::array<double, 3>{};
   std::array<double, 3> reaction{};
   // Asleep, the regions are exactly at rest at time 0: a touch steps on from there in this very
@@ -232,7 +234,7 @@ void HapticLoop::RestartEnergyWatch() noexcept {
   balance_peak_stored_j_ = 0;
   runaway_seen_ = false;
   runaway_periods_ = 0;
-  periods_since_over_watch_line_ = kNeverOverWatchLine;
+  over_watch_line_ = 0;
 }
 
 void HapticLoop::PublishPeriod(std::int64_t now_ns, const std::array<double, 3>& force_n,
@@ -277,16 +279,19 @@ void HapticLoop::TakeInput(const DeviceSample& sample) noexcept {
 
 void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
   if (sent.new_fault != PortGuard::Fault::kNone) {
-    // A simulated force no tissue gives while the state is, or within the watch's
-    // kRunawayPeriods periods was, above the runaway watch's line: that is the runaway the watch
-    // would count some periods later (its ratio swings across the line from period to period as
-    // it grows). Counted now, before the fault, so that the supervisor takes the regions off this
+    // A simulated force no tissue gives (or none at all), in a period these regions stepped,
+    // while their state has been above the runaway watch's line in at least kFaultRunawayPeriods
+    // of the watch's last kRunawayPeriods periods: that is the runaway the watch would count
+    // some periods later (its ratio swings across the line from period to period as it grows).
+    // Counted now, before the fault, so that the supervisor takes the regions off this
     // configuration instead of restarting it from rest — and the watch's count with it — where it
-    // ran away.
-    if (sent.new_fault == PortGuard::Fault::kDivergence &&
-        periods_since_over_watch_line_ < AsyncRegions::kRunawayPeriods) {
-      PublishRunaway();
-    }
+    // ran away. One period above the line is a prescribed jump of the contact node (see
+    // AsyncRegions::kRunawayPeriods), not a runaway.
+    const bool diverged = sent.new_fault == PortGuard::Fault::kDivergence ||
+                          sent.new_fault == PortGuard::Fault::kNonFinite;
+    const int recent =
+        std::popcount(over_watch_line_ & ((1u << AsyncRegions::kRunawayPeriods) - 1));
+    if (diverged && watched_this_period_ && recent >= kFaultRunawayPeriods) PublishRunaway();
     counters_.last_fault.Set(static_cast<int>(sent.new_fault));
     counters_.fault_latched.Set(true);
     restarted_since_fault_ = false;
@@ -315,11 +320,10 @@ void HapticLoop::WatchEnergyBalance() noexcept {
   // Once per set of regions: the supervisor takes them off this configuration (release: the
   // regions it reads with the count are the ones that ran away).
   const bool held = regions_->RunawayHeld(balance, &runaway_periods_);
+  watched_this_period_ = true;
+  over_watch_line_ = (over_watch_line_ << 1) | (runaway_periods_ > 0 ? 1u : 0u);
   if (runaway_periods_ > 0) {
-    periods_since_over_watch_line_ = 0;
     watched_ = {balance.state_energy_j, std::max(balance.allowed_j, regions_->port_floor_j())};
-  } else if (periods_since_over_watch_line_ < kNeverOverWatchLine) {
-    ++periods_since_over_watch_line_;
   }
   if (held) PublishRunaway();
 }

@@ -355,22 +355,25 @@ class HapticLoop {
   // secondary region of the installed regions.
   std::vector<std::unique_ptr<DeadlineMonitor>> monitors_;
   // The loop's protocols between its threads, one type each (see each one's memory order):
-  InputHandoff inputs_;                        // I/O → primary: every input, and the idle wait
-  ForceRing forces_;                           // primary → I/O: the answers
-  BlackBoxRing black_box_;                     // primary → supervisor: every period's record
-  RegionHandover handover_;                    // supervisor ↔ primary: a reconfiguration
-  SecondaryParking<kMaxRegions> parking_;      // primary ↔ secondaries: sleeping at rest
-  LoopCounters<kMaxRegions> counters_;         // region threads → anyone: counts and gauges
+  InputHandoff inputs_;                    // I/O → primary: every input, and the idle wait
+  ForceRing forces_;                       // primary → I/O: the answers
+  BlackBoxRing black_box_;                 // primary → supervisor: every period's record
+  RegionHandover handover_;                // supervisor ↔ primary: a reconfiguration
+  SecondaryParking<kMaxRegions> parking_;  // primary ↔ secondaries: sleeping at rest
+  LoopCounters<kMaxRegions> counters_;     // region threads → anyone: counts and gauges
   // Supervisor → primary: the error and flags every answer carries (each a value of its own).
   Relaxed<double> error_percent_{-1};
   Relaxed<std::int32_t> error_flags_{0};
   double balance_peak_stored_j_ = 0;  // primary thread: since the regions last started from rest
   bool runaway_seen_ = false;         // primary thread: these regions' runaway is counted
   int runaway_periods_ = 0;           // primary thread: periods in a row above the watch's line
-  // Primary thread: watched periods since the state was last above that line, and what the
-  // watch measured then (these regions'; kNeverOverWatchLine: not yet).
-  static constexpr int kNeverOverWatchLine = 1 << 30;
-  int periods_since_over_watch_line_ = kNeverOverWatchLine;
+  // Primary thread, of these regions: whether the watch ran in this period, one bit per
+  // watched period (newest lowest) set where the state was above its line, and what the watch
+  // measured the last time it was. A divergence fault counts as their runaway once the state
+  // was above the line in kFaultRunawayPeriods of the watch's last kRunawayPeriods periods.
+  static constexpr int kFaultRunawayPeriods = 2;
+  bool watched_this_period_ = false;
+  std::uint32_t over_watch_line_ = 0;
   RunawayEnergies watched_;
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::thread primary_thread_;
@@ -412,7 +415,7 @@ class HapticLoop {
   // another (only then does an answer cover first_seq … seq).
   std::int64_t first_taken_seq_ = -1;
   bool taken_in_sequence_ = true;
-  std::int64_t periods_run_ = 0;         // primary periods answered since the loop was made
+  std::int64_t periods_run_ = 0;  // primary periods answered since the loop was made
   DeviceSample last_input_;
 };
 

@@ -1,6 +1,7 @@
 #include "core/errormap/error_sweep.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -11,6 +12,7 @@
 #include "core/errormap/parallel_for.hpp"
 #include "core/errormap/sweep_journal.hpp"
 #include "core/errormap/sweep_plan.hpp"
+#include "core/fnv1a.hpp"
 #include "core/regions/async_regions.hpp"
 #include "core/scene/scene_model.hpp"
 #include "core/scene/scene_toml.hpp"
@@ -41,6 +43,29 @@ using References = std::map<ReferenceKey, Reference>;
 using PlacedSamples = std::vector<std::pair<std::size_t, MapSample>>;
 
 // The map the sweep fills: every sample's point, no result yet, and where it comes from.
+// The base scene as the map records it. On a geometry: its contact node resolved (a lookup of
+// the map's own node need not build the object), and a hash of the voxels the file held, as a
+// comment, so that a shard, a journal or a map of another file's object is not taken for this
+// one (merge and --resume compare the recorded scene).
+std::string RecordedScene(const Scene& base) {
+  if (!base.geometry.from_file()) return FormatSceneToml(base);
+  Scene resolved = base;
+  resolved.input.contact_node = SceneContactNode(base);
+  std::string comment;
+  if (base.loaded_geometry) {
+    const LabelVolume& v = base.loaded_geometry->voxels;
+    Fnv1a hash;
+    hash.Bytes(v.voxels.data(), sizeof v.voxels);
+    hash.Bytes(&v.spacing_m, sizeof v.spacing_m);
+    hash.Bytes(v.labels.data(), v.labels.size() * sizeof v.labels[0]);
+    char text[96];
+    std::snprintf(text, sizeof text, "# geometry.file's voxels: FNV-1a %016llx\n",
+                  static_cast<unsigned long long>(hash.value()));
+    comment = text;
+  }
+  return comment + FormatSceneToml(resolved);
+}
+
 ErrorMap EmptyMap(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   const ModelTraits& model, bool linear) {
   ErrorMap map;
@@ -51,7 +76,7 @@ ErrorMap EmptyMap(const Scene& base, const SweepGrid& grid, const SweepOptions& 
   } else {
     map = ErrorMap::MakeGrid(grid.axes);
   }
-  map.provenance.scene_toml = FormatSceneToml(base);
+  map.provenance.scene_toml = RecordedScene(base);
   map.provenance.model = model.name;
   map.provenance.code_version = CodeVersion();
   map.provenance.grid = grid.name;
@@ -175,10 +200,10 @@ std::vector<std::size_t> ShardTasks(const std::vector<SweepTask>& tasks,
 // The map's material axes are material.*: the one material of a cube, or of every voxel of a
 // geometry without [[material]] tables.
 constexpr const char* kOneMaterialOnly =
-    "the error map's material axes are material.* (E, ν, ρ, d), which an object of one material "
-    "has: a scene with [[material]] tables needs the map's material-contrast axis, which it does "
-    "not have yet. Give the object one material (material.*, no [[material]] tables), or run the "
-    "scene offline with `hapticsim simulate`";
+    "the error map's material axes are material.* (E, ν, ρ, d), which [[material]] tables "
+    "override, and an object of several materials needs the map's material-contrast axis, which "
+    "it does not have yet. Give the object one material with material.* and no [[material]] "
+    "tables, or run the scene offline with `hapticsim simulate`";
 
 }  // namespace
 

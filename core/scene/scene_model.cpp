@@ -99,7 +99,8 @@ int ContactOf(const Scene& scene, const ObjectLayout& object) {
   if (!scene.input.contact_node) return DefaultContactOnVolume(grid, object.field);
   const LatticeIndex at = *scene.input.contact_node;
   const std::string name = "input.contact_node = " + GetSceneValue(scene, "input.contact_node");
-  HAPTICSIM_THROW_UNLESS(at[0] < grid.nx() && at[1] < grid.ny() && at[2] < grid.nz(),
+  HAPTICSIM_THROW_UNLESS(at[0] >= 0 && at[1] >= 0 && at[2] >= 0 && at[0] < grid.nx() &&
+                             at[1] < grid.ny() && at[2] < grid.nz(),
                          name + " is outside the geometry's lattice of " +
                              std::to_string(grid.nx()) + " × " + std::to_string(grid.ny()) + " × " +
                              std::to_string(grid.nz()) + " nodes");
@@ -152,7 +153,11 @@ LatticeIndex SceneContactNode(const Scene& scene) {
 }
 
 std::string ContactNodeProblemOn(const Scene& scene, const LatticeIndex& node) {
-  if (!scene.geometry.from_file()) return ContactNodeProblem(scene.mesh, node);
+  // The cube's rule, and on the cube with [[support]] tables, whether they hold the node.
+  if (!scene.geometry.from_file()) {
+    const std::string problem = ContactNodeProblem(scene.mesh, node);
+    if (!problem.empty() || scene.supports.empty()) return problem;
+  }
   Scene at = scene;
   at.input.contact_node = node;
   try {

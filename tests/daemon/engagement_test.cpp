@@ -120,7 +120,9 @@ TEST(QuietPress, TheForceSentIsTheSimulatedForceWhereverTheGuardDidNotAct) {
     const bool contact = played.flags[n] & force_flags::kInContact;
     if (contact) simulated_peak = std::max(simulated_peak, -played.simulated_z[n]);
     peak = std::max(peak, -played.force_z[n]);
-    if (!acted && contact) EXPECT_EQ(played.force_z[n], played.simulated_z[n]) << n;
+    if (!acted && contact) {
+      EXPECT_EQ(played.force_z[n], played.simulated_z[n]) << n;
+    }
     if (acted) {
       ++limited;
       pulling += played.simulated_z[n] > 0;  // the tissue would pull the tool in: cut to zero

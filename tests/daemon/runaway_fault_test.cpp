@@ -1,10 +1,11 @@
 // A runaway that reaches the port first. The stress scene of the daemon's runaway test (seed 1,
-// case 160: a primary one element deep, the secondary at 700 Hz) grows by about 2.5× a period
-// once it runs away, so the port's divergence fault can latch before the runaway watch has seen
-// its kRunawayPeriods periods in a row. Were the fault only a fault, the supervisor would restart
-// the same configuration from rest where it ran away — and the watch's count with it. A
-// divergence while the state is, or within the watch's periods was, above the watch's line is
-// counted as the runaway at once, so the supervisor takes the regions to equal rates either way.
+// case 160: a primary one element deep, the secondary at 700 Hz) grows its energy by about 2× a
+// period once it runs away, so the port's divergence fault can latch before the runaway watch has
+// seen its kRunawayPeriods periods in a row. Were the fault only a fault, the supervisor would
+// restart the same configuration from rest where it ran away — and the watch's count with it. A
+// divergence once the state has been above the watch's line in 2 of the watch's last 5 periods
+// is counted as the runaway at once, so the supervisor takes the regions to equal rates either
+// way; a divergence before that is only a fault.
 // Played through hapticsimd's real primary period on one thread, in virtual time.
 #include <gtest/gtest.h>
 
@@ -66,11 +67,20 @@ TEST(RunawayAtThePort, ADivergenceWhileTheStateRunsAwayIsCountedAsTheRunawayAtOn
   EXPECT_EQ(faulted.runaway_period, faulted.fault_period)
       << "the divergence above the watch's line is the runaway: counted with the fault";
   EXPECT_GT(faulted.runaway.state_j, AsyncRegions::kRunawayFactor * faulted.runaway.allowed_j);
+  // A 20 N limit latches before the state has been above the watch's line at all (its ratio to
+  // what the balance allows is 31 then, against the line's 32): only a fault, no runaway.
+  HapticLoop::Options lower_fault;
+  lower_fault.port.fault_force_n = 20;
+  const PressRun early = Press(lower_fault, watched.runaway_period - 3);
+  ASSERT_GE(early.fault_period, 0) << "no divergence fault";
+  EXPECT_LT(early.fault_period, faulted.fault_period);
+  EXPECT_EQ(early.runaway_period, -1) << "counted in period " << early.runaway_period;
   std::printf(
       "runaway at the port: the watch alone counts it in period %d; a 30 N fault limit latches "
-      "in period %d and the runaway is counted with it (%.3e J against %.3e J allowed)\n",
+      "in period %d and the runaway is counted with it (%.3e J against %.3e J allowed); a 20 N "
+      "limit latches in period %d, below the line, and counts none\n",
       watched.runaway_period, faulted.fault_period, faulted.runaway.state_j,
-      faulted.runaway.allowed_j);
+      faulted.runaway.allowed_j, early.fault_period);
 }
 
 }  // namespace

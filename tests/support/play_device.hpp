@@ -37,9 +37,11 @@ inline std::vector<ForceRecord> PlayDevice(
 
 /**
  * hapticsimd's threads played on this one, for one primary period at `release_ns`: the input
- * (if any) arrives at the release, the secondary regions step in virtual time as far as the
- * primary's coming step needs (unless one of them may not: parked or paused), then the primary
- * period runs as if woken on time. Deterministic: no clock is read.
+ * (if any) arrives at the release, the secondary regions step in virtual time up to one primary
+ * step ahead (unless one of them may not: parked or paused), then the primary period runs as if
+ * woken on time. Deterministic: no clock is read. With several primary substeps a period, its
+ * later substeps see the secondaries' boundary as of the first (as behind a secondary thread a
+ * little late), not the virtual-time trial's exchange before every substep.
  */
 inline void PlayPeriodInVirtualTime(HapticLoop& loop, std::int64_t release_ns,
                                     const std::optional<DeviceSample>& input) {

@@ -173,7 +173,12 @@ TEST(RegionHandover, ThePrimaryLeavesTheRegionsAloneFromItsAcknowledgementUntilT
     handover.Resume(r % 3 == 0 ? RegionRestart::kCarryingMotion : RegionRestart::kKeepingContact,
                     at);
   }
-  std::this_thread::sleep_for(milliseconds(5));
+  // The last hand-back too, then a few periods.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (handed_back.load() < kReplacements + 1 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(microseconds(50));
+  }
+  std::this_thread::sleep_for(milliseconds(2));
   stop = true;
   primary.join();
   EXPECT_EQ(stepped_while_paused, 0);

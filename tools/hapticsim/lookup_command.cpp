@@ -48,7 +48,7 @@ int Run(const LookupCommandOptions& o) {
                            "--set " + assignment + ": expected KEY=VALUE or KEY=LOW:HIGH");
     const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
     if (key == "contact_node" || key == "input.contact_node") {  // the three axes at once
-      Scene scene = map_scene;  // "middle" is the middle of the map's mesh
+      Scene scene = map_scene;  // "middle": the map's object's default contact node
       SetSceneValue(&scene, "input.contact_node", value);  // "ix,iy,iz", refused with the format
       const LatticeIndex node = SceneContactNode(scene);
       const std::string problem = ContactNodeProblemOn(scene, node);
