@@ -42,7 +42,6 @@ struct Reference {
 using References = std::map<ReferenceKey, Reference>;
 using PlacedSamples = std::vector<std::pair<std::size_t, MapSample>>;
 
-// The map the sweep fills: every sample's point, no result yet, and where it comes from.
 // The base scene as the map records it. On a geometry: its contact node resolved (a lookup of
 // the map's own node need not build the object), and a hash of the voxels the file held, as a
 // comment, so that a shard, a journal or a map of another file's object is not taken for this
@@ -66,6 +65,7 @@ std::string RecordedScene(const Scene& base) {
   return comment + FormatSceneToml(resolved);
 }
 
+// The map the sweep fills: every sample's point, no result yet, and where it comes from.
 ErrorMap EmptyMap(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   const ModelTraits& model, bool linear) {
   ErrorMap map;

@@ -15,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "daemon/haptic_loop.hpp"
+#include "tests/support/play_device.hpp"
 
 namespace hapticsim {
 namespace {
@@ -32,30 +33,23 @@ struct Played {
   double most_attractive_n = 0;  // the largest +z force (pulling the tool in); 0 is right
 };
 
-// hapticsimd's threads played on this one: each period the input that arrived at its release
-// (when the device sent one), the secondary regions stepped in virtual time as far as the
-// primary's coming step needs, then the primary period. `before(n)` runs first (a supervisor).
+// hapticsimd's threads played on this one (testing::PlayPeriodInVirtualTime): each period the
+// input that arrived at its release (when the device sent one), then the secondaries and the
+// primary period. `before(n)` runs first (a supervisor).
 Played Play(
     HapticLoop& loop, const Depth& depth, int periods,
     const std::function<void(int)>& before = [](int) {}, std::int64_t seq_origin = 0) {
-  auto& regions = const_cast<AsyncRegions&>(loop.regions());
   Played played;
   static std::int64_t release = 1'000'000'000;  // one clock across the plays of a test
   ForceRecord record;
   double last = 0;
   for (int n = 0; n < periods; ++n, release += 1'000'000) {
     before(n);
+    std::optional<DeviceSample> input;
     if (const std::optional<double> z = depth(n)) {
-      loop.OfferInput(DeviceSample{seq_origin + n, release, {0.125, 0.125, *z}, false});
+      input = DeviceSample{seq_origin + n, release, {0.125, 0.125, *z}, false};
     }
-    bool may_step = true;
-    auto& live = const_cast<AsyncRegions&>(loop.regions());
-    for (int r = 1; r < live.num_regions() && may_step; ++r) may_step &= loop.SecondaryMayStep(r);
-    if (may_step) {
-      live.AdvanceSecondariesTo(live.state_ticks(kPrimaryRegion) +
-                                live.period_ticks(kPrimaryRegion));
-    }
-    loop.PrimaryPeriod(release, release);
+    testing::PlayPeriodInVirtualTime(loop, release, input);
     BlackBoxRecord box;
     while (loop.black_box().Pop(&box)) played.simulated_z.push_back(box.raw_force_n[2]);
     while (loop.forces().Pop(&record)) {
@@ -67,7 +61,6 @@ Played Play(
       last = z;
     }
   }
-  (void)regions;
   return played;
 }
 
