@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
                                                        {600, 1000},
                                                        {5, 6},
                                                        {6},
-                                                       {0}};
+                                                       {0},
+                                                       {1}};
   ErrorMap map = ErrorMap::MakeGrid(axes);
   for (size_t i = 0; i < map.samples.size(); ++i) {
     MapSample& s = map.samples[i];

@@ -205,7 +205,9 @@ class MapFileReader {
     if (version != kErrorMapFormatVersion) {
       Refuse(path_, "wrong format version " + std::to_string(version) + "; this hapticsim reads " +
                         std::to_string(kErrorMapFormatVersion) +
-                        (version == 1 ? " (version 1 maps have no contact-node axes)" : "") +
+                        (version == 1   ? " (version 1 maps have no contact-node axes)"
+                         : version == 2 ? " (version 2 maps have no material-contrast axis)"
+                                        : "") +
                         ": remake it with hapticsim sweep");
     }
     const auto count = Read<std::uint32_t>(header, 12);

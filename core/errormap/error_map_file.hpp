@@ -26,8 +26,9 @@ namespace hapticsim {
 /**
  * File format version written by SaveErrorMap and the only one LoadErrorMap reads.
  * 2: the contact node's three axes appended (version 1 maps have nine axes).
+ * 3: the material contrast appended (version 2 maps have twelve axes).
  */
-inline constexpr std::uint32_t kErrorMapFormatVersion = 2;
+inline constexpr std::uint32_t kErrorMapFormatVersion = 3;
 
 /** Writes the map atomically (a temporary file renamed over `path`). @throws Error on I/O. */
 void SaveErrorMap(const ErrorMap& map, const std::string& path);

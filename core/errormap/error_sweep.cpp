@@ -197,14 +197,6 @@ std::vector<std::size_t> ShardTasks(const std::vector<SweepTask>& tasks,
   return mine;
 }
 
-// The map's material axes are material.*: the one material of a cube, or of every voxel of a
-// geometry without [[material]] tables.
-constexpr const char* kOneMaterialOnly =
-    "the error map's material axes are material.* (E, ν, ρ, d), which [[material]] tables "
-    "override, and an object of several materials needs the map's material-contrast axis, which "
-    "it does not have yet. Give the object one material with material.* and no [[material]] "
-    "tables, or run the scene offline with `hapticsim simulate`";
-
 }  // namespace
 
 ModelTraits CurrentModel() {
@@ -217,7 +209,6 @@ std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
 ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   SweepStats* stats_out) {
   ValidateGrid(grid);
-  HAPTICSIM_THROW_UNLESS(base.materials.empty(), kOneMaterialOnly);
   HAPTICSIM_THROW_UNLESS(options.shard_count >= 1 && options.shard_index >= 0 &&
                              options.shard_index < options.shard_count,
                          "--shard I/N needs 1 ≤ I ≤ N");

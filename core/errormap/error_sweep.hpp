@@ -6,8 +6,8 @@
 #include <string>
 
 #include "core/errormap/error_map.hpp"
-#include "core/scene/scene.hpp"
 #include "core/errormap/sweep_grid.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 
@@ -34,13 +34,14 @@ struct SweepProgress {
 };
 
 struct SweepOptions {
-  int jobs = 1;                ///< worker threads
-  int shard_index = 0;         ///< this slice, 0-based
-  int shard_count = 1;         ///< slices of the task list
-  bool use_linearity = true;   ///< derive the amplitude axis when the model is linear
-  bool use_similarity = true;  ///< materials of equal E/ρ, ν, d: run once, force scaled by ρ
-  std::string journal_path;    ///< completed tasks are appended here ("" = none)
-  bool resume = false;         ///< read the journal first and skip what it holds
+  int jobs = 1;               ///< worker threads
+  int shard_index = 0;        ///< this slice, 0-based
+  int shard_count = 1;        ///< slices of the task list
+  bool use_linearity = true;  ///< derive the amplitude axis when the model is linear
+  bool use_similarity =
+      true;  ///< materials of equal E/ρ, ν, d, contrast: run once, force scaled by ρ
+  std::string journal_path;                 ///< completed tasks are appended here ("" = none)
+  bool resume = false;                      ///< read the journal first and skip what it holds
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after current tasks
   std::function<void(const SweepProgress&)> progress;
   double progress_interval_s = 0.5;
@@ -48,20 +49,22 @@ struct SweepOptions {
 
 /** What a sweep did, and what each saving bought (counts of runs not made). */
 struct SweepStats {
-  std::size_t samples = 0;                   ///< in this shard
-  std::size_t samples_resumed = 0;           ///< taken from the journal
-  std::size_t tasks = 0;                     ///< (material, configuration) tasks in this shard
-  std::size_t reference_trials = 0;          ///< full-resolution runs made
-  std::size_t adaptive_trials = 0;           ///< adaptive runs made
-  std::size_t stability_estimates = 0;  ///< always 0: the sweep no longer estimates (scripts read it)
+  std::size_t samples = 0;           ///< in this shard
+  std::size_t samples_resumed = 0;   ///< taken from the journal
+  std::size_t tasks = 0;             ///< (material, configuration) tasks in this shard
+  std::size_t reference_trials = 0;  ///< full-resolution runs made
+  std::size_t adaptive_trials = 0;   ///< adaptive runs made
+  std::size_t stability_estimates =
+      0;  ///< always 0: the sweep no longer estimates (scripts read it)
   std::size_t saved_by_reference_reuse = 0;  ///< reference runs not made: one per material+input
-  std::size_t saved_by_similarity = 0;  ///< adaptive runs not made: a material of equal E/ρ, ν, d
-  std::size_t saved_by_linearity = 0;   ///< adaptive runs not made: other amplitudes
+  std::size_t saved_by_similarity =
+      0;  ///< adaptive runs not made: a material of equal E/ρ, ν, d, contrast
+  std::size_t saved_by_linearity = 0;  ///< adaptive runs not made: other amplitudes
   std::size_t saved_by_same_regions =
       0;                                ///< adaptive runs not made: a size giving the same regions
   std::size_t saved_by_prediction = 0;  ///< always 0: nothing is refused (scripts read it)
   double reference_seconds = 0, adaptive_seconds = 0;  ///< CPU time
-  double stability_seconds = 0;  ///< always 0, as stability_estimates
+  double stability_seconds = 0;                        ///< always 0, as stability_estimates
   double wall_seconds = 0;
   bool interrupted = false;
 };

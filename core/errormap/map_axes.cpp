@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/scene/material_contrast.hpp"
 #include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
@@ -22,7 +23,26 @@ constexpr std::array<MapAxisInfo, kNumMapAxes> kAxes{{
     {"input.contact_node.x", "contact_node_x", "node", "contact x", true, false, 0},
     {"input.contact_node.y", "contact_node_y", "node", "contact y", true, false, 1},
     {"input.contact_node.z", "contact_node_z", "node", "contact z", true, false, 2},
+    // Not a scene key of its own: the [[material]] tables' stiffness relative to the base's.
+    {"[[material]] contrast", "material_contrast", "", "E ratio", false, true},
 }};
+
+constexpr int kContrast = static_cast<int>(MapAxis::kMaterialContrast);
+
+double MaterialValue(const Material& m, MapAxis axis) {
+  switch (axis) {
+    case MapAxis::kPoissonRatio:
+      return m.poisson_ratio;
+    case MapAxis::kDensity:
+      return m.density_kg_m3;
+    case MapAxis::kDamping:
+      return m.damping_per_s;
+    case MapAxis::kYoungsModulus:
+      return m.youngs_modulus_pa;
+    default:
+      return 0;
+  }
+}
 
 }  // namespace
 
@@ -31,16 +51,28 @@ const MapAxisInfo& AxisInfo(int axis) { return kAxes.at(static_cast<size_t>(axis
 MapPoint PointOfScene(const Scene& scene) {
   MapPoint point{};
   const LatticeIndex node = SceneContactNode(scene);
+  const Material base = BaseMaterial(scene);
   for (int a = 0; a < kNumMapAxes; ++a) {
     const MapAxisInfo& info = AxisInfo(a);
-    point[a] = info.node_component >= 0 ? node[info.node_component]
-                                        : std::stod(GetSceneValue(scene, info.scene_key));
+    if (a == kContrast) {
+      point[a] = MaterialContrast(scene);
+    } else if (info.material) {
+      point[a] = MaterialValue(base, static_cast<MapAxis>(a));
+    } else {
+      point[a] = info.node_component >= 0 ? node[info.node_component]
+                                          : std::stod(GetSceneValue(scene, info.scene_key));
+    }
   }
   return point;
 }
 
 Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
-  Scene scene = base;
+  Material material;
+  material.poisson_ratio = point[static_cast<int>(MapAxis::kPoissonRatio)];
+  material.density_kg_m3 = point[static_cast<int>(MapAxis::kDensity)];
+  material.damping_per_s = point[static_cast<int>(MapAxis::kDamping)];
+  material.youngs_modulus_pa = point[static_cast<int>(MapAxis::kYoungsModulus)];
+  Scene scene = SceneWithMaterials(base, material, point[kContrast]);
   // "ix,iy,iz" (the node axes come in component order), set through the scene key so that it is
   // checked as any other value.
   std::string node;
@@ -56,7 +88,7 @@ Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
         continue;
       }
       SetSceneValue(&scene, info.scene_key, std::to_string(static_cast<long>(point[a])));
-    } else {
+    } else if (!info.material) {
       SetSceneValue(&scene, info.scene_key, FormatReal(point[a]));
     }
   }

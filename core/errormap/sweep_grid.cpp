@@ -17,8 +17,10 @@ std::size_t SweepGrid::NumSamples() const {
 
 namespace {
 
-void SetContactAxes(const MapPoint& scene_point, SweepGrid* grid) {
-  for (MapAxis axis : {MapAxis::kContactNodeX, MapAxis::kContactNodeY, MapAxis::kContactNodeZ}) {
+// The axes a grid of the paper's does not vary: the scene's contact node and material contrast.
+void SetSceneAxes(const MapPoint& scene_point, SweepGrid* grid) {
+  for (MapAxis axis : {MapAxis::kContactNodeX, MapAxis::kContactNodeY, MapAxis::kContactNodeZ,
+                       MapAxis::kMaterialContrast}) {
     const int a = static_cast<int>(axis);
     grid->axes[a] = {scene_point[a]};
   }
@@ -40,7 +42,7 @@ SweepGrid PaperGrid(const MapPoint& scene_point) {
       {1, 2, 3, 4},
       {600, 700, 800, 900, 1000},
   }};
-  SetContactAxes(scene_point, &grid);
+  SetSceneAxes(scene_point, &grid);
   return grid;
 }
 
@@ -59,7 +61,13 @@ SweepGrid QuickGrid(const Scene& scene) {
       {1, 4},
       {600, 1000},
   }};
-  SetContactAxes(scene_point, &grid);
+  SetSceneAxes(scene_point, &grid);
+  // An object of several materials: from one material (contrast 1) to the scene's contrast.
+  const int contrast = static_cast<int>(MapAxis::kMaterialContrast);
+  if (scene_point[contrast] != 1) {
+    grid.axes[contrast] = {std::min(1.0, scene_point[contrast]),
+                           std::max(1.0, scene_point[contrast])};
+  }
   const LatticeIndex node = SceneContactNode(scene);
   for (int axis = 0; axis < 3; ++axis) {
     for (int step : {-1, 1}) {

@@ -23,15 +23,16 @@ struct SweepGrid {
  * The paper's grid (Section V-B): ν {0.40, 0.45, 0.49}, ρ {800, 1000, 1200} kg/m³,
  * d {10, 20, 30, 40} 1/s, E {5, 10, 15, 20} kPa, amplitude {0.005, 0.010, 0.015} m,
  * frequency {0.5, 1.0, 1.25} Hz, spacing factor {1, 2, 3}, primary size {1, 2, 3, 4},
- * secondary rate {1000, 900, 800, 700, 600} Hz: 77,760 samples, all at the contact node of
- * `scene_point` (the paper presses one node).
+ * secondary rate {1000, 900, 800, 700, 600} Hz: 77,760 samples, all at the contact node and
+ * material contrast of `scene_point` (the paper presses one node of one material).
  */
 SweepGrid PaperGrid(const MapPoint& scene_point);
 
 /**
  * Two values on every axis of the paper's grid (the ends), and two contact nodes: the scene's and
  * its first neighbour (−x, +x, −y, +y, −z, +z) that is a free surface node of the scene's mesh
- * (the scene's alone if none is). Under a minute.
+ * (the scene's alone if none is); on an object of several materials, two contrasts: 1 and the
+ * scene's. Under a minute on the cube.
  */
 SweepGrid QuickGrid(const Scene& scene);
 

@@ -51,34 +51,43 @@ std::vector<int> RegionSignature(const Scene& scene) {
   return signature;
 }
 
-// The grid's materials (the four material axes, the last fastest) and, per material, the one
-// that is run for it: the first of equal E/ρ, ν and d when `similar`, else itself.
+// The map's material axes: the base material's four, then the contrast of the others to it.
+constexpr std::array<int, 5> kMaterialAxes = {
+    Axis(MapAxis::kPoissonRatio), Axis(MapAxis::kDensity), Axis(MapAxis::kDamping),
+    Axis(MapAxis::kYoungsModulus), Axis(MapAxis::kMaterialContrast)};
+using MaterialIndex = std::array<int, kMaterialAxes.size()>;  // per material axis, in that order
+
+// The grid's materials (the material axes, the last fastest) and, per material, the one that is
+// run for it: the first of equal E/ρ, ν, d and contrast when `similar`, else itself. (At equal
+// contrast every material's E and ρ scale with the base's, so equal E/ρ of the base is equal
+// wave speeds everywhere: SceneWithMaterials.)
 struct GridMaterials {
-  std::vector<std::array<int, 4>> index;  // per material: its index on each material axis
+  std::vector<MaterialIndex> index;  // per material: its index on each material axis
   std::vector<std::size_t> run_as;
 };
 GridMaterials MaterialsOf(const Axes& ax, bool similar) {
-  const int nu = Axis(MapAxis::kPoissonRatio), rho = Axis(MapAxis::kDensity),
-            d = Axis(MapAxis::kDamping), e = Axis(MapAxis::kYoungsModulus);
-  static_assert(Axis(MapAxis::kPoissonRatio) == 0 && Axis(MapAxis::kYoungsModulus) == 3,
-                "the material axes are the first four");
+  enum { kNu, kRho, kD, kE, kContrast };  // positions in kMaterialAxes
+  auto value = [&ax](const MaterialIndex& index, int k) { return ax[kMaterialAxes[k]][index[k]]; };
   GridMaterials out;
-  const size_t count = ax[0].size() * ax[1].size() * ax[2].size() * ax[3].size();
+  size_t count = 1;
+  for (int a : kMaterialAxes) count *= ax[a].size();
   for (size_t m = 0; m < count; ++m) {
-    std::array<int, 4> index{};
-    for (int a = 3, rest = static_cast<int>(m); a >= 0; --a) {
-      index[a] = rest % static_cast<int>(ax[a].size());
-      rest /= static_cast<int>(ax[a].size());
+    MaterialIndex index{};
+    for (int k = static_cast<int>(kMaterialAxes.size()) - 1, rest = static_cast<int>(m); k >= 0;
+         --k) {
+      const int size = static_cast<int>(ax[kMaterialAxes[k]].size());
+      index[k] = rest % size;
+      rest /= size;
     }
     out.index.push_back(index);
     out.run_as.push_back(m);
     if (!similar) continue;
-    const double wave_speed_squared = ax[e][index[e]] / ax[rho][index[rho]];
+    const double wave_speed_squared = value(index, kE) / value(index, kRho);
     for (size_t earlier = 0; earlier < m; ++earlier) {
       if (out.run_as[earlier] != earlier) continue;  // only a material that is run answers
-      const std::array<int, 4>& o = out.index[earlier];
-      if (o[nu] == index[nu] && o[d] == index[d] &&
-          std::abs(ax[e][o[e]] / ax[rho][o[rho]] - wave_speed_squared) <=
+      const MaterialIndex& o = out.index[earlier];
+      if (o[kNu] == index[kNu] && o[kD] == index[kD] && o[kContrast] == index[kContrast] &&
+          std::abs(value(o, kE) / value(o, kRho) - wave_speed_squared) <=
               1e-12 * wave_speed_squared) {
         out.run_as.back() = earlier;
         break;
@@ -86,6 +95,10 @@ GridMaterials MaterialsOf(const Axes& ax, bool similar) {
     }
   }
   return out;
+}
+
+void SetMaterialIndex(const MaterialIndex& material, AxisIndex* index) {
+  for (size_t k = 0; k < kMaterialAxes.size(); ++k) (*index)[kMaterialAxes[k]] = material[k];
 }
 
 // Per contact node and spacing factor, the primary sizes grouped by the regions they give: each
@@ -154,7 +167,7 @@ SweepTask TaskFor(const Axes& ax, const ErrorMap& layout, const GridMaterials& m
       const double amplitude = run.point[amp_axis];
       for (size_t member : answered) {
         AxisIndex target_index = index;
-        for (int a = 0; a < 4; ++a) target_index[a] = materials.index[member][a];
+        SetMaterialIndex(materials.index[member], &target_index);
         const double density_ratio =
             ax[density][target_index[density]] / ax[density][index[density]];
         for (int s : group) {
@@ -185,7 +198,7 @@ ReferenceKey ReferenceKeyOf(const MapPoint& p) {
           p[Axis(MapAxis::kDamping)],      p[Axis(MapAxis::kYoungsModulus)],
           p[Axis(MapAxis::kAmplitude)],    p[Axis(MapAxis::kFrequency)],
           p[Axis(MapAxis::kContactNodeX)], p[Axis(MapAxis::kContactNodeY)],
-          p[Axis(MapAxis::kContactNodeZ)]};
+          p[Axis(MapAxis::kContactNodeZ)], p[Axis(MapAxis::kMaterialContrast)]};
 }
 
 std::vector<SweepTask> PlanGridTasks(const Scene& base, const SweepGrid& grid, bool linear,
@@ -204,7 +217,7 @@ std::vector<SweepTask> PlanGridTasks(const Scene& base, const SweepGrid& grid, b
     for (size_t other = m; other < materials.index.size(); ++other) {
       if (materials.run_as[other] == m) answered.push_back(other);
     }
-    for (int a = 0; a < 4; ++a) index[a] = materials.index[m][a];
+    SetMaterialIndex(materials.index[m], &index);
     for (std::size_t c = 0; c < size_groups.size(); ++c) {
       SetContactIndex(ax, c, &index);
       for (size_t l = 0; l < ax[lod_axis].size(); ++l) {

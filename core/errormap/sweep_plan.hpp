@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "core/errormap/error_map.hpp"
-#include "core/scene/scene.hpp"
 #include "core/errormap/sweep_grid.hpp"
+#include "core/scene/scene.hpp"
 
 namespace hapticsim {
 
@@ -32,15 +32,15 @@ struct SweepTask {
 };
 
 /** The material and input (with the contact node) a reference run depends on. */
-using ReferenceKey = std::array<double, 9>;
+using ReferenceKey = std::array<double, 10>;
 ReferenceKey ReferenceKeyOf(const MapPoint& point);
 
 /**
  * The grid's tasks, in the fixed order that shards and journals number: materials outermost,
  * then contact node, spacing factor, rate and region group. Primary sizes that give the same
  * regions around a node share one task; with `linear`, one run per frequency answers every
- * amplitude; with `similar`, a material of an earlier one's E/ρ, ν and d has no tasks of its own
- * (the earlier one's runs fill its samples, forces × the density ratio).
+ * amplitude; with `similar`, a material of an earlier one's E/ρ, ν, d and contrast has no tasks of
+ * its own (the earlier one's runs fill its samples, forces × the density ratio).
  * @throws Error naming the contact node or configuration the grid cannot run.
  */
 std::vector<SweepTask> PlanGridTasks(const Scene& base, const SweepGrid& grid, bool linear,

@@ -46,7 +46,8 @@ void SetMaterialTableValue(LabelMaterial* table, std::string_view key, std::stri
   if (std::find(MaterialTableKeys().begin(), MaterialTableKeys().end(), key) ==
       MaterialTableKeys().end()) {
     std::string known;
-    for (std::string_view k : MaterialTableKeys()) known += (known.empty() ? "" : ", ") + std::string(k);
+    for (std::string_view k : MaterialTableKeys())
+      known += (known.empty() ? "" : ", ") + std::string(k);
     throw Error("unknown [[material]] key '" + std::string(key) + "'; known keys: " + known);
   }
   // The [material] key of the same name checks the range and says what is allowed.
@@ -104,17 +105,16 @@ void ValidateLabelMaterials(const Scene& scene) {
   for (std::size_t i = 0; i < tables.size(); ++i) {
     HAPTICSIM_THROW_UNLESS(
         std::find(present.begin(), present.end(), tables[i].label) != present.end(),
-        TableName(tables[i], i) + ": label " + std::to_string(tables[i].label) +
-            " is not in " + scene.geometry.file + " at geometry.spacing_m (its labels: " +
-            LabelList(present) + ")");
+        TableName(tables[i], i) + ": label " + std::to_string(tables[i].label) + " is not in " +
+            scene.geometry.file + " at geometry.spacing_m (its labels: " + LabelList(present) +
+            ")");
   }
   for (std::uint16_t label : present) {
     const bool named = std::any_of(tables.begin(), tables.end(),
                                    [&](const LabelMaterial& t) { return t.label == label; });
-    HAPTICSIM_THROW_UNLESS(named, scene.geometry.file + " has voxels labelled " +
-                                      std::to_string(label) +
-                                      " but no [[material]] table names label " +
-                                      std::to_string(label) + ": add one");
+    HAPTICSIM_THROW_UNLESS(
+        named, scene.geometry.file + " has voxels labelled " + std::to_string(label) +
+                   " but no [[material]] table names label " + std::to_string(label) + ": add one");
   }
 }
 
@@ -126,10 +126,18 @@ LabelMaterialIndex IndexLabelMaterials(const Scene& scene) {
     std::fill(index.index_of_label.begin() + 1, index.index_of_label.end(), 0);
     return index;
   }
+  // Labels of equal materials share one: the object has no boundary between them, so the
+  // regions may coarsen across it (a coarse element is of one material).
+  auto same = [](const Material& a, const Material& b) {
+    return a.youngs_modulus_pa == b.youngs_modulus_pa && a.poisson_ratio == b.poisson_ratio &&
+           a.density_kg_m3 == b.density_kg_m3 && a.damping_per_s == b.damping_per_s;
+  };
   for (const LabelMaterial& table : scene.materials) {
+    const auto equal = std::find_if(index.materials.begin(), index.materials.end(),
+                                    [&](const Material& m) { return same(m, table.material); });
     index.index_of_label[static_cast<std::size_t>(table.label)] =
-        static_cast<int>(index.materials.size());
-    index.materials.push_back(table.material);
+        static_cast<int>(equal - index.materials.begin());
+    if (equal == index.materials.end()) index.materials.push_back(table.material);
   }
   return index;
 }

@@ -31,7 +31,8 @@ void ValidateLabelMaterials(const Scene& scene);
 
 /**
  * The material of each label 0…65535 as an index into `materials` (−1: none, label 0 always),
- * and those materials: the [[material]] tables, or [material] for every label when there are none.
+ * and those materials: the [[material]] tables' (labels of equal materials share one: there is
+ * no boundary between them), or [material] for every label when there are none.
  */
 struct LabelMaterialIndex {
   std::vector<Material> materials;

@@ -97,6 +97,11 @@ TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSaying
   WriteAll(path, version);
   EXPECT_NE(LoadError(path).find("version 1 maps have no contact-node axes"), std::string::npos)
       << LoadError(path);
+  version[8] = 2;  // a map from before the material-contrast axis
+  WriteAll(path, version);
+  EXPECT_NE(LoadError(path).find("version 2 maps have no material-contrast axis"),
+            std::string::npos)
+      << LoadError(path);
 
   WriteAll(path, "[mesh]\nnodes = 13\n# a scene file, not a map\n");
   EXPECT_NE(LoadError(path).find("not an error map"), std::string::npos) << LoadError(path);

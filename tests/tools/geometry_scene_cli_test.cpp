@@ -166,18 +166,20 @@ TEST(GeometrySceneCli, AGeometrySceneThatCannotRunIsRefusedSayingWhatToChange) {
             std::string::npos);
   EXPECT_NE(refused("[geometry]\nfile = \"shape.ply\"\nspacing_m = 0.05\n").find(".nii, .nii.gz"),
             std::string::npos);
-  // The error map's material axes are material.*, which [[material]] tables override (and an
-  // object of several materials needs an axis the map does not have yet): refused.
+  // One [[material]] table is an object of one material: the map has no contrast for it but 1.
   {
     std::ofstream(Temp("sweep.toml"))
         << BoxScene(box)
         << "\n[[material]]\nlabel = 1\nyoungs_modulus = 10000.0\npoisson_ratio = 0.45\n"
            "density = 1000.0\ndamping = 10.0\n";
+    std::ofstream(Temp("contrast.toml")) << "[axes]\nmaterial_contrast = [1.0, 5.0]\n";
     const CommandResult sweep =
-        Hapticsim({"sweep", "--scene", Temp("sweep.toml"), "--out", Temp("never.hsmap"), "--set",
-                   "adaptivity.primary_size=3"});
+        Hapticsim({"sweep", "--scene", Temp("sweep.toml"), "--grid", Temp("contrast.toml"), "--out",
+                   Temp("never.hsmap"), "--set", "adaptivity.primary_size=3"});
     EXPECT_EQ(sweep.exit_status, 2) << sweep.out;
-    EXPECT_NE(sweep.err.find("which [[material]] tables override"), std::string::npos) << sweep.err;
+    EXPECT_NE(sweep.err.find("material contrast = 5.0 needs an object of several materials"),
+              std::string::npos)
+        << sweep.err;
   }
   EXPECT_NE(refused(BoxScene(box), {"--set", "geometry.spacing_m=0.00001"})
                 .find("coarser geometry.spacing_m"),

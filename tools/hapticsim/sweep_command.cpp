@@ -124,7 +124,7 @@ int Run(const SweepCommandOptions& o) {
                                       : "")
             << "\n"
             << "  runs saved: " << stats.saved_by_reference_reuse << " references (reuse), "
-            << stats.saved_by_similarity << " adaptive (materials of equal E/ρ, ν, d), "
+            << stats.saved_by_similarity << " adaptive (materials of equal E/ρ, ν, d, contrast), "
             << stats.saved_by_linearity << " adaptive (linearity in amplitude), "
             << stats.saved_by_same_regions << " adaptive (sizes giving the same regions)\n"
             << "  CPU time: references " << Duration(stats.reference_seconds) << ", adaptive "
@@ -144,8 +144,8 @@ Command AddSweepCommand(CLI::App& parent) {
   AddSceneOptions(app, &o->scene);
   app->add_option(
          "--grid", o->grid,
-         "paper (the paper's 77,760 points), quick (2 values per parameter, 2 contact nodes, "
-         "under a minute), "
+         "paper (the paper's 77,760 points), quick (2 values per parameter, 2 contact nodes; "
+         "under a minute on the cube), "
          "scene (the scene's material, all inputs and configurations: the daemon's map) "
          "or FILE.toml ([axes] lists)")
       ->capture_default_str();
@@ -166,8 +166,8 @@ Command AddSweepCommand(CLI::App& parent) {
   app->add_flag("--no-linearity", o->no_linearity,
                 "Run every amplitude instead of deriving the amplitude axis from linearity");
   app->add_flag("--no-similarity", o->no_similarity,
-                "Run every material instead of deriving a material of the same E/ρ, ν and d as "
-                "an earlier one from it (its forces scaled by the density ratio)");
+                "Run every material instead of deriving a material of the same E/ρ, ν, d and "
+                "contrast as an earlier one from it (its forces scaled by the density ratio)");
   return {app, [o] { return Run(*o); }};
 }
 

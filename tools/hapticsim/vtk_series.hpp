@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/regions/hybrid_mesh.hpp"
-#include "core/fem/object_state.hpp"
 #include "core/fem/material.hpp"
+#include "core/fem/object_state.hpp"
+#include "core/regions/hybrid_mesh.hpp"
 #include "core/scene/scene_model.hpp"
 
 namespace hapticsim::cli {
@@ -37,7 +37,8 @@ VtkObject VtkObjectOf(const SceneObject& object);
  *              voxel uses: zero, and no cell refers to it),
  *   cell data  `von_mises_pa` (Pa, at each cell's centre, VonMisesPerCell, of the cell's
  *              material), `region` (0 the primary, 1… the secondary shells; 0 everywhere for the
- *              reference) and `material` (0, 1, … in the order of the [[material]] tables),
+ *              reference) and `material` (0, 1, … the distinct materials in the order of the
+ *              [[material]] tables that first give them; tables of equal material share one),
  * and a .pvd collection that gives each file its time, s. Written as ASCII with 17 significant
  * digits, so a reader gets back the simulation's doubles exactly. The format is small enough to
  * write here; VTK's own library would bring a large dependency to a tool that only writes it.
@@ -55,7 +56,7 @@ class VtkSeries {
   std::filesystem::path collection() const { return dir_ / (name_ + ".pvd"); }
   int frames() const { return static_cast<int>(written_.size()); }
 
- /** A cell of the object: its lattice cell's number (ix slowest) and its lowest corner. */
+  /** A cell of the object: its lattice cell's number (ix slowest) and its lowest corner. */
   struct Cell {
     std::size_t lattice_cell;
     std::array<int, 3> corner;

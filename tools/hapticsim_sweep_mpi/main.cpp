@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   app.add_option("--jobs,-j", o.jobs, "Worker threads per rank")->capture_default_str();
   app.add_option("--out,-o", o.out, "Merged map to write")->capture_default_str();
   app.add_flag("--no-linearity", o.no_linearity, "Run every amplitude");
-  app.add_flag("--no-similarity", o.no_similarity, "Run every material (equal E/ρ, ν, d too)");
+  app.add_flag("--no-similarity", o.no_similarity,
+               "Run every material (equal E/ρ, ν, d and contrast too)");
   int status = 0;
   try {
     app.parse(argc, argv);
