@@ -17,8 +17,8 @@ enum class Cell : char { kEmpty, kCoarse, kRefined };
 
 // What each coarse cell becomes, to which region it belongs, and of which material it is whole.
 struct CellPlan {
-  int k = 1;                   // fine intervals per coarse cell
-  std::array<int, 3> nc{};     // coarse cells per axis
+  int k = 1;                // fine intervals per coarse cell
+  std::array<int, 3> nc{};  // coarse cells per axis
   std::vector<Cell> state;
   std::vector<RegionIndex> region;
   std::vector<std::int16_t> material;  // a coarse cell's one material
@@ -102,15 +102,22 @@ struct Supports {
       if (p[a] < 0 || p[a] >= padded[a]) return false;
     return std::binary_search(held.begin(), held.end(), Key(p));
   }
-  // No held node among its six lattice neighbours: a point support.
-  bool Isolated(const std::array<int, 3>& p) const {
-    for (int a = 0; a < 3; ++a)
+  // A point support (no held node among its six lattice neighbours) or a node of a line of them
+  // (held neighbours along one lattice axis only): both are singular, the displacement near
+  // them unbounded in the continuum, so a coarse cell there is far too stiff. A node of a held
+  // surface (held neighbours along two axes or more) is not.
+  bool PointOrLine(const std::array<int, 3>& p) const {
+    int axes_held = 0;
+    for (int a = 0; a < 3; ++a) {
+      bool held = false;
       for (int step : {-1, 1}) {
         std::array<int, 3> q = p;
         q[a] += step;
-        if (Held(q)) return false;
+        held = held || Held(q);
       }
-    return true;
+      axes_held += held;
+    }
+    return axes_held <= 1;
   }
 };
 
@@ -174,9 +181,9 @@ CellPlan PlanCells(const HybridMesh::Options& options, const std::array<int, 3>&
   Supports supports{padded, {}};
   for (const auto& s : options.supports) supports.held.push_back(supports.Key(s));
   std::sort(supports.held.begin(), supports.held.end());
-  std::vector<std::array<int, 3>> point_supports;
+  std::vector<std::array<int, 3>> singular_supports;
   for (const auto& s : options.supports)
-    if (supports.Isolated(s)) point_supports.push_back(s);
+    if (supports.PointOrLine(s)) singular_supports.push_back(s);
   const int reach = options.support_layers * k;
   for (int cz = 0; cz < plan.nc[2]; ++cz) {
     for (int cy = 0; cy < plan.nc[1]; ++cy) {
@@ -189,7 +196,7 @@ CellPlan PlanCells(const HybridMesh::Options& options, const std::array<int, 3>&
           primary = primary && CellOverlaps(c[a], k, options.primary_lo[a], options.primary_hi[a]);
         }
         bool near_support = false;
-        for (const auto& s : point_supports) {
+        for (const auto& s : singular_supports) {
           bool near = reach > 0;
           for (int a = 0; a < 3; ++a)
             near = near && CellOverlaps(c[a], k, s[a] - reach, s[a] + reach);
@@ -429,10 +436,9 @@ Eigen::VectorXd HybridMesh::DofMass(const std::vector<Material>& materials) cons
 
 Eigen::VectorXd HybridMesh::DofDamping(const std::vector<Material>& materials) const {
   const double first = materials.at(elements_.front().material).damping_per_s;
-  const bool one_rate =
-      std::all_of(elements_.begin(), elements_.end(), [&](const HybridElement& e) {
-        return materials.at(e.material).damping_per_s == first;
-      });
+  const bool one_rate = std::all_of(
+      elements_.begin(), elements_.end(),
+      [&](const HybridElement& e) { return materials.at(e.material).damping_per_s == first; });
   if (one_rate) return Eigen::VectorXd::Constant(num_dofs(), first);
   // Σ_e d_e·M_e lumped, divided by Σ_e M_e.
   const int nr = num_independent();

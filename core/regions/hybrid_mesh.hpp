@@ -32,8 +32,8 @@ struct GatherTerm {
 /**
  * An object on a lattice meshed at two resolutions: coarse cells of k × k × k fine intervals, of
  * which some are refined into their fine cells — those meeting the primary box around the contact,
- * those around point supports, and those the object fills only in part or with more than one
- * material (its surface and its material boundaries, so a coarse element is always whole and of
+ * those around point and line supports, and those the object fills only in part or with more than
+ * one material (its surface and its material boundaries, so a coarse element is always whole and of
  * one material). Where a refined cell meets an unrefined one, the fine nodes that are not coarse
  * vertices ("hanging nodes") are constrained to the coarse cell's trilinear field, which on the
  * shared face is bilinear, so the displacement stays continuous (conforming).
@@ -53,9 +53,9 @@ struct GatherTerm {
 class HybridMesh {
  public:
   struct Options {
-    std::array<int, 3> lattice_nodes{13, 13, 13};   ///< fine lattice points along x, y, z
-    double spacing_m = 0.25 / 12;                   ///< fine spacing h, m
-    int coarse_factor = 2;                          ///< k
+    std::array<int, 3> lattice_nodes{13, 13, 13};  ///< fine lattice points along x, y, z
+    double spacing_m = 0.25 / 12;                  ///< fine spacing h, m
+    int coarse_factor = 2;                         ///< k
     /// Per fine lattice cell, x fastest (MaterialField's element order): its material index, or
     /// −1 where the object is not. Empty: every cell of material 0.
     std::vector<std::int16_t> cell_material;
@@ -64,8 +64,9 @@ class HybridMesh {
     /// field it does not share (a vertex of that cell is free) refines the cell, so every support
     /// is held exactly.
     std::vector<std::array<int, 3>> supports;
-    /// Coarse cells refined around each point support (a held node none of whose six lattice
-    /// neighbours is held), per direction: a coarse cell at a point support is far too stiff.
+    /// Coarse cells refined around each point or line support (a held node whose held lattice
+    /// neighbours, if any, lie along one axis), per direction: a coarse cell at a singular
+    /// support is far too stiff. Held surfaces are not singular and are not refined.
     int support_layers = 1;
     /// Secondary cells split into this many nested shells around the primary cells (regions
     /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.

@@ -228,7 +228,8 @@ void AddInputKeys(std::vector<KeyAccess>& keys) {
   keys.push_back(Real(
       {"input.stroke_length", "m", "finite and >= 0",
        "how far a stroke moves the tool along the surface (input.waveform = \"stroke\")"},
-      [](Scene& s) -> double& { return s.input.stroke_length_m; }, [](double v) { return v >= 0; }));
+      [](Scene& s) -> double& { return s.input.stroke_length_m; },
+      [](double v) { return v >= 0; }));
   keys.push_back(Choice(
       {"input.stroke_direction", "",
        "\"x\", \"-x\", \"y\", \"-y\", \"z\" or \"-z\", along the contact's face",
@@ -284,8 +285,9 @@ void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
       [](double v) { return v >= 1 && v == std::floor(v); }));
   keys.push_back(Integer(
       {"adaptivity.support_layers", "", "a whole number from 0 to 100",
-       "coarse cells refined around each point support, a held node with no held "
-       "neighbour such as the cube's corners (singular: a coarse cell there is far too stiff)"},
+       "coarse cells refined around each point or line support: a held node with no held "
+       "neighbour (the cube's corners) or held neighbours along one axis only (a held edge); "
+       "singular, a coarse cell there is far too stiff"},
       [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
   keys.push_back(Integer(
       {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",
@@ -297,8 +299,7 @@ void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
        "thickness of each secondary shell but the last, in coarse cells"},
       [](Scene& s) -> int& { return s.adaptivity.shell_cells; }, 1, 100));
   keys.push_back(Real(
-      {"adaptivity.outer_rate", "Hz",
-       "a whole number of Hz from 1 to the primary rate 1/solver.dt",
+      {"adaptivity.outer_rate", "Hz", "a whole number of Hz from 1 to the primary rate 1/solver.dt",
        "update rate of the secondary shells beyond the first"},
       [](Scene& s) -> double& { return s.adaptivity.outer_rate_hz; },
       [](double v) { return v >= 1 && v == std::floor(v); }));
