@@ -2,14 +2,68 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "core/error.hpp"
 #include "core/errormap/error_map_file.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {
 
+namespace {
+
+std::string DescribeObject(const Scene& scene) {
+  if (scene.geometry.from_file()) {
+    return "geometry.file = \"" + scene.geometry.file +
+           "\" at geometry.spacing_m = " + FormatReal(scene.geometry.spacing_m) + " m";
+  }
+  return "the built-in cube of mesh.nodes = " + std::to_string(scene.mesh.nodes) +
+         ", mesh.edge = " + FormatReal(scene.mesh.edge_m) + " m";
+}
+
+std::vector<int> Labels(const Scene& scene) {
+  std::vector<int> labels;
+  for (const LabelMaterial& table : scene.materials) labels.push_back(table.label);
+  std::sort(labels.begin(), labels.end());
+  return labels;
+}
+
+}  // namespace
+
+std::string MapObjectProblem(const Scene& scene, const ErrorMap& map) {
+  Scene made_for;
+  try {
+    made_for = ParseSceneText(map.provenance.scene_toml, "the map's recorded scene");
+  } catch (const Error& e) {
+    return std::string("its recorded scene cannot be read: ") + e.what();
+  }
+  const bool same_shape =
+      made_for.geometry.from_file() == scene.geometry.from_file() &&
+      (scene.geometry.from_file()
+           ? made_for.geometry == scene.geometry
+           : made_for.mesh.nodes == scene.mesh.nodes && made_for.mesh.edge_m == scene.mesh.edge_m);
+  if (!same_shape) {
+    return "it was made for " + DescribeObject(made_for) + ", and this scene's object is " +
+           DescribeObject(scene) + ": make a map of this scene with hapticsim sweep";
+  }
+  if (made_for.supports != scene.supports) {
+    return "it was made for the object held by other [[support]] tables than this scene's: make "
+           "a map of this scene with hapticsim sweep";
+  }
+  if (Labels(made_for) != Labels(scene)) {
+    return "it was made for the object with [[material]] tables of other labels than this "
+           "scene's: make a map of this scene with hapticsim sweep";
+  }
+  return "";
+}
+
 std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Scene& scene) {
   auto map = std::make_shared<const ErrorMap>(LoadErrorMap(path));
+  if (const std::string problem = MapObjectProblem(scene, *map); !problem.empty()) {
+    throw Error("error map " + path + " refused: " + problem);
+  }
   if (const std::string problem = MapProblem(scene, *map); !problem.empty()) {
     throw Error("error map " + path + " refused: " + problem);
   }

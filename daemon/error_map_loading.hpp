@@ -15,7 +15,16 @@ struct MapState {
 };
 
 /**
- * The map at `path`, checked as the supervisor will use it with `scene` (MapProblem).
+ * Why `map` was made for another object than `scene`'s ("" when it was not): the built-in cube of
+ * other mesh.* or a geometry file (or one and the other), other [[support]] tables, or other
+ * [[material]] labels. Its errors are of that object's regions, so they say nothing of this one.
+ * Reads the map's recorded scene (and so its geometry file, if it names one).
+ */
+std::string MapObjectProblem(const Scene& scene, const ErrorMap& map);
+
+/**
+ * The map at `path`, checked as the supervisor will use it with `scene` (MapProblem) and made for
+ * the scene's object (MapObjectProblem).
  * @throws Error naming the file and what is wrong with it.
  */
 std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Scene& scene);

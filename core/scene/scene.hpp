@@ -63,6 +63,8 @@ struct SupportRegion {
   int label = 0;
   std::array<double, 3> box_min_m{}, box_max_m{};
   std::array<double, 3> point_m{}, normal{};
+
+  bool operator==(const SupportRegion&) const = default;
 };
 
 /** A geometry file read and voxelised, with the settings it was made from. */

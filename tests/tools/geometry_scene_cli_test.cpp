@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/box_stl.hpp"
 #include "tests/support/hapticsim_cli.hpp"
 
 namespace hapticsim {
@@ -19,31 +20,9 @@ namespace {
 using testing::CommandResult;
 using testing::Hapticsim;
 using testing::Json;
+using testing::WriteBoxStl;
 
 std::string Temp(const std::string& name) { return ::testing::TempDir() + name; }
-
-// An ASCII STL of the box [0, edge]³, 12 triangles, written by hand.
-void WriteBoxStl(const std::string& path, double edge) {
-  std::ofstream out(path);
-  const double e = edge;
-  // Each face as two triangles (v0 v1 v2, v0 v2 v3), corners listed around the face.
-  const double faces[6][4][3] = {
-      {{0, 0, 0}, {0, e, 0}, {e, e, 0}, {e, 0, 0}}, {{0, 0, e}, {e, 0, e}, {e, e, e}, {0, e, e}},
-      {{0, 0, 0}, {e, 0, 0}, {e, 0, e}, {0, 0, e}}, {{0, e, 0}, {0, e, e}, {e, e, e}, {e, e, 0}},
-      {{0, 0, 0}, {0, 0, e}, {0, e, e}, {0, e, 0}}, {{e, 0, 0}, {e, e, 0}, {e, e, e}, {e, 0, e}}};
-  out << "solid box\n";
-  for (const auto& face : faces) {
-    for (const auto& triangle : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-      out << " facet normal 0 0 0\n  outer loop\n";
-      for (int corner : triangle) {
-        out << "   vertex " << face[corner][0] << " " << face[corner][1] << " " << face[corner][2]
-            << "\n";
-      }
-      out << "  endloop\n endfacet\n";
-    }
-  }
-  out << "endsolid box\n";
-}
 
 // A number as TOML that reads back to it exactly.
 std::string Exact(double value) {

@@ -1,0 +1,95 @@
+// The daemon takes an error map only for the object it serves: a map records the scene it was
+// made for, and one of another object (a cube of other mesh.*, a geometry file, other supports
+// or material labels) is refused when loaded, naming both objects, because its errors are of
+// another object's regions. What a map varies (the material, the input, the configuration)
+// is no reason to refuse it.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/error.hpp"
+#include "core/errormap/error_map_file.hpp"
+#include "core/scene/scene_toml.hpp"
+#include "daemon/error_map_loading.hpp"
+#include "tests/support/box_stl.hpp"
+
+namespace hapticsim {
+namespace {
+
+std::string Temp(const std::string& name) { return ::testing::TempDir() + "map_object_" + name; }
+
+// A one-sample map of the scene's own point, recorded as made for `made_for`.
+ErrorMap MapMadeFor(const Scene& scene, const Scene& made_for) {
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  const MapPoint at = PointOfScene(scene);
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  map.samples[0].status = SampleStatus::kOk;
+  map.samples[0].max_magnitude_percent = 1;
+  map.provenance.scene_toml = FormatSceneToml(made_for);
+  return map;
+}
+
+std::string LoadError(const Scene& scene, const ErrorMap& map, const std::string& name) {
+  const std::string path = Temp(name + ".hsmap");
+  SaveErrorMap(map, path);
+  try {
+    LoadUsableMap(path, scene);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MapObject, AMapOfTheSameObjectIsTakenWhateverItsMaterialAndInput) {
+  const Scene scene;
+  Scene other_material = scene;
+  other_material.material.youngs_modulus_pa = 5e3;
+  other_material.input.amplitude_m = 0.005;
+  EXPECT_EQ(MapObjectProblem(scene, MapMadeFor(scene, other_material)), "");
+  EXPECT_EQ(LoadError(scene, MapMadeFor(scene, other_material), "same"), "");
+}
+
+TEST(MapObject, ACubeOfOtherNodesIsRefusedNamingBoth) {
+  Scene scene;
+  Scene nine = scene;
+  nine.mesh.nodes = 9;
+  const std::string error = LoadError(scene, MapMadeFor(scene, nine), "nine");
+  EXPECT_NE(error.find("refused: it was made for the built-in cube of mesh.nodes = 9, mesh.edge = "
+                       "0.25 m, and this scene's object is the built-in cube of mesh.nodes = 13"),
+            std::string::npos)
+      << error;
+}
+
+TEST(MapObject, AGeometrysMapIsRefusedOnTheCube) {
+  const std::string stl = Temp("box.stl");
+  testing::WriteBoxStl(stl, 0.25);
+  const Scene box = ParseSceneText("[geometry]\nfile = \"" + stl +
+                                       "\"\nspacing_m = 0.025\n[[support]]\n"
+                                       "plane_point = [0.0, 0.0, 0.25]\nplane_normal = [0.0, 0.0, "
+                                       "1.0]\n",
+                                   "the box scene");
+  const Scene cube;
+  const std::string error = MapObjectProblem(cube, MapMadeFor(cube, box));
+  EXPECT_NE(error.find("it was made for geometry.file = \"" + stl + "\""), std::string::npos)
+      << error;
+}
+
+TEST(MapObject, OtherSupportsOrMaterialLabelsAreRefused) {
+  const Scene scene;
+  Scene held = scene;
+  SupportRegion plane;
+  plane.kind = SupportRegion::Kind::kPlane;
+  plane.point_m = {0, 0, 0.25};
+  plane.normal = {0, 0, 1};
+  held.supports = {plane};
+  EXPECT_NE(MapObjectProblem(scene, MapMadeFor(scene, held)).find("other [[support]] tables"),
+            std::string::npos);
+  Scene tabled = scene;
+  tabled.materials = {{1, scene.material}};
+  EXPECT_NE(MapObjectProblem(scene, MapMadeFor(scene, tabled)).find("[[material]] tables of other"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace hapticsim
