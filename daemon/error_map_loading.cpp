@@ -33,9 +33,10 @@ std::vector<int> Labels(const Scene& scene) {
 }  // namespace
 
 std::string MapObjectProblem(const Scene& scene, const ErrorMap& map) {
+  if (map.provenance.scene_toml.empty()) return "";  // says no object: only MapProblem's checks
   Scene made_for;
-  try {
-    made_for = ParseSceneText(map.provenance.scene_toml, "the map's recorded scene");
+  try {  // not its geometry file: a path from another machine, and slow to read on a reload
+    made_for = ParseSceneSettings(map.provenance.scene_toml, "the map's recorded scene");
   } catch (const Error& e) {
     return std::string("its recorded scene cannot be read: ") + e.what();
   }

@@ -18,7 +18,8 @@ struct MapState {
  * Why `map` was made for another object than `scene`'s ("" when it was not): the built-in cube of
  * other mesh.* or a geometry file (or one and the other), other [[support]] tables, or other
  * [[material]] labels. Its errors are of that object's regions, so they say nothing of this one.
- * Reads the map's recorded scene (and so its geometry file, if it names one).
+ * Compares the recorded scene's settings (its geometry file is not read); a map that records no
+ * scene (made in memory) has no object to compare.
  */
 std::string MapObjectProblem(const Scene& scene, const ErrorMap& map);
 

@@ -102,22 +102,32 @@ struct Supports {
       if (p[a] < 0 || p[a] >= padded[a]) return false;
     return std::binary_search(held.begin(), held.end(), Key(p));
   }
-  // A point support (no held node among its six lattice neighbours) or a node of a line of them
-  // (held neighbours along one lattice axis only): both are singular, the displacement near
-  // them unbounded in the continuum, so a coarse cell there is far too stiff. A node of a held
-  // surface (held neighbours along two axes or more) is not.
+  // A point support or a node of a held line (the corner of an L of lines too): both are
+  // singular, the displacement near them unbounded in the continuum, so a coarse cell there is
+  // far too stiff. A node of a held surface is not: it is a corner of a held parallelogram of
+  // lattice neighbours, p, p + a, p + b, p + a + b with a and b not parallel (a unit square of
+  // an axis-aligned face; a rhombus of a diagonal plane's nodes).
   bool PointOrLine(const std::array<int, 3>& p) const {
-    int axes_held = 0;
-    for (int a = 0; a < 3; ++a) {
-      bool held = false;
-      for (int step : {-1, 1}) {
-        std::array<int, 3> q = p;
-        q[a] += step;
-        held = held || Held(q);
+    std::array<std::array<int, 3>, 26> held{};
+    int count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if ((dx || dy || dz) && Held({p[0] + dx, p[1] + dy, p[2] + dz})) {
+            held[count++] = {dx, dy, dz};
+          }
+    for (int i = 0; i < count; ++i) {
+      for (int j = i + 1; j < count; ++j) {
+        const auto& a = held[i];
+        const auto& b = held[j];
+        const bool parallel =
+            a[1] * b[2] == a[2] * b[1] && a[2] * b[0] == a[0] * b[2] && a[0] * b[1] == a[1] * b[0];
+        if (!parallel && Held({p[0] + a[0] + b[0], p[1] + a[1] + b[1], p[2] + a[2] + b[2]})) {
+          return false;
+        }
       }
-      axes_held += held;
     }
-    return axes_held <= 1;
+    return true;
   }
 };
 

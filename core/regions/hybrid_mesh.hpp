@@ -64,9 +64,9 @@ class HybridMesh {
     /// field it does not share (a vertex of that cell is free) refines the cell, so every support
     /// is held exactly.
     std::vector<std::array<int, 3>> supports;
-    /// Coarse cells refined around each point or line support (a held node whose held lattice
-    /// neighbours, if any, lie along one axis), per direction: a coarse cell at a singular
-    /// support is far too stiff. Held surfaces are not singular and are not refined.
+    /// Coarse cells refined around each point or line support (a held node that is no corner of
+    /// a held parallelogram of lattice neighbours), per direction: a coarse cell at a singular
+    /// support is far too stiff. Held surfaces (axis-aligned or not) are not and are not refined.
     int support_layers = 1;
     /// Secondary cells split into this many nested shells around the primary cells (regions
     /// 1…n), each shell_cells coarse cells thick (Chebyshev distance); the last takes the rest.

@@ -33,8 +33,9 @@ struct RegionDofs {
  *   (adaptivity.shell_cells coarse cells thick; the outermost takes the rest) — except
  *   adaptivity.support_layers coarse cells around each point or line support (the cube's corners,
  *   a held edge), refined to h too because a coarse cell at such a support is far too stiff (its
- *   stiffness is singular); and the cells the object fills only in part or with two materials (its
- * surface, its material boundaries), refined so each coarse element is whole and of one material;
+ *   stiffness is singular); and the cells the object fills only in part or with two materials
+ *   (its surface, its material boundaries), refined so each coarse element is whole and of one
+ *   material;
  * - an **interface Γ** between each pair of neighbouring shells: the independent nodes touched by
  *   elements of both. The outer region owns it (integrates it with the lumped mass of both sides
  *   and receives the inner region's forces); the inner region takes Γ's displacement as a

@@ -285,9 +285,8 @@ void AddAdaptivityKeys(std::vector<KeyAccess>& keys) {
       [](double v) { return v >= 1 && v == std::floor(v); }));
   keys.push_back(Integer(
       {"adaptivity.support_layers", "", "a whole number from 0 to 100",
-       "coarse cells refined around each point or line support: a held node with no held "
-       "neighbour (the cube's corners) or held neighbours along one axis only (a held edge); "
-       "singular, a coarse cell there is far too stiff"},
+       "coarse cells refined around each point or line support, such as the cube's corners or "
+       "a held edge (singular: a coarse cell there is far too stiff; a held surface is not)"},
       [](Scene& s) -> int& { return s.adaptivity.support_layers; }, 0, 100));
   keys.push_back(Integer(
       {"adaptivity.secondary_regions", "", "a whole number from 1 to 8",

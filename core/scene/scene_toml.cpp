@@ -62,7 +62,8 @@ std::vector<const toml::table*> TablesOf(const toml::node& node, const std::stri
 }
 
 void ReadMaterialTables(Scene* scene, const toml::node& node, const std::string& path) {
-  for (const toml::table* table : TablesOf(node, "material", "scene file " + Location(path, node.source()))) {
+  for (const toml::table* table :
+       TablesOf(node, "material", "scene file " + Location(path, node.source()))) {
     LabelMaterial material;
     for (const auto& [key, value] : *table) {
       const std::string where = "scene file " + Location(path, value.source());
@@ -120,7 +121,8 @@ SupportRegion ReadSupportTable(const toml::table& table, const std::string& path
                         keys == "box_min, box_max" || keys == "plane_normal, plane_point" ||
                         keys == "plane_point, plane_normal";
   if (!one_kind) {
-    throw Error(where + ": a [[support]] table is one of label = N; box_min and box_max; or "
+    throw Error(where +
+                ": a [[support]] table is one of label = N; box_min and box_max; or "
                 "plane_point and plane_normal; this one has " +
                 (keys.empty() ? std::string("no key") : keys));
   }
@@ -128,7 +130,8 @@ SupportRegion ReadSupportTable(const toml::table& table, const std::string& path
 }
 
 void ReadSupportTables(Scene* scene, const toml::node& node, const std::string& path) {
-  for (const toml::table* table : TablesOf(node, "support", "scene file " + Location(path, node.source()))) {
+  for (const toml::table* table :
+       TablesOf(node, "support", "scene file " + Location(path, node.source()))) {
     scene->supports.push_back(
         ReadSupportTable(*table, path, "scene file " + Location(path, table->source())));
   }
@@ -144,16 +147,21 @@ void ResolveGeometryPath(Scene* scene, const std::string& scene_path) {
 
 }  // namespace
 
-// Reads `text` when given, else the file at `path` (which names the source in messages).
-Scene ParseScene(const std::string& path, const std::optional<std::string>& text);
+// Reads `text` when given, else the file at `path` (which names the source in messages); with
+// `load`, reads the geometry file too and validates the scene.
+Scene ParseScene(const std::string& path, const std::optional<std::string>& text, bool load);
 
-Scene LoadSceneFile(const std::string& path) { return ParseScene(path, std::nullopt); }
+Scene LoadSceneFile(const std::string& path) { return ParseScene(path, std::nullopt, true); }
 
 Scene ParseSceneText(const std::string& text, const std::string& origin) {
-  return ParseScene(origin, text);
+  return ParseScene(origin, text, true);
 }
 
-Scene ParseScene(const std::string& path, const std::optional<std::string>& text) {
+Scene ParseSceneSettings(const std::string& text, const std::string& origin) {
+  return ParseScene(origin, text, false);
+}
+
+Scene ParseScene(const std::string& path, const std::optional<std::string>& text, bool load) {
   toml::table document;
   try {
     document = text ? toml::parse(*text, path) : toml::parse_file(path);
@@ -188,6 +196,7 @@ Scene ParseScene(const std::string& path, const std::optional<std::string>& text
     }
   }
   if (!text) ResolveGeometryPath(&scene, path);
+  if (!load) return scene;
   try {
     LoadSceneGeometry(&scene);
     ValidateScene(scene);

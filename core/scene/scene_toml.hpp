@@ -20,6 +20,12 @@ Scene LoadSceneFile(const std::string& path);
 Scene ParseSceneText(const std::string& text, const std::string& origin);
 
 /**
+ * As ParseSceneText, without reading the geometry file or checking the scene as a whole: its
+ * settings as written (each value still checked alone), for comparing what two scenes say.
+ */
+Scene ParseSceneSettings(const std::string& text, const std::string& origin);
+
+/**
  * Applies "section.key=value" overrides in order (the --set option).
  * @throws Error naming the key, as SetSceneValue does, or the malformed assignment.
  */

@@ -33,6 +33,7 @@ Scene HeldOnTwoLines(int support_layers, int secondary_lod) {
                     Box({-t, e - t, e - t}, {e + t, e + t, e + t})};
   scene.adaptivity.primary_size = 1;
   scene.adaptivity.secondary_lod = secondary_lod;
+  scene.adaptivity.secondary_rate_hz = 1000;  // in step with the primary
   scene.adaptivity.support_layers = support_layers;
   return scene;
 }
@@ -82,6 +83,14 @@ TEST(SupportRefinement, AHeldLineIsRefinedAroundAndTheForceComesCloserToTheRefer
 
 TEST(SupportRefinement, AHeldSurfaceIsNotSingularAndNotRefined) {
   EXPECT_EQ(Nodes(HeldOnTheBackFace(1)), Nodes(HeldOnTheBackFace(0)));
+  // A diagonal plane through lattice nodes (x + y = 16 h, across the cube's far corner) holds a
+  // one node-thick staircase of nodes with no held neighbour along x or y: a surface all the same.
+  Scene diagonal = HeldOnTheBackFace(1);
+  diagonal.supports[0].point_m = {kEdge * 16 / 12, 0, 0};
+  diagonal.supports[0].normal = {1, 1, 0};
+  Scene unrefined = diagonal;
+  unrefined.adaptivity.support_layers = 0;
+  EXPECT_EQ(Nodes(diagonal), Nodes(unrefined));
 }
 
 }  // namespace

@@ -73,6 +73,14 @@ TEST(MapObject, AGeometrysMapIsRefusedOnTheCube) {
   const std::string error = MapObjectProblem(cube, MapMadeFor(cube, box));
   EXPECT_NE(error.find("it was made for geometry.file = \"" + stl + "\""), std::string::npos)
       << error;
+  // The map's file is not read to compare: one made on another machine says what it was for.
+  Scene elsewhere = cube;
+  elsewhere.geometry.file = "/nowhere/on/this/machine/organ.nii";
+  elsewhere.geometry.spacing_m = 0.002;
+  const std::string away = MapObjectProblem(cube, MapMadeFor(cube, elsewhere));
+  EXPECT_NE(away.find("made for geometry.file = \"/nowhere/on/this/machine/organ.nii\""),
+            std::string::npos)
+      << away;
 }
 
 TEST(MapObject, OtherSupportsOrMaterialLabelsAreRefused) {
