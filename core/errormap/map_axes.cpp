@@ -29,20 +29,11 @@ constexpr std::array<MapAxisInfo, kNumMapAxes> kAxes{{
 
 constexpr int kContrast = static_cast<int>(MapAxis::kMaterialContrast);
 
-double MaterialValue(const Material& m, MapAxis axis) {
-  switch (axis) {
-    case MapAxis::kPoissonRatio:
-      return m.poisson_ratio;
-    case MapAxis::kDensity:
-      return m.density_kg_m3;
-    case MapAxis::kDamping:
-      return m.damping_per_s;
-    case MapAxis::kYoungsModulus:
-      return m.youngs_modulus_pa;
-    default:
-      return 0;
-  }
-}
+// The base material's field each of the first four axes is (MapAxis order).
+constexpr std::array<double Material::*, 4> kMaterialFields = {
+    &Material::poisson_ratio, &Material::density_kg_m3, &Material::damping_per_s,
+    &Material::youngs_modulus_pa};
+static_assert(static_cast<int>(MapAxis::kYoungsModulus) == 3, "the material axes come first");
 
 }  // namespace
 
@@ -57,7 +48,7 @@ MapPoint PointOfScene(const Scene& scene) {
     if (a == kContrast) {
       point[a] = MaterialContrast(scene);
     } else if (info.material) {
-      point[a] = MaterialValue(base, static_cast<MapAxis>(a));
+      point[a] = base.*kMaterialFields[a];
     } else {
       point[a] = info.node_component >= 0 ? node[info.node_component]
                                           : std::stod(GetSceneValue(scene, info.scene_key));
@@ -68,10 +59,9 @@ MapPoint PointOfScene(const Scene& scene) {
 
 Scene SceneAtPoint(const Scene& base, const MapPoint& point) {
   Material material;
-  material.poisson_ratio = point[static_cast<int>(MapAxis::kPoissonRatio)];
-  material.density_kg_m3 = point[static_cast<int>(MapAxis::kDensity)];
-  material.damping_per_s = point[static_cast<int>(MapAxis::kDamping)];
-  material.youngs_modulus_pa = point[static_cast<int>(MapAxis::kYoungsModulus)];
+  for (int a = 0; a < static_cast<int>(kMaterialFields.size()); ++a) {
+    material.*kMaterialFields[a] = point[a];
+  }
   Scene scene = SceneWithMaterials(base, material, point[kContrast]);
   // "ix,iy,iz" (the node axes come in component order), set through the scene key so that it is
   // checked as any other value.

@@ -25,22 +25,16 @@
 namespace hapticsim {
 namespace {
 
+using testing::SupportBox;
 using testing::VoxelScene;
-
-SupportRegion Box(std::array<double, 3> low, std::array<double, 3> high) {
-  SupportRegion box;
-  box.kind = SupportRegion::Kind::kBox;
-  box.box_min_m = low;
-  box.box_max_m = high;
-  return box;
-}
 
 // The cube's four back corners as boxes a tenth of a voxel wide around them.
 std::vector<SupportRegion> CornerBoxes(double edge) {
   const double e = 0.01 * edge;
   std::vector<SupportRegion> boxes;
   for (double x : {0.0, edge}) {
-    for (double y : {0.0, edge}) boxes.push_back(Box({x - e, y - e, edge - e}, {x + e, y + e, edge + e}));
+    for (double y : {0.0, edge})
+      boxes.push_back(SupportBox({x - e, y - e, edge - e}, {x + e, y + e, edge + e}));
   }
   return boxes;
 }
@@ -89,11 +83,7 @@ Scene BlockWithInclusion(double contrast) {
     const bool inside = x >= 3 && x < 7 && y >= 3 && y < 7 && z >= 2 && z < 6;
     return inside ? 2 : 1;
   });
-  SupportRegion back;
-  back.kind = SupportRegion::Kind::kPlane;
-  back.point_m = {0, 0, 0.1};
-  back.normal = {0, 0, 1};
-  scene.supports = {back};
+  testing::HoldPlaneZ(&scene, 0.1);
   LabelMaterial tissue{1, Material{}}, inclusion{2, Material{}};
   inclusion.material.youngs_modulus_pa *= contrast;
   scene.materials = {tissue, inclusion};
@@ -139,12 +129,12 @@ TEST(SceneModel, RefusesWhatThePhysicsCannotRunSayingWhatToChange) {
             std::string::npos);
 
   Scene one_edge = BlockWithInclusion(5.0);
-  one_edge.supports = {Box({0, 0, 0.1}, {0.1, 0, 0.1})};  // nodes on one line: it can turn
+  one_edge.supports = {SupportBox({0, 0, 0.1}, {0.1, 0, 0.1})};  // nodes on one line: it can turn
   EXPECT_NE(MessageOf([&] { SceneModel{one_edge}; }).find("could move as a rigid body"),
             std::string::npos);
 
   Scene missed = BlockWithInclusion(5.0);
-  missed.supports = {Box({1, 1, 1}, {2, 2, 2})};
+  missed.supports = {SupportBox({1, 1, 1}, {2, 2, 2})};
   EXPECT_NE(MessageOf([&] { SceneModel{missed}; }).find("[[support]] 1 (box) holds no node"),
             std::string::npos);
 

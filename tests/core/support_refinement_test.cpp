@@ -10,6 +10,7 @@
 
 #include "core/errormap/error_sweep.hpp"
 #include "core/regions/region_partition.hpp"
+#include "tests/support/voxel_scene.hpp"
 
 namespace hapticsim {
 namespace {
@@ -17,20 +18,12 @@ namespace {
 constexpr double kEdge = 0.25;  // the cube's, m
 constexpr double kTolerance = 0.001;
 
-SupportRegion Box(std::array<double, 3> lo, std::array<double, 3> hi) {
-  SupportRegion box;
-  box.kind = SupportRegion::Kind::kBox;
-  box.box_min_m = lo;
-  box.box_max_m = hi;
-  return box;
-}
-
 // The cube held on its back face's bottom (y = 0) and top (y = edge) edges: two lines of 13.
 Scene HeldOnTwoLines(int support_layers, int secondary_lod) {
   Scene scene;
   const double t = kTolerance, e = kEdge;
-  scene.supports = {Box({-t, -t, e - t}, {e + t, t, e + t}),
-                    Box({-t, e - t, e - t}, {e + t, e + t, e + t})};
+  scene.supports = {testing::SupportBox({-t, -t, e - t}, {e + t, t, e + t}),
+                    testing::SupportBox({-t, e - t, e - t}, {e + t, e + t, e + t})};
   scene.adaptivity.primary_size = 1;
   scene.adaptivity.secondary_lod = secondary_lod;
   scene.adaptivity.secondary_rate_hz = 1000;  // in step with the primary
@@ -40,11 +33,7 @@ Scene HeldOnTwoLines(int support_layers, int secondary_lod) {
 
 Scene HeldOnTheBackFace(int support_layers) {
   Scene scene;
-  SupportRegion plane;
-  plane.kind = SupportRegion::Kind::kPlane;
-  plane.point_m = {0, 0, kEdge};
-  plane.normal = {0, 0, 1};
-  scene.supports = {plane};
+  testing::HoldPlaneZ(&scene, kEdge);
   scene.adaptivity.primary_size = 1;
   scene.adaptivity.secondary_lod = 2;
   scene.adaptivity.support_layers = support_layers;

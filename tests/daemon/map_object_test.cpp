@@ -12,6 +12,7 @@
 #include "core/scene/scene_toml.hpp"
 #include "daemon/error_map_loading.hpp"
 #include "tests/support/box_stl.hpp"
+#include "tests/support/voxel_scene.hpp"
 
 namespace hapticsim {
 namespace {
@@ -86,11 +87,7 @@ TEST(MapObject, AGeometrysMapIsRefusedOnTheCube) {
 TEST(MapObject, OtherSupportsOrMaterialLabelsAreRefused) {
   const Scene scene;
   Scene held = scene;
-  SupportRegion plane;
-  plane.kind = SupportRegion::Kind::kPlane;
-  plane.point_m = {0, 0, 0.25};
-  plane.normal = {0, 0, 1};
-  held.supports = {plane};
+  testing::HoldPlaneZ(&held, 0.25);
   EXPECT_NE(MapObjectProblem(scene, MapMadeFor(scene, held)).find("other [[support]] tables"),
             std::string::npos);
   Scene tabled = scene;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -41,6 +42,15 @@ inline void HoldPlaneZ(Scene* scene, double z_m) {
   back.point_m = {0, 0, z_m};
   back.normal = {0, 0, 1};
   scene->supports = {back};
+}
+
+/** A [[support]] box: every node inside [low, high] (m) held. */
+inline SupportRegion SupportBox(std::array<double, 3> low, std::array<double, 3> high) {
+  SupportRegion box;
+  box.kind = SupportRegion::Kind::kBox;
+  box.box_min_m = low;
+  box.box_max_m = high;
+  return box;
 }
 
 /** n³ voxels. */
