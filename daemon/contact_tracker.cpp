@@ -123,6 +123,21 @@ void ContactTracker::StartRamp(const std::array<double, 3>& from_m,
   ramp_duration_ns_ = duration_ns;
 }
 
+std::array<double, 3> ContactTracker::OwnPathInside(double since_s) const noexcept {
+  std::array<double, 3> path{};
+  for (int c = 0; c < 3; ++c) path[c] = ramp_from_[c] + ramp_velocity_[c] * since_s;
+  // A tool only pushes: the node it drives is never outside its face. A path going outwards
+  // comes from a mispredicted tip (at a touch-down at 1 m/s the resampler put the tip 0.32 mm in
+  // while the next inputs said 2 µm; going on at the −0.32 m/s of its way back, the blend pulled
+  // the node 2.3 mm out of the object, and the port guard then damped its return with 0.5 N).
+  double outwards = 0;
+  for (int c = 0; c < 3; ++c) outwards += path[c] * inward_[c];
+  if (outwards < 0) {
+    for (int c = 0; c < 3; ++c) path[c] -= outwards * inward_[c];
+  }
+  return path;
+}
+
 ContactTracker::Contact ContactTracker::Advance(
     std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept {
   if (state_ == State::kWaiting && centre && *centre == node_) {
@@ -156,9 +171,9 @@ ContactTracker::Contact ContactTracker::Advance(
     since_s = static_cast<double>(now_ns - ramp_start_ns_) * 1e-9;
     if (tau >= 1) ramping_ = false;
   }
+  const std::array<double, 3> own_path = OwnPathInside(since_s);
   for (int c = 0; c < 3; ++c) {
-    const double own_path = ramp_from_[c] + ramp_velocity_[c] * since_s;
-    contact.displacement_m[c] = (1 - weight) * own_path + weight * (tip_[c] - entry_[c]);
+    contact.displacement_m[c] = (1 - weight) * own_path[c] + weight * (tip_[c] - entry_[c]);
   }
   if (last_ns_ > 0 && now_ns > last_ns_) {
     const double dt = static_cast<double>(now_ns - last_ns_) * 1e-9;

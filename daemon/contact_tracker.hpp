@@ -31,7 +31,9 @@ namespace hapticsim {
  * a touch-down found deeper than kDeepTouchDown_m (a session that begins inside the object, or a
  * tip that jumped in) ramps from zero, fresh input after a stale gap (Hold) ramps from the
  * held displacement to the tip's, and a tip that jumped while engaged (late input) is caught up
- * with over kCatchUp_ns from the node's own path.
+ * with over kCatchUp_ns from the node's own path. That own path never leaves the object: its
+ * part outwards along the entry face's normal is cut (a tool that only pushes cannot pull the
+ * node out, whatever velocity a mispredicted tip gave it).
  */
 class ContactTracker {
  public:
@@ -99,6 +101,9 @@ class ContactTracker {
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
+  // The ramp's own path `since_s` after it started, its outward part along the entry face's
+  // normal removed.
+  std::array<double, 3> OwnPathInside(double since_s) const noexcept;
   // The node catches up with the tip from `from_m` at `from_ns`, going on at its velocity, over
   // kCatchUp_ns or what is left of a ramp under way if longer.
   void CatchUp(const std::array<double, 3>& from_m, std::int64_t from_ns) noexcept;

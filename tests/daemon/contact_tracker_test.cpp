@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+
+#include "daemon/input_resampler.hpp"
 
 namespace hapticsim {
 namespace {
@@ -238,6 +242,58 @@ TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
   back.Update({0.125, 0.125, kEdge + 0.0001}, 0, middle);
   EXPECT_EQ(back.Update({0.125, 0.125, kEdge - 0.0001}, kMs, LatticeIndex{6, 6, 12}).inward_normal,
             (std::array<double, 3>{0, 0, -1}));
+}
+
+TEST(ContactTracker, AMispredictedTouchDownNeverPullsTheNodeOutOfTheObject) {
+  // As measured beside two busy threads: the tool comes down at 1 m/s (−1 mm, then on the surface
+  // in one device period) and starts the paper's press there, 1 cm at 1 Hz. The two inputs after
+  // the touch-down come 1.4 ms late, so the resampler predicts the tip on at 1 m/s, 0.35 mm in
+  // here (0.32 mm measured), and the next tip is 2 µm in. The node jumped in and back; the catch-up that followed went on
+  // at the velocity of that way back and pulled the node 2.3 mm out of the object while the tool
+  // pressed. A tool only pushes: the node's depth is never negative, and it is back on the tip.
+  InputResampler resampler(1e-3, 10e-3);
+  ContactTracker tracker(Mesh(), 0.1);
+  const LatticeIndex middle{6, 6, 0};
+  auto press_z = [](std::int64_t seq) {
+    return seq < 100 ? -0.001 : 0.005 * (1 - std::cos(2 * M_PI * (seq - 100) * 1e-3));
+  };
+  auto received_ns = [](std::int64_t seq) {
+    return seq * kMs + (seq == 101 || seq == 102 ? 1'400'000 : 50'000);
+  };
+  double touch_down_depth = -1, shallowest = 1, largest_step_change = 0, previous = 0;
+  double previous_step = 0, lag = 0;
+  std::int64_t next_seq = 0;
+  for (std::int64_t k = 0; k < 200; ++k) {
+    const std::int64_t release = k * kMs + 400'000;  // our period, 0.35 ms after an on-time input
+    while (received_ns(next_seq) <= release) {
+      resampler.Add(next_seq, received_ns(next_seq), {0.125, 0.125, press_z(next_seq)});
+      ++next_seq;
+    }
+    const std::array<double, 3> tip = resampler.TipAt(release);
+    const ContactTracker::Contact contact = tracker.Update(tip, release, middle);
+    if (!contact.engaged) continue;
+    const double d = contact.displacement_m[2];
+    if (touch_down_depth < 0) touch_down_depth = tip[2];
+    shallowest = std::min(shallowest, d);
+    EXPECT_NEAR(contact.point_m[2], d, 1e-15);  // the port guard's contact point: on the node
+    // After the mispredicted touch-down itself (in 0.35 mm and back: what the tip did):
+    if (k > 105) {
+      largest_step_change = std::max(largest_step_change, std::abs(d - previous - previous_step));
+    }
+    previous_step = d - previous;
+    previous = d;
+    lag = tip[2] - d;
+  }
+  // Mispredicted, yet shallower than a deep touch-down (which ramps in from zero instead).
+  ASSERT_GT(touch_down_depth, 0.25e-3) << "the resampler did not mispredict the touch-down";
+  ASSERT_LT(touch_down_depth, ContactTracker::kDeepTouchDown_m);
+  EXPECT_GE(shallowest, 0.0) << "the node was pulled out of the object";
+  EXPECT_NEAR(lag, 0.0, 1e-12) << "not caught up with the tip";
+  // The node's way back from the mispredicted depth is smooth: no period's step differs from the
+  // last by more than a few µm (a 10 µm change is 40 mN at the node's 4 kN/m over a period).
+  EXPECT_LT(largest_step_change, 5e-6);
+  std::printf("predicted touch-down depth %.0f µm; shallowest node %.2f µm; step change %.2f µm\n",
+              touch_down_depth * 1e6, shallowest * 1e6, largest_step_change * 1e6);
 }
 
 }  // namespace

@@ -350,11 +350,16 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
     // Beside two busy threads 1–31 % of the answers were near a late wake (with or without
     // switches): half, and what is left still covers the press.
     EXPECT_LT(switched.near_late_wakes, switched.forces.size() / 2);
-    // The unswitched press is smooth, and the switches add at most 50 mN to its largest change
-    // (measured: 0.0132 N against 0.0075 N quiet, 0.0185 N against 0.0092 N beside two busy
-    // threads).
+    // Both presses are smooth between periods woken on time: under the 0.1 N of every smoothness
+    // check (measured: 0.0132 N switched against 0.0075 N plain quiet, 0.0185 N against 0.0092 N
+    // beside two busy threads). And each switch woken on time adds at most 50 mN to the plain
+    // press's largest change. (Measured at the switches, not as the switched press's largest
+    // change over all: that was once an input stall's 0.067 N, the device thread held up 9 ms
+    // and the tip predicted meanwhile, far from any switch; what input stalls do is the input
+    // prediction's to test, in InputPrediction and docs/reliability.md.)
     EXPECT_LE(plain.largest_jump_n, 0.1);
-    EXPECT_LE(switched.largest_jump_n, plain.largest_jump_n + 0.05);
+    EXPECT_LE(switched.largest_jump_n, 0.1);
+    EXPECT_LE(across_on_time, plain.largest_jump_n + 0.05);
     // Across each switch itself, late wakes included: a late wake there is no excuse for a step.
     // Quiet, the 0.1 N of every smoothness check; beside busy threads, where a late wake alone
     // steps the force (the soak's worst in contact under load: 0.2 N), 0.25 N.
