@@ -129,7 +129,10 @@ std::array<double, 3> ContactTracker::OwnPathInside(double since_s) const noexce
   // A tool only pushes: the node it drives is never outside its face. A path going outwards
   // comes from a mispredicted tip (at a touch-down at 1 m/s the resampler put the tip 0.32 mm in
   // while the next inputs said 2 µm; going on at the −0.32 m/s of its way back, the blend pulled
-  // the node 2.3 mm out of the object, and the port guard then damped its return with 0.5 N).
+  // the node 2.3 mm out of the object, and the port guard then damped its return with up to
+  // 1.06 N). Where the path meets the face its normal velocity stops there: the one place a ramp
+  // changes the node's velocity at once, by at most (1 − w) times the outward speed, which the
+  // uncut path would have kept pulling the node out with.
   double outwards = 0;
   for (int c = 0; c < 3; ++c) outwards += path[c] * inward_[c];
   if (outwards < 0) {

@@ -33,7 +33,8 @@ namespace hapticsim {
  * held displacement to the tip's, and a tip that jumped while engaged (late input) is caught up
  * with over kCatchUp_ns from the node's own path. That own path never leaves the object: its
  * part outwards along the entry face's normal is cut (a tool that only pushes cannot pull the
- * node out, whatever velocity a mispredicted tip gave it).
+ * node out, whatever velocity a mispredicted tip gave it); where it meets the face, its normal
+ * velocity stops, the one velocity change a ramp makes at once.
  */
 class ContactTracker {
  public:

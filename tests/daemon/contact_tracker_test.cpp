@@ -248,7 +248,7 @@ TEST(ContactTracker, AMispredictedTouchDownNeverPullsTheNodeOutOfTheObject) {
   // As measured beside two busy threads: the tool comes down at 1 m/s (−1 mm, then on the surface
   // in one device period) and starts the paper's press there, 1 cm at 1 Hz. The two inputs after
   // the touch-down come 1.4 ms late, so the resampler predicts the tip on at 1 m/s, 0.35 mm in
-  // here (0.32 mm measured), and the next tip is 2 µm in. The node jumped in and back; the catch-up that followed went on
+  // here (0.32 mm measured), and the next tips are under a µm in (2 µm measured). The node jumped in and back; the catch-up that followed went on
   // at the velocity of that way back and pulled the node 2.3 mm out of the object while the tool
   // pressed. A tool only pushes: the node's depth is never negative, and it is back on the tip.
   InputResampler resampler(1e-3, 10e-3);
@@ -282,13 +282,14 @@ TEST(ContactTracker, AMispredictedTouchDownNeverPullsTheNodeOutOfTheObject) {
     }
     previous_step = d - previous;
     previous = d;
-    lag = tip[2] - d;
+    // Caught up within the catch-up's 20 ms from the jump found at input 103 (and held since).
+    if (k >= 125) lag = std::max(lag, std::abs(tip[2] - d));
   }
   // Mispredicted, yet shallower than a deep touch-down (which ramps in from zero instead).
   ASSERT_GT(touch_down_depth, 0.25e-3) << "the resampler did not mispredict the touch-down";
   ASSERT_LT(touch_down_depth, ContactTracker::kDeepTouchDown_m);
   EXPECT_GE(shallowest, 0.0) << "the node was pulled out of the object";
-  EXPECT_NEAR(lag, 0.0, 1e-12) << "not caught up with the tip";
+  EXPECT_LT(lag, 1e-12) << "not caught up with the tip within the catch-up";
   // The node's way back from the mispredicted depth is smooth: no period's step differs from the
   // last by more than a few µm (a 10 µm change is 40 mN at the node's 4 kN/m over a period).
   EXPECT_LT(largest_step_change, 5e-6);
