@@ -248,9 +248,10 @@ TEST(ContactTracker, AMispredictedTouchDownNeverPullsTheNodeOutOfTheObject) {
   // As measured beside two busy threads: the tool comes down at 1 m/s (−1 mm, then on the surface
   // in one device period) and starts the paper's press there, 1 cm at 1 Hz. The two inputs after
   // the touch-down come 1.4 ms late, so the resampler predicts the tip on at 1 m/s, 0.35 mm in
-  // here (0.32 mm measured), and the next tips are under a µm in (2 µm measured). The node jumped in and back; the catch-up that followed went on
-  // at the velocity of that way back and pulled the node 2.3 mm out of the object while the tool
-  // pressed. A tool only pushes: the node's depth is never negative, and it is back on the tip.
+  // here (0.32 mm measured), and the next tips are under a µm in (2 µm measured). The node
+  // jumped in and back; the catch-up that followed went on at the velocity of that way back and
+  // pulled the node 2.3 mm out of the object while the tool pressed. A tool only pushes: the
+  // node's depth is never negative, and it is back on the tip.
   InputResampler resampler(1e-3, 10e-3);
   ContactTracker tracker(Mesh(), 0.1);
   const LatticeIndex middle{6, 6, 0};

@@ -278,13 +278,10 @@ PressResult PaperPress(bool switch_configurations, int busy_threads) {
 struct SwitchWindow {
   double largest_jump_n = 0;          // between any two consecutive answers in it
   double largest_on_time_jump_n = 0;  // … of those where neither is near a late wake
-  bool on_time = true;                // none of them near a late wake
+  int on_time_steps = 0;              // how many steps are between two such answers
 };
 
-// `on_time_steps`: how many steps in all the windows are between answers woken on time.
-std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces,
-                                        int* on_time_steps_out) {
-  int on_time_steps = 0;
+std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces) {
   std::vector<Wake> wakes;
   for (const ForceRecord& f : forces) wakes.push_back({f.period, f.utime_us});
   const std::vector<bool> near_late = NearALateWake(wakes);
@@ -303,13 +300,11 @@ std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces,
       const bool on_time = !near_late[k] && !near_late[k - 1];
       w.largest_jump_n = std::max(w.largest_jump_n, jump);
       if (on_time) w.largest_on_time_jump_n = std::max(w.largest_on_time_jump_n, jump);
-      on_time_steps += on_time;
-      w.on_time = w.on_time && on_time;
+      w.on_time_steps += on_time;
     }
     windows.push_back(w);
     i = end;
   }
-  *on_time_steps_out = on_time_steps;
   return windows;
 }
 
@@ -334,19 +329,18 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
       }
     }
     EXPECT_GT(held, 3) << "no period was answered while the regions were replaced";
+    const std::vector<SwitchWindow> windows = SwitchWindows(switched.forces);
     int on_time_steps = 0;
-    const std::vector<SwitchWindow> windows = SwitchWindows(switched.forces, &on_time_steps);
-    int on_time = 0;
     double across_on_time = 0, across_any = 0;
     for (const SwitchWindow& w : windows) {
       across_any = std::max(across_any, w.largest_jump_n);
       across_on_time = std::max(across_on_time, w.largest_on_time_jump_n);
-      on_time += w.on_time;
+      on_time_steps += w.on_time_steps;
     }
     std::printf(
-        "%d busy threads: %zu holds, %d wholly on time, %d steps in them on time; largest change "
-        "across a switch %.4f N between periods woken on time, %.4f N any\n",
-        busy, windows.size(), on_time, on_time_steps, across_on_time, across_any);
+        "%d busy threads: %zu holds, %d steps in them between periods woken on time; largest "
+        "change across a switch %.4f N between periods woken on time, %.4f N any\n",
+        busy, windows.size(), on_time_steps, across_on_time, across_any);
     std::printf(
         "%d busy threads: largest force change between periods woken on time %.4f N with 3 "
         "switches in the press (%d periods held), %.4f N without; between any periods %.4f N "
