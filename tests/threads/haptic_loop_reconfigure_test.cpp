@@ -14,6 +14,7 @@
 #include "daemon/supervisor.hpp"
 #include "tests/support/late_wakes.hpp"
 #include "tests/support/play_device.hpp"
+#include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
 namespace {
@@ -23,11 +24,6 @@ constexpr double kH = 0.25 / 12;  // the default 13³ cube's node spacing
 // Under a sanitizer every step is several times slower than its period: the hand-over protocol
 // is checked (that is what the sanitizer is for), the forces are not (see RealTimeSchedule's
 // CompletesWithFiniteForcesWhateverTheTiming for what a lagging region does to them).
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 
 Scene AdaptiveScene() {
   Scene scene;

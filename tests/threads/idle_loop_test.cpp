@@ -12,17 +12,14 @@
 
 #include "daemon/haptic_loop.hpp"
 #include "tests/support/play_device.hpp"
+#include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;  // every step several times slower: latencies are not checked
-#else
-constexpr bool kSanitized = false;
-#endif
+// Under a sanitizer (kSanitized) every step is several times slower: latencies are not checked.
 
 constexpr std::array<double, 3> kAbove{0.125, 0.125, -0.002};  // 2 mm off the front face
 

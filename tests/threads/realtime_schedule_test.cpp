@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "core/trial/force_error.hpp"
+#include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
 namespace {
@@ -31,11 +32,7 @@ Scene Adaptive(int primary_size, int lod, double rate_hz) {
 // quarter (250 periods, in to 5 mm at its fastest): a whole second of it missed a deadline in
 // every one of 10 attempts on a 2-vCPU VM that stalls threads for milliseconds now and then
 // (2026-12-05: 1 to 9 misses an attempt), and a quarter of it is a quarter as likely to.
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;  // slowed down many times: deadlines are not the point here
-#else
-constexpr bool kSanitized = false;
-#endif
+// Under a sanitizer (kSanitized) every step is slowed down many times: deadlines are not the point.
 
 TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
   if (kSanitized) GTEST_SKIP() << "timing test; the sanitizer run covers the threads below";

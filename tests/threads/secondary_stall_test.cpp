@@ -21,15 +21,12 @@
 #include <vector>
 
 #include "daemon/haptic_loop.hpp"
+#include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
 namespace {
 
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;  // steps slower than their periods: forces are not checked
-#else
-constexpr bool kSanitized = false;
-#endif
+// Under a sanitizer (kSanitized) steps are slower than their periods: forces are not checked.
 
 constexpr long kStallMs = 300;
 std::atomic<long> stall_ms{kStallMs};
