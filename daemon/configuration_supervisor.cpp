@@ -26,7 +26,7 @@ ConfigurationSupervisor::ConfigurationSupervisor(const Scene& scene, MapState ma
       map_(std::move(map)),
       target_(target_percent),
       decision_(first),
-      chosen_for_nodes_{ContactNode(scene)},
+      chosen_for_nodes_{loop.centre_node()},
       mover_(scene, {{first.configuration, true, false}, loop.centre_node()}),
       reported_error_(first.error_percent),
       reported_target_met_(first.target_met) {

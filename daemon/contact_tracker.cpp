@@ -12,31 +12,12 @@ std::array<double, 3> Minus(const std::array<double, 3>& a, const std::array<dou
 
 }  // namespace
 
-ContactTracker::ContactTracker(const MeshSettings& mesh, double engage_ramp_s)
-    : mesh_(mesh),
-      h_(mesh.edge_m / (mesh.nodes - 1)),
-      ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
+ContactTracker::ContactTracker(const ContactBox& box, double engage_ramp_s)
+    : box_(box), ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
 
 LatticeIndex ContactTracker::NearestContactNode(
     const std::array<double, 3>& surface_point_m) const noexcept {
-  const int last = mesh_.nodes - 1;
-  LatticeIndex node{};
-  for (int c = 0; c < 3; ++c) {
-    node[c] = std::clamp(static_cast<int>(std::lround(surface_point_m[c] / h_)), 0, last);
-  }
-  if (IsSupportNode(mesh_, node)) {
-    // A fixed corner cannot be driven: its free neighbour along the axis the point is farthest
-    // from the corner on. The corner has every index on the boundary, so the neighbour keeps two
-    // and stays on the surface.
-    int axis = 0;
-    double farthest = -1;
-    for (int c = 0; c < 3; ++c) {
-      const double off = std::abs(surface_point_m[c] / h_ - node[c]);
-      if (off > farthest) farthest = off, axis = c;
-    }
-    node[axis] += node[axis] == 0 ? 1 : -1;
-  }
-  return node;
+  return box_.NearestDrivable(surface_point_m);
 }
 
 ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_m,
@@ -46,14 +27,14 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   if (held_) fresh_tips_ = 0;  // a gap: its jump is the stale ramp's
   const bool after_gap = held_;
   held_ = false;
-  const double edge = mesh_.edge_m;
+  const std::array<double, 3>& edge = box_.extent_m();
   bool inside = true;
-  for (double x : tip_m) inside = inside && x > 0 && x < edge;
+  for (int c = 0; c < 3; ++c) inside = inside && tip_m[c] > 0 && tip_m[c] < edge[c];
   if (!inside) {
     state_ = State::kFree;
     fresh_tips_ = 0;
     std::array<double, 3> nearest = tip_m;
-    for (double& x : nearest) x = std::clamp(x, 0.0, edge);
+    for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, edge[c]);
     wanted_ = NearestContactNode(nearest);
     return {};
   }
@@ -65,7 +46,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     double face = 0, depth = tip_m[2];
     for (int c : {2, 0, 1}) {
       if (tip_m[c] < depth) depth = tip_m[c], axis = c, face = 0;
-      if (edge - tip_m[c] < depth) depth = edge - tip_m[c], axis = c, face = edge;
+      if (edge[c] - tip_m[c] < depth) depth = edge[c] - tip_m[c], axis = c, face = edge[c];
     }
     entry_ = tip_m;
     entry_[axis] = face;

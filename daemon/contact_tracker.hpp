@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "core/scene/scene.hpp"
+#include "daemon/contact_box.hpp"
 
 namespace hapticsim {
 
@@ -12,12 +13,13 @@ namespace hapticsim {
  * Where the tool tip touches the object and how far it has pressed: the primary thread's contact
  * state, as plain logic (no threads, no allocation) so it can be tested on its own.
  *
- * The object is the cube [0, L]³ in the object frame. The tip is in contact while it is strictly
+ * The object is a box, [0, Lx] × [0, Ly] × [0, Lz] in the object frame (ContactBox: the
+ * paper's cube, or a geometry that fills its lattice). The tip is in contact while it is strictly
  * inside. At touch-down the entry face is the one the tip is least deep behind; the entry point
  * is the tip projected on that face, and the contact node is the surface node nearest to the
- * entry point (never one of the fixed back corners: their free neighbour instead). While in
- * contact the node follows the tip: displacement = tip − entry point, in all three directions.
- * The node stays the same until lift-off (as in the paper, the contact does not slide).
+ * entry point (never one a support holds: a free neighbour instead, ContactBox::NearestDrivable).
+ * While in contact the node follows the tip: displacement = tip − entry point, in all three
+ * directions. The node stays the same until lift-off (as in the paper, the contact does not slide).
  *
  * The regions are centred on one node. A touch-down on another node waits (zero force, "waiting"
  * set) until the regions are centred on it, then engages with its force ramped in from zero: the
@@ -38,7 +40,7 @@ namespace hapticsim {
  */
 class ContactTracker {
  public:
-  ContactTracker(const MeshSettings& mesh, double engage_ramp_s);
+  ContactTracker(const ContactBox& box, double engage_ramp_s);
 
   /** The result of one update. */
   struct Contact {
@@ -95,7 +97,7 @@ class ContactTracker {
   static constexpr double kCatchUpJump_m = 10e-6;
   static constexpr std::int64_t kCatchUp_ns = 20'000'000;
 
-  /** The surface node nearest to a point on (or projected onto) the surface; never a support. */
+  /** The surface node nearest to a point on (or projected onto) the surface; never a held one. */
   LatticeIndex NearestContactNode(const std::array<double, 3>& surface_point_m) const noexcept;
 
  private:
@@ -111,8 +113,7 @@ class ContactTracker {
   void StartRamp(const std::array<double, 3>& from_m, const std::array<double, 3>& velocity_m_per_s,
                  std::int64_t duration_ns, std::int64_t now_ns) noexcept;
 
-  MeshSettings mesh_;
-  double h_ = 0;
+  ContactBox box_;
   std::int64_t ramp_ns_ = 0;
   State state_ = State::kAwaitLiftOff;
   std::array<double, 3> tip_{};

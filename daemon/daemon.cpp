@@ -58,7 +58,7 @@ Daemon::Daemon(const DaemonArguments& args, StartupConfig startup)
   loop_ = std::make_unique<HapticLoop>(SceneWith(config_.scene, first.configuration),
                                        LoopOptionsOf(config_, args_.no_port_guard));
   loop_->SetErrorState(first.error_percent, DecisionFlags(first));
-  const LatticeIndex contact = ContactNode(config_.scene);
+  const LatticeIndex contact = loop_->centre_node();
   spdlog::info("contact: the regions are centred on node ({}, {}, {}) and follow the tool",
                contact[0], contact[1], contact[2]);
   StartTransports();
@@ -92,7 +92,7 @@ void Daemon::StartTransports() {
     bridge_ = std::make_unique<LcmBridge>(config_, *loop_, counters_, LcmCommandGateOf(config_));
   }
   if (config_.shm_enabled) {
-    shm_ = std::make_unique<ShmServer>(config_.shm_socket, config_.shm_group, config_.scene.mesh,
+    shm_ = std::make_unique<ShmServer>(config_.shm_socket, config_.shm_group,
                                        config_.workspace_margin_m, config_.max_speed_m_per_s,
                                        config_.max_log_lines_per_s, *loop_, counters_,
                                        DeviceInputOf(config_) == "shm");

@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/scene/scene_toml.hpp"
+#include "daemon/contact_box.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {
@@ -257,9 +258,11 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
-  const std::string cube_only = CubeOnlyProblem(c.scene, "hapticsimd");
-  require(cube_only.empty(), cube_only);
   ValidateScene(c.scene);
+  // The contact tracker, the input guard and the deformation output take the object to be the
+  // box of its lattice (ContactBox): a scene whose object leaves voxels empty is refused here.
+  const std::string not_a_box = BoxObjectProblem(DescribeSceneObject(c.scene));
+  require(not_a_box.empty(), not_a_box);
 }
 
 std::string LcmUrlProblem(const std::string& url, bool allow_network) {

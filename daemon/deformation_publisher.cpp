@@ -24,8 +24,7 @@ DeformationPublisher::~DeformationPublisher() {
 }
 
 deformation_t DeformationPublisher::Message(const HapticLoop::SurfaceFrame& frame,
-                                            const Scene& scene, std::int64_t number,
-                                            bool with_ids) {
+                                            std::int64_t number, bool with_ids) {
   deformation_t out{};
   out.frame = number;
   out.configuration_id = static_cast<std::int32_t>(frame.configuration_id);
@@ -35,8 +34,8 @@ deformation_t DeformationPublisher::Message(const HapticLoop::SurfaceFrame& fram
   for (int c = 0; c < 3; ++c) out.contact_node[c] = frame.centre[c];
   out.in_contact = frame.in_contact;
   out.complete = frame.complete;
-  out.nodes_per_axis = scene.mesh.nodes;
-  out.spacing_m = scene.mesh.edge_m / (scene.mesh.nodes - 1);
+  out.nodes_per_axis = frame.nodes_per_axis;
+  out.spacing_m = frame.spacing_m;
   if (with_ids) out.node_ids = frame.ids;
   out.num_ids = static_cast<std::int32_t>(out.node_ids.size());
   out.num_nodes = static_cast<std::int32_t>(frame.ids.size());
@@ -69,7 +68,7 @@ void DeformationPublisher::Run() {
     if (!loop_.TakeSurface(max_wait_ns, &frame)) continue;  // regions replaced: the next frame
     const bool with_ids = frame.configuration_id != ids_configuration ||
                           HapticLoop::NowNs() - ids_sent_ns >= kIdsEvery_s * 1e9;
-    deformation_t message = Message(frame, config_.scene, number, with_ids);
+    deformation_t message = Message(frame, number, with_ids);
     const std::int64_t sent_ns = HapticLoop::NowNs();
     message.utime = sent_ns / 1000;
     message.latency_ms = static_cast<float>((sent_ns - frame.asked_ns) * 1e-6);

@@ -39,8 +39,8 @@ class DeformationPublisher {
   double max_latency_ms() const { return max_latency_ms_.load(std::memory_order_relaxed); }
 
   /** The message of one frame: ids only when `with_ids`. */
-  static deformation_t Message(const HapticLoop::SurfaceFrame& frame, const Scene& scene,
-                               std::int64_t number, bool with_ids);
+  static deformation_t Message(const HapticLoop::SurfaceFrame& frame, std::int64_t number,
+                               bool with_ids);
 
  private:
   void Run();

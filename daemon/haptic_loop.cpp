@@ -27,8 +27,8 @@ std::int64_t HapticLoop::NowNs() noexcept { return MonotonicNowNs(); }
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene),
       options_(options),
-      nodes_(scene.mesh.nodes),
-      contact_(scene.mesh, options.engage_ramp_s),
+      box_(ContactBox::Of(scene)),
+      contact_(box_, options.engage_ramp_s),
       guard_(options.port, 1e-3) {
   Install(scene, std::make_unique<AsyncRegions>(scene));
   guard_ =
@@ -62,9 +62,7 @@ std::array<double, 3> HapticLoop::StepPrimaryPeriod(
 std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
   const std::int64_t code = counters_.wanted_node_code.value();
   if (code < 0) return std::nullopt;
-  const std::int64_t n = nodes_;
-  return LatticeIndex{static_cast<int>(code / (n * n)), static_cast<int>(code / n % n),
-                      static_cast<int>(code % n)};
+  return box_.Decode(code);
 }
 
 void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcept {
@@ -139,9 +137,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
 void HapticLoop::PublishContactRequest(const ContactTracker::Contact& contact) noexcept {
   counters_.contact_waiting.Set(contact.waiting);
   const std::optional<LatticeIndex> wanted = contact_.wanted_node();
-  const std::int64_t n = nodes_;
-  counters_.wanted_node_code.Set(wanted ? ((*wanted)[0] * n + (*wanted)[1]) * n + (*wanted)[2]
-                                        : -1);
+  counters_.wanted_node_code.Set(wanted ? box_.Code(*wanted) : -1);
 }
 
 std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,

@@ -152,7 +152,11 @@ class HapticLoop {
     AdaptivitySettings configuration;    ///< the regions' (primary_size, secondary_lod, rates)
     LatticeIndex centre{};               ///< the node the regions are centred on
     bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
-    std::vector<std::int32_t> ids;       ///< AsyncRegions::surface_ids (the same for every one)
+    /// The surface nodes on the wire's lattice (ContactBox::ToWireIds of AsyncRegions::surface_ids,
+    /// the same for every configuration): id = (ix · n + iy) · n + iz, n = nodes_per_axis.
+    std::vector<std::int32_t> ids;
+    std::int32_t nodes_per_axis = 0;     ///< ContactBox::wire_nodes_per_axis
+    double spacing_m = 0;                ///< the lattice's, m
     std::vector<double> displacement_m;  ///< 3 per id, m
     std::int64_t asked_ns = 0;           ///< CLOCK_MONOTONIC when the regions were asked
     bool complete = true;  ///< every region published after being asked (else its last part)
@@ -170,6 +174,8 @@ class HapticLoop {
   std::optional<LatticeIndex> wanted_contact_node() const;
   /** True while the tip is inside on a node the regions are not centred on (force zero). */
   bool contact_waiting() const { return counters_.contact_waiting.value(); }
+  /** The object as the tool meets it (its box and drivable nodes): fixed for the loop's life. */
+  const ContactBox& contact_box() const { return box_; }
   /** The node the regions are centred on. Supervisor thread only. */
   const LatticeIndex& centre_node() const { return centre_; }
   /** Regions replaced since the loop was made (Reconfigure calls that took effect). */
@@ -349,7 +355,7 @@ class HapticLoop {
 
   Scene scene_;
   Options options_;
-  const int nodes_;  // per axis; the same for every configuration of the object
+  const ContactBox box_;  // the object as the tool meets it: the same for every configuration
   std::unique_ptr<AsyncRegions> regions_;
   // [0] the primary's (kept across reconfigurations: its period never changes), then one per
   // secondary region of the installed regions.

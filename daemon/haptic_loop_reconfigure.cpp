@@ -18,7 +18,7 @@ void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regio
     regions_ = std::move(regions);
     ++installs_;
   }
-  centre_ = ContactNode(scene);
+  centre_ = regions_->partition().contact_node();
   const int count = regions_->num_regions();
   tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
   auto nominal_ns = [&](int a) {
@@ -50,12 +50,13 @@ std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
 
 void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
-  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || scene.mesh.nodes != nodes_ ||
-      scene.mesh.edge_m != scene_.mesh.edge_m) {
+  const auto& lattice = regions->partition().mesh().options();
+  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || lattice.lattice_nodes != box_.nodes() ||
+      lattice.spacing_m != box_.spacing_m()) {
     throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
   }
   const bool carry = handover == Handover::kCarryMotion;
-  if (carry && ContactNode(scene) != centre_) {
+  if (carry && regions->partition().contact_node() != centre_) {
     throw Error("the motion can be carried only to regions around the same contact node");
   }
   ++reconfigurations_;

@@ -28,8 +28,10 @@ InputRejection InputGuard::Check(std::int64_t seq, const std::array<double, 3>& 
   for (double x : p) {
     if (!std::isfinite(x)) return InputRejection::kNonFinite;
   }
-  for (double x : p) {
-    if (x < -margin_m_ || x > edge_m_ + margin_m_) return InputRejection::kOutsideWorkspace;
+  for (int c = 0; c < 3; ++c) {
+    if (p[c] < -margin_m_ || p[c] > extent_m_[c] + margin_m_) {
+      return InputRejection::kOutsideWorkspace;
+    }
   }
   // A device silent for a while starts a new session: a restarted driver counts from 1 again and
   // its tool may be anywhere, so neither the old seq nor the old position applies.

@@ -33,8 +33,10 @@ class InputGuard {
    *  every integer; at 1 kHz, 285,000 years of device periods. */
   static constexpr std::int64_t kMaxSeq = std::int64_t{1} << 53;
 
-  InputGuard(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s)
-      : edge_m_(mesh.edge_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}
+  /** `object_extent_m`: the object's box, from 0 to it along each axis (ContactBox::extent_m). */
+  InputGuard(const std::array<double, 3>& object_extent_m, double workspace_margin_m,
+             double max_speed_m_per_s)
+      : extent_m_(object_extent_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}
 
   InputRejection Check(std::int64_t seq, const std::array<double, 3>& position_m,
                        std::int64_t received_ns) noexcept;
@@ -44,7 +46,8 @@ class InputGuard {
   void Reset() { have_last_ = false; }
 
  private:
-  double edge_m_, margin_m_, max_speed_;
+  std::array<double, 3> extent_m_;
+  double margin_m_, max_speed_;
   bool have_last_ = false;
   std::int64_t last_seq_ = 0, last_ns_ = 0, gaps_ = 0;
   std::array<double, 3> last_position_{};

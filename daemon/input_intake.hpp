@@ -16,9 +16,9 @@ namespace hapticsim {
  */
 class InputIntake {
  public:
-  InputIntake(const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s,
-              HapticLoop& loop, InputCounters& counters, bool owns_input)
-      : guard_(mesh, workspace_margin_m, max_speed_m_per_s),
+  InputIntake(double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
+              InputCounters& counters, bool owns_input)
+      : guard_(loop.contact_box().extent_m(), workspace_margin_m, max_speed_m_per_s),
         loop_(loop),
         counters_(counters),
         owns_input_(owns_input) {}

@@ -47,8 +47,8 @@ LcmBridge::LcmBridge(const DaemonConfig& config, HapticLoop& loop, InputCounters
     : config_(config),
       counters_(counters),
       lcm_(config.lcm_url),
-      intake_(config.scene.mesh, config.workspace_margin_m, config.max_speed_m_per_s, loop,
-              counters, DeviceInputOf(config) == "lcm"),
+      intake_(config.workspace_margin_m, config.max_speed_m_per_s, loop, counters,
+              DeviceInputOf(config) == "lcm"),
       gate_(std::move(gate)) {
   if (const std::string problem = LcmStartProblem(lcm_, config.lcm_url); !problem.empty()) {
     throw Error(problem + " (lcm.url in the config)");

@@ -18,14 +18,12 @@ constexpr int kAcceptsPerPoll = 4;
 }  // namespace
 
 ShmServer::ShmServer(const std::string& socket_path, const std::string& group,
-                     const MeshSettings& mesh, double workspace_margin_m, double max_speed_m_per_s,
+                     double workspace_margin_m, double max_speed_m_per_s,
                      double max_log_lines_per_s, HapticLoop& loop, InputCounters& counters,
                      bool owns_input)
     : listener_(socket_path, group),
-      intake_(mesh, workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input),
+      intake_(workspace_margin_m, max_speed_m_per_s, loop, counters, owns_input),
       surface_nodes_(static_cast<std::uint32_t>(loop.regions().surface_ids().size())),
-      nodes_per_axis_(mesh.nodes),
-      spacing_m_(mesh.edge_m / (mesh.nodes - 1)),
       counters_(counters),
       min_log_gap_ns_(1e9 / max_log_lines_per_s) {}
 
@@ -137,8 +135,8 @@ void ShmServer::OfferDeformation(const HapticLoop::SurfaceFrame& frame, std::int
   deformation_meta_.configuration_id = frame.configuration_id;
   deformation_meta_.in_contact = frame.in_contact;
   deformation_meta_.complete = frame.complete;
-  deformation_meta_.nodes_per_axis = nodes_per_axis_;
-  deformation_meta_.spacing_m = spacing_m_;
+  deformation_meta_.nodes_per_axis = frame.nodes_per_axis;
+  deformation_meta_.spacing_m = frame.spacing_m;
   for (int c = 0; c < 3; ++c) deformation_meta_.contact_node[c] = frame.centre[c];
   deformation_ids_ = frame.ids;
   deformation_u_ = frame.displacement_m;

@@ -27,9 +27,9 @@ namespace hapticsim {
 class ShmServer {
  public:
   /** @throws Error when the socket cannot be made (the message says what to check). */
-  ShmServer(const std::string& socket_path, const std::string& group, const MeshSettings& mesh,
-            double workspace_margin_m, double max_speed_m_per_s, double max_log_lines_per_s,
-            HapticLoop& loop, InputCounters& counters, bool owns_input);
+  ShmServer(const std::string& socket_path, const std::string& group, double workspace_margin_m,
+            double max_speed_m_per_s, double max_log_lines_per_s, HapticLoop& loop,
+            InputCounters& counters, bool owns_input);
 
   /** Answers drivers that connected, notices one that left, reads the session's inputs, and
    *  writes a deformed surface offered since (PublishPendingDeformation). */
@@ -60,8 +60,6 @@ class ShmServer {
   shm::PeerIdentity session_peer_;             // and who it is
   shm::ShmInputReader inputs_;
   const std::uint32_t surface_nodes_;  // every frame's, for the segment's size
-  const std::int32_t nodes_per_axis_;
-  const double spacing_m_;
   // The newest frame offered, under deformation_mutex_, and whether the session has it yet.
   std::mutex deformation_mutex_;
   shm::ShmDeformationFrame deformation_meta_;

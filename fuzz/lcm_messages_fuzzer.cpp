@@ -15,7 +15,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   // One guard for the whole run, as the daemon keeps one: state across messages is fuzzed too.
-  static hapticsim::InputGuard guard(hapticsim::MeshSettings{}, 0.05, 5.0);
+  static hapticsim::InputGuard guard({0.25, 0.25, 0.25}, 0.05, 5.0);
   static std::int64_t now_ns = 0;
   const int channel = data[0] % 2;
   void* bytes = const_cast<std::uint8_t*>(data + 1);

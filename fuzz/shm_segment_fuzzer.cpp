@@ -62,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     shm::MappedSegment mapping = shm::MappedSegment::Adopt(fd, "the fuzzer");  // closes fd
     if (!sealed) __builtin_trap();  // an unsealed segment must be refused
     // The input ring read as the daemon reads it: at most kInputSlots, whatever the index says.
-    hapticsim::InputGuard guard(hapticsim::MeshSettings{}, 0.05, 5.0);
+    hapticsim::InputGuard guard({0.25, 0.25, 0.25}, 0.05, 5.0);
     shm::ShmInputReader reader;
     const int read = reader.ReadNew(mapping.segment(), [&](const shm::ShmDeviceInput& input) {
       const auto verdict = guard.Check(

@@ -144,7 +144,7 @@ struct ShmDeformationFrame {
   std::int64_t configuration_id = -1;  ///< changes whenever the regions are replaced
   bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
   bool complete = true;                ///< every region published its part after being asked
-  std::int32_t nodes_per_axis = 0;     ///< n: node id = (ix · n + iy) · n + iz
+  std::int32_t nodes_per_axis = 0;     ///< n, the largest count: id = (ix · n + iy) · n + iz
   double spacing_m = 0;                ///< lattice spacing, m: rest position = index · spacing
   std::int32_t contact_node[3] = {};   ///< the node the regions are centred on
   std::uint32_t num_nodes = 0;         ///< surface nodes in the frame (ShmDeformationArea::nodes)

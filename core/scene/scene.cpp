@@ -159,20 +159,6 @@ void ValidateScene(const Scene& scene) {
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 
-std::string CubeOnlyProblem(const Scene& scene, const std::string& who) {
-  std::string what;
-  if (scene.geometry.from_file()) {
-    what = "geometry.file";
-  } else if (!scene.materials.empty() || !scene.supports.empty()) {
-    what = "[[material]] or [[support]] tables";
-  } else {
-    return "";
-  }
-  return who + " runs the built-in cube only so far, not a scene with " + what +
-         ": run it offline with `hapticsim simulate` (the reference, or the regions with "
-         "adaptivity.primary_size >= 1)";
-}
-
 std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node) {
   const int last = mesh.nodes - 1;
   for (int c : node) {

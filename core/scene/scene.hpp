@@ -188,13 +188,6 @@ std::string GetSceneValue(const Scene& scene, std::string_view key);
 void ValidateScene(const Scene& scene);
 
 /**
- * "" for the paper's cube ([material], its four back corners, no tables, no geometry file);
- * otherwise why `who` (e.g. "hapticsimd", "the error map") cannot run this scene yet, and what
- * to do instead: those parts still read the object as the cube of mesh.nodes³.
- */
-std::string CubeOnlyProblem(const Scene& scene, const std::string& who);
-
-/**
  * The paper's contact: the middle node of the front face (z = 0); with an even node count, the
  * one just below the centre in x and y. The one definition every model of the cube uses.
  */

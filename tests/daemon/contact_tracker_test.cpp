@@ -17,9 +17,14 @@ constexpr double kEdge = 0.25, kH = kEdge / 12;  // the default 13³ cube
 constexpr std::int64_t kMs = 1'000'000;
 
 MeshSettings Mesh() { return MeshSettings{}; }
+// The default cube as the daemon's tracker sees it: a box of 13³ nodes, its back corners held.
+const ContactBox& CubeBox() {
+  static const ContactBox box = ContactBox::Of(Scene{});
+  return box;
+}
 
 TEST(ContactTracker, ATouchOnTheCentredNodeEngagesAtOnceAndFollowsTheTip) {
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   EXPECT_FALSE(tracker.Update({0.125, 0.125, -0.002}, 0, middle).engaged);
   EXPECT_EQ(tracker.wanted_node(), middle);
@@ -61,7 +66,7 @@ TEST(ContactTracker, ATouchThroughAnyFacePicksTheNearestNodeOnThatFace) {
       {{0.07, kEdge + d, 0.2}, {0.07, kEdge - d, 0.2}, {3, 12, 10}, {0, -d, 0}},
   };
   for (const Case& c : cases) {
-    ContactTracker tracker(Mesh(), 0.1);
+    ContactTracker tracker(CubeBox(), 0.1);
     tracker.Update(c.outside, 0, c.node);
     EXPECT_EQ(tracker.wanted_node(), c.node) << "hovering";
     const auto contact = tracker.Update(c.inside, kMs, c.node);
@@ -72,7 +77,7 @@ TEST(ContactTracker, ATouchThroughAnyFacePicksTheNearestNodeOnThatFace) {
 }
 
 TEST(ContactTracker, AFixedBackCornerIsNeverTheContactNode) {
-  const ContactTracker tracker(Mesh(), 0.1);
+  const ContactTracker tracker(CubeBox(), 0.1);
   // Near the corner (0, 0, 12), a little farther from it along y than along x.
   const LatticeIndex node = tracker.NearestContactNode({0.2 * kH, 0.4 * kH, kEdge});
   EXPECT_FALSE(IsSupportNode(Mesh(), node));
@@ -84,7 +89,7 @@ TEST(ContactTracker, AFixedBackCornerIsNeverTheContactNode) {
 
 TEST(ContactTracker, ATouchElsewhereWaitsThenRampsItsDepthInFromZero) {
   const double ramp_s = 0.1;
-  ContactTracker tracker(Mesh(), ramp_s);
+  ContactTracker tracker(CubeBox(), ramp_s);
   const LatticeIndex middle{6, 6, 0}, side{2, 3, 0};
   tracker.Update({2 * kH, 3 * kH, -0.001}, 0, middle);
   EXPECT_EQ(tracker.wanted_node(), side);
@@ -121,7 +126,7 @@ TEST(ContactTracker, ATouchElsewhereWaitsThenRampsItsDepthInFromZero) {
 }
 
 TEST(ContactTracker, AfterARestartFromRestATipInsideMustLiftOffFirst) {
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.001}, 0, middle);
   EXPECT_TRUE(tracker.Update({0.125, 0.125, 0.003}, kMs, middle).engaged);
@@ -131,12 +136,12 @@ TEST(ContactTracker, AfterARestartFromRestATipInsideMustLiftOffFirst) {
   tracker.Update({0.125, 0.125, -0.001}, 4 * kMs, middle);
   EXPECT_TRUE(tracker.Update({0.125, 0.125, 0.001}, 5 * kMs, middle).engaged);
   // A fresh tracker (a started loop) behaves the same: a tip already inside waits for lift-off.
-  ContactTracker fresh(Mesh(), 0.1);
+  ContactTracker fresh(CubeBox(), 0.1);
   EXPECT_FALSE(fresh.Update({0.125, 0.125, 0.004}, 0, middle).engaged);
 }
 
 TEST(ContactTracker, ARestartKeepingContactEngagesAgainFromZero) {
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.001}, 0, middle);
   tracker.Update({0.125, 0.125, 0.003}, kMs, middle);
@@ -152,7 +157,7 @@ TEST(ContactTracker, ARestartKeepingContactEngagesAgainFromZero) {
 TEST(ContactTracker, ATipThatJumpsIsCaughtUpWithFromTheNodesOwnPath) {
   // A press at 30 mm/s whose input stalls for 9 ms and comes back 0.27 mm on: the node does not
   // jump there in one period; it goes on at its speed and catches up over kCatchUp_ns.
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.0001}, 0, middle);
   double z = 0, previous = 0, previous_step = 0, largest_change = 0;
@@ -177,7 +182,7 @@ TEST(ContactTracker, AJumpOfAFewPeriodsAfterAShortHoldIsCaughtUpWithToo) {
   // exhausted and the tip held for 3 periods, then the late inputs arrive and the tip is 49 µm
   // on in one period. Rendered as it came, that jump was a 0.2 N spike on a 1.4 N press; the node
   // catches up instead, its per-period step never changing by more than a few µm.
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.0001}, 0, middle);
   double previous = 0, previous_step = 0, largest_change = 0, z = 0;
@@ -197,7 +202,7 @@ TEST(ContactTracker, AJumpOfAFewPeriodsAfterAShortHoldIsCaughtUpWithToo) {
 TEST(ContactTracker, AFastTouchDownAndATouchAgainFollowTheTipWithoutACatchUp) {
   // 0.1 m/s, 100 µm per period, in and out and in again: a step that is steady is no jump, and
   // a new touch starts from rest, not with the last contact's velocity.
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   std::int64_t t = 0;
   for (int touch = 0; touch < 2; ++touch) {
@@ -212,7 +217,7 @@ TEST(ContactTracker, AFastTouchDownAndATouchAgainFollowTheTipWithoutACatchUp) {
 
 TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
   // A session that begins with the tool 1 cm inside (or a tip that jumped in): no step.
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.001}, 0, middle);
   const std::array<double, 3> tip{0.125, 0.125, 0.01};
@@ -225,7 +230,7 @@ TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
 }
 
 TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   tracker.Update({0.125, 0.125, -0.0001}, 0, middle);
   for (int n = 1; n <= 40; ++n) tracker.Update({0.125, 0.125, 1e-4 * n}, n * kMs, middle);
@@ -238,7 +243,7 @@ TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
   EXPECT_NEAR(tracker.Update(tip, 651 * kMs, middle).displacement_m[2], 0.006, 1e-12);
   EXPECT_NEAR(tracker.Update(tip, 701 * kMs, middle).displacement_m[2], 0.008, 1e-15);
   // Through the back face the inward normal is −z.
-  ContactTracker back(Mesh(), 0.1);
+  ContactTracker back(CubeBox(), 0.1);
   back.Update({0.125, 0.125, kEdge + 0.0001}, 0, middle);
   EXPECT_EQ(back.Update({0.125, 0.125, kEdge - 0.0001}, kMs, LatticeIndex{6, 6, 12}).inward_normal,
             (std::array<double, 3>{0, 0, -1}));
@@ -253,7 +258,7 @@ TEST(ContactTracker, AMispredictedTouchDownNeverPullsTheNodeOutOfTheObject) {
   // pulled the node 2.3 mm out of the object while the tool pressed. A tool only pushes: the
   // node's depth is never negative, and it is back on the tip.
   InputResampler resampler(1e-3, 10e-3);
-  ContactTracker tracker(Mesh(), 0.1);
+  ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};
   auto press_z = [](std::int64_t seq) {
     return seq < 100 ? -0.001 : 0.005 * (1 - std::cos(2 * M_PI * (seq - 100) * 1e-3));

@@ -7,11 +7,10 @@
 #include <limits>
 #include <tuple>
 
-#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
+#include "core/regions/async_regions.hpp"
 #include "daemon/command_check.hpp"
 #include "daemon/daemon_config.hpp"
-#include "rt/deadline_monitor.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
 #include "daemon/overload_watch.hpp"
@@ -20,6 +19,8 @@
 #include "hapticsim/device_input_t.hpp"
 #include "hapticsim/force_feedback_t.hpp"
 #include "hapticsim/status_t.hpp"
+#include "rt/deadline_monitor.hpp"
+#include "tests/support/box_stl.hpp"
 
 namespace hapticsim {
 namespace {
@@ -199,15 +200,24 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 // adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
 // main.cpp builds its HapticLoop). Without [adaptivity] the daemon starts from the default size
 // at equal rates.
-TEST(DaemonConfig, AnObjectOtherThanTheCubeIsRefusedSayingWhereItRuns) {
+// hapticsimd runs any object that fills its lattice's box (ContactBox): here a box drawn as an
+// STL, 4 × 4 × 4 voxels of 1 cm, with a [[material]] table and its back face held by a
+// [[support]] plane. (An object that leaves voxels empty is refused by the same check,
+// BoxObjectProblem: ContactBox.AnObjectThatLeavesVoxelsEmptyIsRefusedSayingHowMany.)
+TEST(DaemonConfig, AGeometryThatFillsItsBoxIsTaken) {
+  const std::string stl = ConfigTestPath() + ".box.stl";
+  testing::WriteBoxStl(stl, 0.04);
   const std::string scene = ConfigTestPath() + ".scene.toml";
-  std::ofstream(scene) << "[[material]]\nlabel = 1\nyoungs_modulus = 20000.0\n";
+  const std::string object = "[geometry]\nfile = \"" + stl +
+                             "\"\nspacing_m = 0.01\n"
+                             "[[material]]\nlabel = 1\nyoungs_modulus = 20000.0\n";
+  std::ofstream(scene) << object << "[[support]]\nplane_point = [0.0, 0.0, 0.04]\n"
+                       << "plane_normal = [0.0, 0.0, 1.0]\n";
+  EXPECT_EQ(ConfigError("[scene]\nfile = \"" + scene + "\"\n"), "");
+  // Without supports the object floats: refused, saying what to add.
+  std::ofstream(scene) << object;
   const std::string error = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
-  EXPECT_NE(error.find("hapticsimd runs the built-in cube only so far, not a scene with "
-                       "[[material]] or [[support]] tables"),
-            std::string::npos)
-      << error;
-  EXPECT_NE(error.find("hapticsim simulate"), std::string::npos) << error;
+  EXPECT_NE(error.find("needs [[support]] tables"), std::string::npos) << error;
 }
 
 TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {
@@ -318,7 +328,7 @@ TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
 }
 
 TEST(InputGuard, RejectsEachKindOfBadInputAndAcceptsAHand) {
-  InputGuard guard(MeshSettings{}, 0.1, 5.0);
+  InputGuard guard({0.25, 0.25, 0.25}, 0.1, 5.0);  // the default cube's box
   const std::int64_t ms = 1'000'000;
   EXPECT_EQ(guard.Check(1, {0.125, 0.125, 0.0}, 0), InputRejection::kAccepted);
   EXPECT_EQ(guard.Check(2, {0.125, 0.125, 0.001}, ms), InputRejection::kAccepted);  // 1 m/s

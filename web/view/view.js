@@ -1,7 +1,8 @@
 // hapticsim view: draws a running hapticsimd's object, tool and force from the messages that
 // `hapticsim view` forwards from LCM over a WebSocket (see tools/view/view_feed.cpp for their
-// fields). Object frame: the cube spans 0 … (n - 1)·spacing on each axis, the tool presses the
-// front face z = 0 towards +z; all lengths are metres, forces newtons.
+// fields). Object frame: the object is a box of lattice nodes from 0 to its largest index times
+// spacing on each axis (the paper's cube: n - 1 on all three); node ids are (ix·n + iy)·n + iz with
+// n = nodes_per_axis, the largest node count. All lengths are metres, forces newtons.
 import * as THREE from 'three';
 import { OrbitControls } from '/OrbitControls.js';
 
@@ -61,21 +62,22 @@ function pointArrow(from, force, metresPerNewton, thickness) {
 // nodes: one position per surface node (what the lattice lines and the tool read); surface: six
 // vertices per lattice square, so each square is coloured by the region it belongs to, sharply.
 const object = {
-  n: 0, spacing: 0, edge: 0, configuration: -1, ids: null, rest: null, quads: null,
+  n: 0, last: [0, 0, 0], spacing: 0, edge: 0, configuration: -1, ids: null, rest: null, quads: null,
   nodes: null, segments: null, surface: null, lattice: null, primaryBox: null, contactIndex: -1,
 };
 let arrowMetresPerNewton = 0.05;
 
 function nodeLattice(id, n) { return [Math.floor(id / (n * n)), Math.floor(id / n) % n, id % n]; }
 
-// The lattice squares on the cube's six faces, as four node indices each, wound outwards.
-function surfaceQuads(n, indexOf) {
-  const last = n - 1, quads = [];
+// The lattice squares on the box's six faces (its largest index per axis: last), as four node
+// indices each, wound outwards.
+function surfaceQuads(n, last, indexOf) {
+  const quads = [];
   for (let a = 0; a < 3; ++a) {
     const b = (a + 1) % 3, c = (a + 2) % 3;
-    for (const side of [0, last]) {
-      for (let i = 0; i < last; ++i) {
-        for (let j = 0; j < last; ++j) {
+    for (const side of [0, last[a]]) {
+      for (let i = 0; i < last[b]; ++i) {
+        for (let j = 0; j < last[c]; ++j) {
           const corner = (di, dj) => {
             const ijk = [0, 0, 0];
             ijk[a] = side; ijk[b] = i + di; ijk[c] = j + dj;
@@ -83,7 +85,7 @@ function surfaceQuads(n, indexOf) {
           };
           const q = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
           if (q.some((v) => v === undefined)) continue;
-          quads.push(...(side === last ? q : [q[0], q[3], q[2], q[1]]));
+          quads.push(...(side === last[a] ? q : [q[0], q[3], q[2], q[1]]));
         }
       }
     }
@@ -113,9 +115,12 @@ function buildObject(m) {
   }
   const n = m.nodes_per_axis, h = m.spacing_m, ids = m.node_ids;
   const indexOf = new Map(ids.map((id, k) => [id, k]));
-  const rest = new Float32Array(3 * ids.length);
-  ids.forEach((id, k) => nodeLattice(id, n).forEach((l, c) => { rest[3 * k + c] = l * h; }));
-  const quads = surfaceQuads(n, indexOf);
+  const rest = new Float32Array(3 * ids.length), last = [0, 0, 0];
+  ids.forEach((id, k) => nodeLattice(id, n).forEach((l, c) => {
+    rest[3 * k + c] = l * h;
+    last[c] = Math.max(last[c], l);
+  }));
+  const quads = surfaceQuads(n, last, indexOf);
   const nodes = new THREE.BufferAttribute(rest.slice(), 3);
   const lines = new THREE.BufferGeometry();
   lines.setAttribute('position', nodes);
@@ -124,7 +129,8 @@ function buildObject(m) {
   surface.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * vertices), 3));
   surface.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * vertices), 3));
   Object.assign(object, {
-    n, spacing: h, edge: (n - 1) * h, configuration: m.configuration_id, ids, rest, quads, nodes,
+    n, last, spacing: h, edge: Math.max(...last) * h, configuration: m.configuration_id, ids, rest,
+    quads, nodes,
     segments: quadLines(quads),
     surface: new THREE.Mesh(surface, surfaceMaterial),
     lattice: new THREE.LineSegments(lines, latticeMaterial),
@@ -137,13 +143,13 @@ function buildObject(m) {
 // The primary region: the coarse cells (secondary_lod fine cells a side) that overlap the box of
 // the contact node ± primary_size, clipped to the object — core/regions/region_partition.cpp makes the
 // box, core/regions/hybrid_mesh.cpp's CellOverlaps takes the cells. Its extent in lattice indices.
-function primaryExtent(m, n) {
-  const k = Math.max(1, m.secondary_lod), last = n - 1, r = m.primary_size;
+function primaryExtent(m, last) {
+  const k = Math.max(1, m.secondary_lod), r = m.primary_size;
   const lo = [], hi = [];
   m.contact_node.forEach((c, a) => {
-    const boxLo = Math.max(0, c - r), boxHi = Math.min(last, c + r);
+    const boxLo = Math.max(0, c - r), boxHi = Math.min(last[a], c + r);
     let first = Infinity, end = -Infinity;
-    for (let j = 0; j * k < last; ++j) {
+    for (let j = 0; j * k < last[a]; ++j) {
       if (j * k < boxHi && (j + 1) * k > boxLo) { first = Math.min(first, j * k); end = (j + 1) * k; }
     }
     lo.push(first); hi.push(end);
@@ -160,7 +166,7 @@ function colourRegions(m) {
     object.primaryBox.geometry.dispose();
   }
   const n = object.n;
-  const { lo, hi } = primaryExtent(m, n);
+  const { lo, hi } = primaryExtent(m, object.last);
   object.primary = { lo, hi };
   const inPrimary = (k) => nodeLattice(object.ids[k], n).every((v, a) => v >= lo[a] && v <= hi[a]);
   const colours = object.surface.geometry.attributes.color;
