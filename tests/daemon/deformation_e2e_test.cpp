@@ -15,7 +15,12 @@
 #include <thread>
 #include <vector>
 
+#include "core/fem/static_solver.hpp"
+#include "core/scene/scene_model.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "hapticsim/deformation_t.hpp"
+#include "hapticsim/force_feedback_t.hpp"
+#include "tests/support/box_stl.hpp"
 #include "tests/support/daemon_harness.hpp"
 #include "tests/support/private_socket.hpp"
 #include "tests/support/run_command.hpp"
@@ -179,6 +184,96 @@ TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthA
       "latency %.2f ms, ids every %.2f s at most, %lld lost\n",
       frames.size(), frames_in_press, touched_held_z, largest_latency_ms, largest_id_gap_s,
       static_cast<long long>(lost));
+}
+
+// A block from a file — 6 × 4 × 3 cm drawn as an STL, voxelised at 1 cm (7 × 5 × 4 nodes), its back
+// face held — served by a real hapticsimd: the deformation's ids decode with its one node count
+// to the block's own surface, the touched node goes where the tool is, and the force on the hand
+// settles to the static solution of the same scene (solved here, not by the daemon).
+TEST(HapticsimdDeformation, ABlockFromAFileIsServedOnItsOwnLattice) {
+  const std::string dir = ::testing::TempDir() + "hapticsimd_block";
+  std::filesystem::create_directories(dir);
+  testing::WriteBoxStl(dir + "/block.stl", {0.06, 0.04, 0.03});
+  const std::string scene_path = dir + "/block.toml";
+  std::ofstream(scene_path) << "[geometry]\nfile = \"block.stl\"\nspacing_m = 0.01\n"
+                            << "[[material]]\nlabel = 1\n"
+                            << "[[support]]\nplane_point = [0.0, 0.0, 0.03]\n"
+                            << "plane_normal = [0.0, 0.0, 1.0]\n"
+                            // (the default primary size, 3 nodes around the contact, would take
+                            // the whole block and leave no secondary region)
+                            << "[adaptivity]\nprimary_size = 2\nsecondary_lod = 1\n"
+                            << "secondary_rate = 1000.0\n";
+  const std::string config = dir + "/hapticsimd.toml", control = testing::PrivateSocketPath();
+  std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
+                        << "[control]\nsocket = \"" << control << "\"\n"
+                        << "[scene]\nfile = \"" << scene_path << "\"\n"
+                        << "[deformation]\nrate_hz = 60\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, dir + "/daemon.log");
+  DeformationListener listener;
+  testing::Client client;
+  testing::WaitUntilServing(daemon);
+  // The default contact: the front-most node of the middle column, (3, 2, 0) at (3, 2, 0) cm.
+  // 3 mm in over 0.3 s, then held for 1 s.
+  constexpr int n = 7;  // the largest node count: x
+  constexpr double kDepth = 0.003;
+  const auto press_start = Clock::now();
+  auto next = press_start;
+  for (std::int64_t seq = 1; seq <= 1500; ++seq) {
+    const double z = seq <= 200 ? -0.003 : kDepth * std::min(1.0, (seq - 200) / 300.0);
+    client.Send(seq, 0.03, 0.02, z);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::vector<DeformationListener::Received> frames = listener.Frames();
+  const std::vector<force_feedback_t> forces = client.Forces();
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  std::filesystem::remove_all(std::filesystem::path(control).parent_path());
+  ASSERT_GT(frames.size(), 50u) << daemon.Log();
+
+  // 7 × 5 × 4 nodes, 5 × 3 × 2 of them inside: 110 on the surface, each id decoding into the box.
+  const deformation_t& first = frames.front().message;
+  EXPECT_EQ(first.nodes_per_axis, n);
+  EXPECT_DOUBLE_EQ(first.spacing_m, 0.01);
+  ASSERT_EQ(first.num_ids, 7 * 5 * 4 - 5 * 3 * 2);
+  for (int32_t id : first.node_ids) {
+    const int x = id / (n * n), y = id / n % n, z = id % n;
+    ASSERT_TRUE(x <= 6 && y <= 4 && z <= 3) << id;
+    EXPECT_TRUE(x == 0 || x == 6 || y == 0 || y == 4 || z == 0 || z == 3) << id;
+  }
+  const int32_t touched_id = (3 * n + 2) * n + 0, held_id = (3 * n + 2) * n + 3;
+  const deformation_t& last = frames.back().message;
+  EXPECT_EQ(last.contact_node[0], 3);
+  EXPECT_EQ(last.contact_node[1], 2);
+  EXPECT_EQ(last.contact_node[2], 0);
+  const auto touched = NodeDisplacement(last, first.node_ids, touched_id);
+  const auto held = NodeDisplacement(last, first.node_ids, held_id);
+  ASSERT_TRUE(touched && held);
+  EXPECT_NEAR((*touched)[2], kDepth, 1e-4);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ((*held)[c], 0.0f) << c;
+
+  // The force over the last 100 ms of the hold against the static solution at 3 mm.
+  const SceneModel model(LoadSceneFile(scene_path));
+  const std::vector<double> driven{0.0, 0.0, kDepth};
+  const StaticSolution solved = SolveStatic(model.model(), driven, 1e-12);
+  ASSERT_TRUE(solved.converged);
+  ASSERT_GT(forces.size(), 200u);
+  // (The answers after the last input hold it until it is stale, then release the force: left out.)
+  double mean_z = 0;
+  int answers = 0;
+  for (const force_feedback_t& f : forces) {
+    if (f.seq <= 1400 || (f.flags & force_feedback_t::FLAG_INPUT_STALE)) continue;
+    EXPECT_TRUE(f.flags & force_feedback_t::FLAG_IN_CONTACT) << f.seq;
+    mean_z += f.force[2];
+    ++answers;
+  }
+  ASSERT_GT(answers, 90);
+  mean_z /= answers;
+  std::printf("block: %zu frames, touched node at %.5f m; force %.5f N, static %.5f N\n",
+              frames.size(), (*touched)[2], mean_z, -solved.driven_reaction[2]);
+  ASSERT_GT(solved.driven_reaction[2], 0.01);  // pressed in (+z), the hand is pushed back (−z)
+  EXPECT_NEAR(mean_z, -solved.driven_reaction[2], 0.02 * solved.driven_reaction[2]);
 }
 
 }  // namespace
