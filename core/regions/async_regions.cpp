@@ -244,9 +244,13 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   if (a > 0) {
     const Region& inner = *regions_[a - 1];
     (void)inner.outward->TryReadLatestTwo(&region.inner);
-    // The schedule keeps the inner region less than one of its nominal periods behind; never
-    // extrapolate further than that, should it be late.
-    const double t = std::min(t0, region.inner.newer.time_s + 1.0 / inner.schedule.rate_hz);
+    // The schedule keeps the inner region less than one of its nominal periods behind. Never
+    // extrapolate its snapshots further than one of its steps (one substep): the line through
+    // two substeps' snapshots, carried a whole period of s substeps ahead, multiplies their
+    // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
+    // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
+    const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
+    const double t = std::min(t0, region.inner.newer.time_s + inner_step_s);
     if (coupling_ == Coupling::kForce) {
       for (size_t i = 0; i < inner_gamma.size(); ++i) {
         region.load_values[i] =
