@@ -14,6 +14,7 @@
 #include "daemon/haptic_loop.hpp"
 #include "tests/support/phantom_scene.hpp"
 #include "tests/support/play_device.hpp"
+#include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
 namespace {
@@ -62,6 +63,9 @@ TEST(StiffObjectThreads, APressStaysBoundedWhereverTheSecondaryIsInItsSubsteps) 
         "attempt %d: largest simulated force %.5f N (offline %.5f N), %d periods in "
         "contact, %lld secondary periods skipped\n",
         attempt, largest, offline, in_contact, static_cast<long long>(loop.skipped_periods(1)));
+    // (Under a sanitizer every step is many times slower than its period: the threads are
+    // checked, not the force.)
+    if (kSanitized) continue;
     EXPECT_GT(in_contact, 300);
     // Timing moves the force a little (the secondary's phase, skipped periods); a diverging
     // coupling reached 54 N and beyond within 20 periods of the touch.
