@@ -28,7 +28,7 @@ ContactBox::ContactBox(const SceneObject& object)
   for (int c = 0; c < 3; ++c) extent_m_[c] = (nodes_[c] - 1) * spacing_m_;
   const std::size_t count = static_cast<std::size_t>(nodes_[0]) * nodes_[1] * nodes_[2];
   drivable_.assign(count, false);
-  std::vector<LatticeIndex> free;
+  bool any_free = false;
   for (int ix = 0; ix < nodes_[0]; ++ix) {
     for (int iy = 0; iy < nodes_[1]; ++iy) {
       for (int iz = 0; iz < nodes_[2]; ++iz) {
@@ -37,23 +37,11 @@ ContactBox::ContactBox(const SceneObject& object)
         const bool held = std::binary_search(object.fixed_nodes.begin(), object.fixed_nodes.end(),
                                              object.grid.Node(ix, iy, iz));
         drivable_[Index(at)] = !held;
-        if (!held) free.push_back(at);
+        any_free = any_free || !held;
       }
     }
   }
-  HAPTICSIM_THROW_UNLESS(!free.empty(), "the supports hold every surface node: nothing to touch");
-  // Each held surface node's stand-in: the drivable node nearest to it (ties to the lower code).
-  substitute_.assign(count, -1);
-  for (std::size_t i = 0; i < count; ++i) {
-    const LatticeIndex at = Decode(static_cast<std::int64_t>(i));
-    if (drivable_[i] || !OnSurface(at)) continue;
-    long best = std::numeric_limits<long>::max();
-    for (const LatticeIndex& f : free) {
-      long d2 = 0;
-      for (int c = 0; c < 3; ++c) d2 += static_cast<long>(f[c] - at[c]) * (f[c] - at[c]);
-      if (d2 < best) best = d2, substitute_[i] = static_cast<std::int32_t>(Code(f));
-    }
-  }
+  HAPTICSIM_THROW_UNLESS(any_free, "the supports hold every surface node: nothing to touch");
 }
 
 bool ContactBox::OnSurface(const LatticeIndex& node) const noexcept {
@@ -90,7 +78,7 @@ void ContactBox::ToWireIds(const std::vector<std::int32_t>& codes,
   }
 }
 
-LatticeIndex ContactBox::NearestDrivable(
+std::optional<LatticeIndex> ContactBox::NearestDrivable(
     const std::array<double, 3>& surface_point_m) const noexcept {
   LatticeIndex node{};
   std::array<double, 3> at{};  // the point in lattice units
@@ -99,9 +87,7 @@ LatticeIndex ContactBox::NearestDrivable(
     node[c] = std::clamp(static_cast<int>(std::lround(at[c])), 0, nodes_[c] - 1);
   }
   if (drivable_[Index(node)]) return node;
-  // Held (a support): its drivable neighbour on the surface nearest to the point, so a touch
-  // beside a held corner picks the node on the side it came down on.
-  LatticeIndex best = node;
+  std::optional<LatticeIndex> best;
   double best_d2 = std::numeric_limits<double>::infinity();
   for (int axis = 0; axis < 3; ++axis) {
     for (int step : {-1, 1}) {
@@ -113,8 +99,7 @@ LatticeIndex ContactBox::NearestDrivable(
       if (d2 < best_d2) best_d2 = d2, best = next;
     }
   }
-  if (best != node) return best;
-  return Decode(substitute_[Index(node)]);
+  return best;
 }
 
 }  // namespace hapticsim

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,12 +37,15 @@ class ContactBox {
   bool Drivable(const LatticeIndex& node) const noexcept;
 
   /**
-   * The drivable node nearest to a point on the surface (or projected onto it), m: the lattice
-   * node it rounds to; if a support holds that one, its drivable neighbour on the surface nearest
-   * to the point; failing that, the drivable node nearest to the held one (found once, at
-   * construction).
+   * The node a touch at a point on the surface (or projected onto it), m, drives: the lattice node
+   * it rounds to; if a support holds that one, its drivable neighbour on the surface nearest to
+   * the point (beside a held corner, the node on the side the touch came down on). None when
+   * the node and all its neighbours are held: a touch on a held face touches the support, which
+   * the model does not render (a far node driven instead would feel like soft tissue where the
+   * object is held rigid).
    */
-  LatticeIndex NearestDrivable(const std::array<double, 3>& surface_point_m) const noexcept;
+  std::optional<LatticeIndex> NearestDrivable(
+      const std::array<double, 3>& surface_point_m) const noexcept;
 
   /** A node as one integer, (ix · ny + iy) · nz + iz (the order of the regions' surface ids),
    *  for an atomic; Decode gives it back. */
@@ -67,8 +71,7 @@ class ContactBox {
   std::array<int, 3> nodes_{};
   double spacing_m_ = 0;
   std::array<double, 3> extent_m_{};
-  std::vector<bool> drivable_;            // by Code
-  std::vector<std::int32_t> substitute_;  // by Code: for a held surface node, the nearest drivable
+  std::vector<bool> drivable_;  // by Code
 };
 
 /**

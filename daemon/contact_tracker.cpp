@@ -15,7 +15,7 @@ std::array<double, 3> Minus(const std::array<double, 3>& a, const std::array<dou
 ContactTracker::ContactTracker(const ContactBox& box, double engage_ramp_s)
     : box_(box), ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
 
-LatticeIndex ContactTracker::NearestContactNode(
+std::optional<LatticeIndex> ContactTracker::NearestContactNode(
     const std::array<double, 3>& surface_point_m) const noexcept {
   return box_.NearestDrivable(surface_point_m);
 }
@@ -52,8 +52,15 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     entry_[axis] = face;
     inward_ = {0, 0, 0};
     inward_[axis] = face == 0 ? 1.0 : -1.0;
-    node_ = NearestContactNode(entry_);
-    wanted_ = node_;
+    const std::optional<LatticeIndex> node = NearestContactNode(entry_);
+    wanted_ = node;
+    if (!node) {
+      // On a held face: the tool touches the support, which is not rendered (ContactBox::
+      // NearestDrivable); nothing until it has left the object.
+      state_ = State::kAwaitLiftOff;
+      return {};
+    }
+    node_ = *node;
     const bool centred = centre && *centre == node_;
     state_ = centred ? State::kEngaged : State::kWaiting;
     ramping_ = false;

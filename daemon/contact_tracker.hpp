@@ -17,7 +17,8 @@ namespace hapticsim {
  * paper's cube, or a geometry that fills its lattice). The tip is in contact while it is strictly
  * inside. At touch-down the entry face is the one the tip is least deep behind; the entry point
  * is the tip projected on that face, and the contact node is the surface node nearest to the
- * entry point (never one a support holds: a free neighbour instead, ContactBox::NearestDrivable).
+ * entry point (never one a support holds: a free neighbour instead, ContactBox::NearestDrivable;
+ * on a held face none, and the touch renders nothing until the tip has left the object).
  * While in contact the node follows the tip: displacement = tip − entry point, in all three
  * directions. The node stays the same until lift-off (as in the paper, the contact does not slide).
  *
@@ -97,8 +98,10 @@ class ContactTracker {
   static constexpr double kCatchUpJump_m = 10e-6;
   static constexpr std::int64_t kCatchUp_ns = 20'000'000;
 
-  /** The surface node nearest to a point on (or projected onto) the surface; never a held one. */
-  LatticeIndex NearestContactNode(const std::array<double, 3>& surface_point_m) const noexcept;
+  /** The surface node a touch at a point on (or projected onto) the surface drives; never a held
+   *  one, and none on a held face (ContactBox::NearestDrivable). */
+  std::optional<LatticeIndex> NearestContactNode(
+      const std::array<double, 3>& surface_point_m) const noexcept;
 
  private:
   enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };

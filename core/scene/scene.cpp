@@ -63,7 +63,7 @@ void ValidateCubeScene(const Scene& scene) {
                 FormatReal(scene.mesh.edge_m) + " m");
   }
   if (const auto& node = scene.input.contact_node) {
-    const std::string problem = ContactNodeProblem(scene.mesh, *node);
+    const std::string problem = ContactNodeProblem(scene.mesh, *node, scene.supports.empty());
     if (!problem.empty()) {
       throw Error("input.contact_node = " + GetSceneValue(scene, "input.contact_node") + " " +
                   problem);
@@ -159,7 +159,8 @@ void ValidateScene(const Scene& scene) {
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 
-std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node) {
+std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node,
+                               bool corners_held) {
   const int last = mesh.nodes - 1;
   for (int c : node) {
     if (c < 0 || c > last) {
@@ -171,7 +172,7 @@ std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& nod
     return "is inside the object: the contact node must be on the surface (some index 0 or " +
            std::to_string(last) + ")";
   }
-  if (IsSupportNode(mesh, node)) {
+  if (corners_held && IsSupportNode(mesh, node)) {
     return "is a fixed back corner: the contact node must be free to move";
   }
   return "";

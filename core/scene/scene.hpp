@@ -207,9 +207,11 @@ bool IsSupportNode(const MeshSettings& mesh, const LatticeIndex& node);
 
 /**
  * Why `node` cannot be the driven node of `mesh` — "is outside the mesh: …", "is inside the
- * object: …", "is a fixed back corner: …" — or "" when it can (ValidateScene's check).
+ * object: …", "is a fixed back corner: …" (only with `corners_held`: the default supports, no
+ * [[support]] tables) — or "" when it can (ValidateScene's check).
  */
-std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node);
+std::string ContactNodeProblem(const MeshSettings& mesh, const LatticeIndex& node,
+                               bool corners_held = true);
 
 /**
  * The unit inward normal of the face a surface node lies on. Nodes on an edge or a corner belong

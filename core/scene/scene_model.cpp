@@ -155,7 +155,7 @@ LatticeIndex SceneContactNode(const Scene& scene) {
 std::string ContactNodeProblemOn(const Scene& scene, const LatticeIndex& node) {
   // The cube's rule, and on the cube with [[support]] tables, whether they hold the node.
   if (!scene.geometry.from_file()) {
-    const std::string problem = ContactNodeProblem(scene.mesh, node);
+    const std::string problem = ContactNodeProblem(scene.mesh, node, scene.supports.empty());
     if (!problem.empty() || scene.supports.empty()) return problem;
   }
   Scene at = scene;

@@ -5,10 +5,11 @@
 
 #include <cmath>
 
-#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/trial/force_error.hpp"
 #include "core/trial/reference_trial.hpp"
+#include "tests/support/voxel_scene.hpp"
 
 namespace hapticsim {
 namespace {
@@ -69,6 +70,16 @@ TEST(ContactNode, RejectsNodesInsideOutsideOrFixed) {
   EXPECT_NE(message("6,6,13").find("outside the mesh"), std::string::npos);
   EXPECT_NE(message("0,0,12").find("fixed back corner"), std::string::npos);
   EXPECT_EQ(message("0,0,11"), "accepted");
+  // [[support]] tables replace the corners: held by the whole back face, the corner is still
+  // refused (by the model, as held); held by the left face only, the back corner is free.
+  Scene back = scene, left = scene;
+  testing::HoldPlaneZ(&back, 0.25);
+  left.supports = {testing::SupportBox({-0.001, -0.001, -0.001}, {0.001, 0.251, 0.251})};
+  EXPECT_NE(ContactNodeProblemOn(back, {12, 12, 12}), "");
+  EXPECT_EQ(ContactNodeProblemOn(left, {12, 0, 12}), "");
+  left.input.contact_node = LatticeIndex{12, 0, 12};
+  EXPECT_NO_THROW(ValidateScene(left));
+  EXPECT_NO_THROW(SceneModel{left});
 }
 
 TEST(ContactNode, EdgeNodesPressAlongTheFrontOrBackFirst) {

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +16,7 @@
 #include "core/fem/static_solver.hpp"
 #include "core/scene/scene_model.hpp"
 #include "daemon/contact_box.hpp"
+#include "daemon/contact_tracker.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/input_guard.hpp"
 #include "tests/support/play_device.hpp"
@@ -63,36 +63,53 @@ TEST(ContactBox, IsTheObjectsLatticeWithItsHeldNodesLeftOut) {
   EXPECT_EQ(std::unique(codes.begin(), codes.end()), codes.end());
 }
 
-TEST(ContactBox, APointOnAHeldFaceGoesToTheNearestFreeNode) {
+TEST(ContactBox, AHeldFaceDrivesAFreeNeighbourAtItsRimAndNothingElsewhere) {
   const ContactBox box = ContactBox::Of(Block());
-  // Every point of a coarse raster over the back face (held): the node chosen is drivable, and
-  // no drivable node is nearer to the point than it (checked against all of them).
+  // Every point of a raster over the back face (held): at its rim, the free node one spacing in
+  // front of the held node the point rounds to (on the side face); inside the face, none — the
+  // tool touches the support there, and no far node is driven instead.
+  int rim = 0, none = 0;
   for (double x = 0; x <= 0.10; x += 0.0037) {
     for (double y = 0; y <= 0.06; y += 0.0041) {
-      const std::array<double, 3> p{x, y, 0.04};
-      const LatticeIndex chosen = box.NearestDrivable(p);
-      ASSERT_TRUE(box.Drivable(chosen)) << x << ", " << y;
-      auto d2 = [&](const LatticeIndex& n) {
-        double s = 0;
-        for (int c = 0; c < 3; ++c) s += (p[c] / kH - n[c]) * (p[c] / kH - n[c]);
-        return s;
-      };
-      // The stand-in is the drivable node nearest to the held node the point rounds to, so it
-      // may be up to one node spacing farther from the point itself than the nearest one.
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < 11; ++i)
-        for (int j = 0; j < 7; ++j)
-          for (int k = 0; k < 5; ++k) {
-            if (box.Drivable({i, j, k})) nearest = std::min(nearest, std::sqrt(d2({i, j, k})));
-          }
-      EXPECT_LE(std::sqrt(d2(chosen)), nearest + 1.0 + 1e-12) << x << ", " << y;
-      EXPECT_EQ(chosen[2], 3) << "a free node next to the held face";
+      const std::optional<LatticeIndex> chosen = box.NearestDrivable({x, y, 0.04});
+      const LatticeIndex held{static_cast<int>(std::lround(x / kH)),
+                              static_cast<int>(std::lround(y / kH)), 4};
+      ASSERT_FALSE(box.Drivable(held));
+      if (held[0] == 0 || held[0] == 10 || held[1] == 0 || held[1] == 6) {
+        ASSERT_TRUE(chosen) << x << ", " << y;
+        EXPECT_EQ(*chosen, (LatticeIndex{held[0], held[1], 3})) << x << ", " << y;
+        ++rim;
+      } else {
+        EXPECT_FALSE(chosen) << x << ", " << y;
+        ++none;
+      }
     }
   }
+  EXPECT_GT(rim, 20);
+  EXPECT_GT(none, 100);
   // On a free face the point's own node, on every face.
   EXPECT_EQ(box.NearestDrivable({0.031, 0.06, 0.019}), (LatticeIndex{3, 6, 2}));
   EXPECT_EQ(box.NearestDrivable({0.10, 0.012, 0.02}), (LatticeIndex{10, 1, 2}));
   EXPECT_EQ(box.NearestDrivable({0.07, 0.03, 0.0}), (LatticeIndex{7, 3, 0}));
+}
+
+TEST(ContactTrackerOnABox, ATouchOnTheHeldFaceRendersNothingUntilTheToolHasLeft) {
+  const ContactBox box = ContactBox::Of(Block());
+  ContactTracker tracker(box, 0.1);
+  const std::int64_t ms = 1'000'000;
+  const LatticeIndex front{5, 3, 0};
+  // Behind the block, then through its back face (z = 4 cm) in the middle: the support.
+  EXPECT_FALSE(tracker.Update({0.05, 0.03, 0.042}, 0, front).engaged);
+  EXPECT_FALSE(tracker.wanted_node()) << "no node to move the regions to behind a held face";
+  for (int n = 1; n <= 20; ++n) {
+    const auto contact = tracker.Update({0.05, 0.03, 0.04 - 1e-4 * n}, n * ms, front);
+    EXPECT_FALSE(contact.engaged) << n;
+    EXPECT_FALSE(contact.waiting) << n;
+  }
+  // Round the block to the front: the front face engages as always.
+  tracker.Update({0.05, 0.03, -0.002}, 30 * ms, front);
+  EXPECT_EQ(tracker.wanted_node(), front);
+  EXPECT_TRUE(tracker.Update({0.05, 0.03, 0.0003}, 31 * ms, front).engaged);
 }
 
 TEST(ContactBox, TheWireIdsDecodeWithOneNodeCountToTheBoxsNodes) {

@@ -79,12 +79,15 @@ TEST(ContactTracker, ATouchThroughAnyFacePicksTheNearestNodeOnThatFace) {
 TEST(ContactTracker, AFixedBackCornerIsNeverTheContactNode) {
   const ContactTracker tracker(CubeBox(), 0.1);
   // Near the corner (0, 0, 12), a little farther from it along y than along x.
-  const LatticeIndex node = tracker.NearestContactNode({0.2 * kH, 0.4 * kH, kEdge});
+  const std::optional<LatticeIndex> nearest =
+      tracker.NearestContactNode({0.2 * kH, 0.4 * kH, kEdge});
+  ASSERT_TRUE(nearest);
+  const LatticeIndex node = *nearest;
   EXPECT_FALSE(IsSupportNode(Mesh(), node));
   EXPECT_TRUE(IsSurfaceNode(Mesh(), node));
   EXPECT_EQ(node, (LatticeIndex{0, 1, 12}));
   EXPECT_EQ(tracker.NearestContactNode({kEdge, kEdge - 0.4 * kH, kEdge - 0.2 * kH}),
-            (LatticeIndex{12, 11, 12}));
+            std::optional<LatticeIndex>(LatticeIndex{12, 11, 12}));
 }
 
 TEST(ContactTracker, ATouchElsewhereWaitsThenRampsItsDepthInFromZero) {

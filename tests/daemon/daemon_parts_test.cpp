@@ -200,11 +200,12 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 // adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
 // main.cpp builds its HapticLoop). Without [adaptivity] the daemon starts from the default size
 // at equal rates.
-// hapticsimd runs any object that fills its lattice's box (ContactBox): here a box drawn as an
-// STL, 4 × 4 × 4 voxels of 1 cm, with a [[material]] table and its back face held by a
-// [[support]] plane. (An object that leaves voxels empty is refused by the same check,
-// BoxObjectProblem: ContactBox.AnObjectThatLeavesVoxelsEmptyIsRefusedSayingHowMany.)
-TEST(DaemonConfig, AGeometryThatFillsItsBoxIsTaken) {
+// hapticsimd's config check takes any object that fills its lattice's box (ContactBox): here a
+// box drawn as an STL, 4 × 4 × 4 voxels of 1 cm, with a [[material]] table and its back face held
+// by a [[support]] plane. (An object that leaves voxels empty is refused by the same check,
+// BoxObjectProblem: ContactBox.AnObjectThatLeavesVoxelsEmptyIsRefusedSayingHowMany; a daemon
+// serving such a block: HapticsimdDeformation.ABlockFromAFileIsServedOnItsOwnLattice.)
+TEST(DaemonConfig, AGeometryThatFillsItsBoxPassesTheCheck) {
   const std::string stl = ConfigTestPath() + ".box.stl";
   testing::WriteBoxStl(stl, 0.04);
   const std::string scene = ConfigTestPath() + ".scene.toml";

@@ -152,7 +152,7 @@ function primaryExtent(m, last) {
     for (let j = 0; j * k < last[a]; ++j) {
       if (j * k < boxHi && (j + 1) * k > boxLo) { first = Math.min(first, j * k); end = (j + 1) * k; }
     }
-    lo.push(first); hi.push(end);
+    lo.push(first); hi.push(Math.min(end, last[a]));  // a coarse cell past the object: clipped
   });
   return { lo, hi };
 }
