@@ -6,10 +6,12 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <thread>
@@ -76,13 +78,36 @@ std::optional<std::array<float, 3>> NodeDisplacement(const deformation_t& d,
   return std::array<float, 3>{row[0], row[1], row[2]};
 }
 
+// The config of a hapticsimd on the test's LCM bus, publishing the deformation at 60 Hz, serving
+// `scene_path` (none: the built-in cube).
+std::string WriteDaemonConfig(const std::string& dir, const std::string& control,
+                              const std::string& scene_path = "") {
+  const std::string config = dir + "/hapticsimd.toml";
+  std::ofstream out(config);
+  out << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
+      << "[control]\nsocket = \"" << control << "\"\n"
+      << "[deformation]\nrate_hz = 60\n";
+  if (!scene_path.empty()) out << "[scene]\nfile = \"" << scene_path << "\"\n";
+  return config;
+}
+
+// A device: one input a millisecond on absolute sleeps, `tip(seq)` for seq = 1 … count.
+void SendEveryMillisecond(testing::Client& client, std::int64_t count,
+                          const std::function<std::array<double, 3>(std::int64_t)>& tip) {
+  auto next = Clock::now();
+  for (std::int64_t seq = 1; seq <= count; ++seq) {
+    const std::array<double, 3> p = tip(seq);
+    client.Send(seq, p[0], p[1], p[2]);
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+  }
+}
+
 TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthAtTheTouchedNode) {
   const std::string dir = ::testing::TempDir() + "hapticsimd_deformation";
   std::filesystem::create_directories(dir);
-  const std::string config = dir + "/hapticsimd.toml", control = testing::PrivateSocketPath();
-  std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
-                        << "[control]\nsocket = \"" << control << "\"\n"
-                        << "[deformation]\nrate_hz = 60\n";
+  const std::string control = testing::PrivateSocketPath();
+  const std::string config = WriteDaemonConfig(dir, control);
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, dir + "/daemon.log");
   DeformationListener listener;
   testing::Client client;
@@ -97,13 +122,10 @@ TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthA
   constexpr int32_t kTouched = (6 * n + 6) * n + 0, kSupport = (0 * n + 0) * n + (n - 1),
                     kFrontCorner = 0;
   const auto press_start = Clock::now();
-  auto next = press_start;
-  for (std::int64_t seq = 1; seq <= 1600; ++seq) {
+  SendEveryMillisecond(client, 1600, [&](std::int64_t seq) {
     const double z = seq <= 300 ? -0.005 : kDepth * std::min(1.0, (seq - 300) / 500.0);
-    client.Send(seq, kEdge / 2, kEdge / 2, z);
-    next += std::chrono::milliseconds(1);
-    std::this_thread::sleep_until(next);
-  }
+    return std::array<double, 3>{kEdge / 2, kEdge / 2, z};
+  });
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const std::vector<DeformationListener::Received> frames = listener.Frames();
   daemon.Signal(SIGTERM);
@@ -203,11 +225,8 @@ TEST(HapticsimdDeformation, ABlockFromAFileIsServedOnItsOwnLattice) {
                             // the whole block and leave no secondary region)
                             << "[adaptivity]\nprimary_size = 2\nsecondary_lod = 1\n"
                             << "secondary_rate = 1000.0\n";
-  const std::string config = dir + "/hapticsimd.toml", control = testing::PrivateSocketPath();
-  std::ofstream(config) << "[lcm]\nurl = \"udpm://239.255.76.67:7667?ttl=0\"\n"
-                        << "[control]\nsocket = \"" << control << "\"\n"
-                        << "[scene]\nfile = \"" << scene_path << "\"\n"
-                        << "[deformation]\nrate_hz = 60\n";
+  const std::string control = testing::PrivateSocketPath();
+  const std::string config = WriteDaemonConfig(dir, control, scene_path);
   testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, dir + "/daemon.log");
   DeformationListener listener;
   testing::Client client;
@@ -216,14 +235,10 @@ TEST(HapticsimdDeformation, ABlockFromAFileIsServedOnItsOwnLattice) {
   // 3 mm in over 0.3 s, then held for 1 s.
   constexpr int n = 7;  // the largest node count: x
   constexpr double kDepth = 0.003;
-  const auto press_start = Clock::now();
-  auto next = press_start;
-  for (std::int64_t seq = 1; seq <= 1500; ++seq) {
+  SendEveryMillisecond(client, 1500, [&](std::int64_t seq) {
     const double z = seq <= 200 ? -0.003 : kDepth * std::min(1.0, (seq - 200) / 300.0);
-    client.Send(seq, 0.03, 0.02, z);
-    next += std::chrono::milliseconds(1);
-    std::this_thread::sleep_until(next);
-  }
+    return std::array<double, 3>{0.03, 0.02, z};
+  });
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const std::vector<DeformationListener::Received> frames = listener.Frames();
   const std::vector<force_feedback_t> forces = client.Forces();
