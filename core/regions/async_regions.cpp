@@ -5,8 +5,9 @@
 #include <cmath>
 #include <random>
 
-#include "core/regions/async_regions_region.hpp"
 #include "core/error.hpp"
+#include "core/regions/async_regions_region.hpp"
+#include "core/trial/proxy_contact.hpp"
 
 namespace hapticsim {
 namespace {
@@ -78,8 +79,9 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
     bands[a] =
         std::make_unique<ElementSetStiffness>(p.mesh(), p.materials(), p.outer_band_elements(a));
   }
-  const std::vector<RegionSchedule> schedules =
-      ScheduleRegions(p, scene, bands, coupling_ == Coupling::kDisplacement, substep_safety);
+  const double spring_omega2 = p.proxy_contact() ? SetUpProxy(scene.contact) : 0.0;
+  const std::vector<RegionSchedule> schedules = ScheduleRegions(
+      p, scene, bands, coupling_ == Coupling::kDisplacement, substep_safety, spring_omega2);
   std::vector<std::int64_t> rates;
   ticks_per_second_ = 1;
   for (const RegionSchedule& schedule : schedules) {
@@ -96,16 +98,7 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
     region->period_ticks = ticks_per_second_ / (rates[a] * schedules[a].substeps);
     // The schedule repeats once every region has completed whole nominal periods.
     common_period_ticks_ = std::lcm(common_period_ticks_, ticks_per_second_ / rates[a]);
-    const double period = 1.0 / region->schedule.rate_hz;
-    std::vector<int> prescribed;
-    if (a == kPrimaryRegion) prescribed.assign(p.contact_dofs().begin(), p.contact_dofs().end());
-    prescribed.insert(prescribed.end(), dofs.fixed.begin(), dofs.fixed.end());
-    region->outer_offset = prescribed.size();
-    prescribed.insert(prescribed.end(), dofs.outer_interface.begin(), dofs.outer_interface.end());
-    region->prescribed_values.assign(prescribed.size(), 0.0);
-    region->integrator = std::make_unique<RegionIntegrator>(
-        p.stiffness(a), p.dof_mass(), p.dof_damping(), dofs.owned, prescribed,
-        dofs.inner_interface, period / region->schedule.substeps);
+    BuildIntegrator(a, *region);
     // The outermost region's controller damps its inner Γ; a middle shell, with links on both
     // sides, and the primary (its last resort only), all their DOFs (ObserveInwardLink).
     if (a + 1 < count) region->integrator->SetControlledDofs(dofs.owned);
@@ -130,7 +123,6 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
       const Region& inner = *regions_[a - 1];
       region->inner = BoundaryChannel::ReadPair(inner.outward->width());
       region->inward_values.assign(dofs.inner_interface.size(), 0.0);
-      region->load_values.assign(dofs.inner_interface.size(), 0.0);
       region->band_u = Eigen::VectorXd::Zero(n);
       region->band_ku = Eigen::VectorXd::Zero(n);
     }
@@ -138,6 +130,46 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
   }
   BuildSurface();
   Reset();
+}
+
+// Region a's integrator: its owned DOFs; prescribed, the contact (the primary's, unless a proxy
+// pushes it), the supports and its outer Γ; loaded, its inner Γ (the primary: a proxy's face).
+void AsyncRegions::BuildIntegrator(RegionIndex a, Region& region) {
+  const RegionPartition& p = partition_;
+  const RegionDofs& dofs = p.dofs(a);
+  std::vector<int> prescribed;
+  std::vector<int> loaded = dofs.inner_interface;
+  if (a == kPrimaryRegion && p.proxy_contact()) {
+    loaded = proxy_loaded_dofs_;
+  } else if (a == kPrimaryRegion) {
+    prescribed.assign(p.contact_dofs().begin(), p.contact_dofs().end());
+  }
+  prescribed.insert(prescribed.end(), dofs.fixed.begin(), dofs.fixed.end());
+  region.outer_offset = prescribed.size();
+  prescribed.insert(prescribed.end(), dofs.outer_interface.begin(), dofs.outer_interface.end());
+  region.prescribed_values.assign(prescribed.size(), 0.0);
+  region.load_values.assign(loaded.size(), 0.0);
+  const double substep_s = 1.0 / region.schedule.rate_hz / region.schedule.substeps;
+  region.integrator =
+      std::make_unique<RegionIntegrator>(p.stiffness(a), p.dof_mass(), p.dof_damping(), dofs.owned,
+                                         prescribed, std::move(loaded), substep_s);
+}
+
+// A stroke's proxy pushes the primary's face nodes through its spring (RegionPartition::
+// proxy_contact): those are the primary's loaded DOFs. Returns the spring's k/m on the lightest of
+// them, 1/s², which counts in the primary's own limit.
+double AsyncRegions::SetUpProxy(const ContactSettings& contact) {
+  const RegionPartition& p = partition_;
+  const ProxyContact proxy(p.PrimaryProxySurface(), p.contact_node(), p.contact_normal(), contact);
+  proxy_loaded_dofs_ = proxy.loaded_dofs();
+  proxy_stiffness_n_per_m_ = contact.stiffness_n_per_m;
+  const auto at =
+      std::find(proxy_loaded_dofs_.begin(), proxy_loaded_dofs_.end(), p.contact_dofs()[0]);
+  HAPTICSIM_THROW_UNLESS(at != proxy_loaded_dofs_.end(),
+                         "internal: the proxy cannot push the contact node it starts on");
+  proxy_contact_slot_ = static_cast<int>(at - proxy_loaded_dofs_.begin());
+  proxy_spring_loads_.assign(proxy_loaded_dofs_.size(), 0.0);
+  return proxy_stiffness_n_per_m_ / proxy.lightest_loaded_mass_kg();
 }
 
 void AsyncRegions::PublishInward(RegionIndex a) noexcept {
@@ -221,7 +253,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   const auto& inner_gamma = region.dofs->inner_interface;
   bool followed = true;  // this step's outer Γ is the outer region's own at the step's end
 
-  if (contact_next != nullptr) {
+  if (contact_next != nullptr && !partition_.proxy_contact()) {
     for (int c = 0; c < 3; ++c) region.prescribed_values[c] = (*contact_next)[c];
   }
   // A failed read (a writer racing ahead) keeps the previous snapshots: still a consistent pair.
@@ -276,7 +308,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
     ControlInterfaces(a, &asked_inward, &asked_outward, &limits);
   integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward,
                   limits);
-  if (reaction != nullptr) {
+  if (reaction != nullptr && !partition_.proxy_contact()) {
     for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
   }
   AccountStep(a, asked_inward, asked_outward);
@@ -293,6 +325,18 @@ std::array<double, 3> AsyncRegions::StepPrimary(
   std::array<double, 3> reaction{};
   StepRegionAt(kPrimaryRegion, &contact_next, &reaction);
   return reaction;
+}
+
+void AsyncRegions::StepPrimaryLoaded(std::span<const double> loads) noexcept {
+  std::vector<double>& values = regions_[kPrimaryRegion]->load_values;
+  const std::size_t count = std::min(values.size(), loads.size());
+  std::copy_n(loads.begin(), count, values.begin());
+  std::fill(values.begin() + static_cast<std::ptrdiff_t>(count), values.end(), 0.0);
+  StepRegionAt(kPrimaryRegion, nullptr, nullptr);
+}
+
+const Eigen::VectorXd& AsyncRegions::primary_state() const noexcept {
+  return regions_[kPrimaryRegion]->integrator->u();
 }
 
 std::array<double, 3> AsyncRegions::primary_contact_m() const noexcept {
@@ -342,7 +386,18 @@ void AsyncRegions::AdvancePrimaryTo(std::int64_t ticks) noexcept {
   Region& primary = *regions_[kPrimaryRegion];
   while (primary.state_ticks < ticks) {
     AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
-    StepPrimary(held);
+    if (partition_.proxy_contact()) {
+      // A stroke's proxy at rest on its start node, the tool held there: the spring pulls the
+      // contact node back to rest, −k·u, as the linearised contact does in every period.
+      const std::array<double, 3> u = primary_contact_m();
+      for (int c = 0; c < 3; ++c) {
+        proxy_spring_loads_[static_cast<std::size_t>(proxy_contact_slot_ + c)] =
+            -proxy_stiffness_n_per_m_ * u[c];
+      }
+      StepPrimaryLoaded(proxy_spring_loads_);
+    } else {
+      StepPrimary(held);
+    }
   }
 }
 

@@ -5,16 +5,17 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
-#include "core/regions/boundary_channel.hpp"
-#include "core/scene/contact_trajectory.hpp"
 #include "core/fem/object_state.hpp"
-#include "core/trial/reference_trial.hpp"
 #include "core/fem/region_integrator.hpp"
+#include "core/fem/stability_estimate.hpp"
+#include "core/regions/boundary_channel.hpp"
 #include "core/regions/region_partition.hpp"
 #include "core/regions/region_schedule.hpp"
-#include "core/fem/stability_estimate.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/trial/reference_trial.hpp"
 
 namespace hapticsim {
 
@@ -222,6 +223,18 @@ class AsyncRegions {
    */
   std::array<double, 3> StepPrimary(const std::array<double, 3>& contact_next) noexcept;
   /**
+   * Primary thread, when the tool touches through a stroke's proxy (RegionPartition::
+   * proxy_contact; StepPrimary does not drive the contact then): one primary step with `loads`
+   * on proxy_loaded_dofs(), in that order (ProxyContact::Update writes them), N.
+   */
+  void StepPrimaryLoaded(std::span<const double> loads) noexcept;
+  /** The primary's DOFs a stroke's proxy may push (ProxyContact::loaded_dofs on
+   *  RegionPartition::PrimaryProxySurface); empty for a driven contact. */
+  const std::vector<int>& proxy_loaded_dofs() const { return proxy_loaded_dofs_; }
+  /** The primary's state vector (its owned DOFs current), in the mesh's DOF order: what a proxy
+   *  reads the surface from. Primary thread. */
+  const Eigen::VectorXd& primary_state() const noexcept;
+  /**
    * Where the contact is in the primary's current state (the last step's contact_next; zero
    * after Reset), m: where a period's substeps start from. Primary thread.
    */
@@ -394,6 +407,8 @@ class AsyncRegions {
 
  private:
   struct Region;
+  double SetUpProxy(const ContactSettings& contact);
+  void BuildIntegrator(RegionIndex region, Region& state);
   void PublishInitialSnapshots();
   /** Reset, then every region's copy of the state set to displacements `u` and velocities `v`
    *  (u⁻ = u − v·h with its own substep h), the boundaries published from it. */
@@ -460,6 +475,13 @@ class AsyncRegions {
     std::vector<SurfaceTerm> terms;
   } surface_;
   std::atomic<std::uint64_t> surface_request_{0};
+
+  // A stroke's proxy (RegionPartition::proxy_contact): the primary's loaded DOFs, the spring,
+  // and for the stability estimate, the contact node's slot among them and a scratch load.
+  std::vector<int> proxy_loaded_dofs_;
+  double proxy_stiffness_n_per_m_ = 0;
+  int proxy_contact_slot_ = 0;
+  std::vector<double> proxy_spring_loads_;
 };
 
 /**

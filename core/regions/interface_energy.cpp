@@ -167,7 +167,9 @@ void AsyncRegions::AccountStep(RegionIndex a, double asked_inward, double asked_
   const double asked = asked_inward + asked_outward;
   const double taken = integrator.ControlledDissipated();
   const double taken_inward = asked > 0 ? taken * asked_inward / asked : 0.0;
-  if (a == kPrimaryRegion) {
+  if (a == kPrimaryRegion && partition_.proxy_contact()) {
+    region.input_work += integrator.LoadWork();  // the proxy's spring
+  } else if (a == kPrimaryRegion) {
     for (int c = 0; c < 3; ++c) region.input_work += integrator.PrescribedWork(c);
   }
   if (a > 0) {

@@ -138,7 +138,8 @@ void RegionPartition::AssignDofs(const std::vector<std::array<int, 3>>& supports
           dofs_[region].fixed.push_back(dof);
         continue;
       }
-      if (std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end())
+      if (!proxy_contact() &&
+          std::find(contact_dofs_.begin(), contact_dofs_.end(), dof) != contact_dofs_.end())
         continue;
       dofs_[outermost].owned.push_back(dof);
       if (outermost != innermost) {
@@ -166,6 +167,41 @@ void RegionPartition::FindBands(const std::vector<std::vector<int>>& elements) {
       if (touches) band_[region].push_back(e);
     }
   }
+}
+
+ProxySurface RegionPartition::PrimaryProxySurface() const {
+  const HybridMesh& mesh = *mesh_;
+  ProxySurface surface;
+  surface.lattice_nodes = mesh.options().lattice_nodes;
+  surface.spacing_m = mesh.options().spacing_m;
+  const std::array<int, 3>& n = surface.lattice_nodes;
+  const auto cells = static_cast<std::size_t>((n[0] - 1) * (n[1] - 1) * (n[2] - 1));
+  const std::vector<std::int16_t>& material = mesh.options().cell_material;
+  surface.occupied.assign(cells, 1);
+  for (std::size_t e = 0; e < material.size(); ++e) surface.occupied[e] = material[e] >= 0 ? 1 : 0;
+  const auto nodes = static_cast<std::size_t>(surface.num_nodes());
+  surface.dof.assign(nodes, -1);
+  surface.loadable.assign(nodes, -1);
+  surface.mass_kg.assign(nodes, 0.0);
+  surface.component_stride = mesh.num_independent();
+  for (int iz = 0; iz < n[2]; ++iz) {
+    for (int iy = 0; iy < n[1]; ++iy) {
+      for (int ix = 0; ix < n[0]; ++ix) {
+        const int r = mesh.IndependentAt(ix, iy, iz);
+        if (r < 0 || !(dof_mass_[mesh.Dof(r, 0)] > 0)) continue;
+        const auto node = static_cast<std::size_t>(surface.Node({ix, iy, iz}));
+        const int dof = mesh.Dof(r, 0);
+        surface.dof[node] = dof;
+        surface.mass_kg[node] = dof_mass_[dof];
+        if (std::binary_search(fixed_dofs_.begin(), fixed_dofs_.end(), dof)) {
+          surface.loadable[node] = 0;
+        } else if (mesh.region_mask()[r] == 1u) {  // the primary's alone: not on Γ
+          surface.loadable[node] = 1;
+        }
+      }
+    }
+  }
+  return surface;
 }
 
 int RegionPartition::num_elements(RegionIndex region) const {

@@ -8,6 +8,7 @@
 #include "core/regions/element_set_stiffness.hpp"
 #include "core/regions/hybrid_mesh.hpp"
 #include "core/scene/scene.hpp"
+#include "core/trial/proxy_contact.hpp"
 
 namespace hapticsim {
 
@@ -62,7 +63,18 @@ class RegionPartition {
   /** Elements of `region` that touch its outer interface (the band whose forces cross it). */
   const std::vector<int>& outer_band_elements(RegionIndex region) const { return band_[region]; }
 
-  /** The contact node's x, y, z DOFs (in the primary region). */
+  /**
+   * Whether the tool touches through a sliding proxy (input.waveform = "stroke"): then the
+   * contact node is free, one of the primary's owned nodes, and the proxy pushes the primary's
+   * nodes on the contact's face (primary_proxy_surface) instead of a node being driven.
+   */
+  bool proxy_contact() const { return scene_.input.waveform == Waveform::kStroke; }
+  /** The surface as the primary region's proxy touches it: the primary's own nodes (not Γ, not
+   *  held) pushable, held nodes taking their share, every other node out of its reach. In the
+   *  primary's state vector. Allocates. */
+  ProxySurface PrimaryProxySurface() const;
+
+  /** The contact node's x, y, z DOFs (in the primary region; prescribed unless proxy_contact). */
   const std::array<int, 3>& contact_dofs() const { return contact_dofs_; }
   /** The contact node's lattice indices and its unit inward normal (SceneObject). */
   const LatticeIndex& contact_node() const { return contact_lattice_; }

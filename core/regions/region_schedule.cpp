@@ -43,7 +43,7 @@ class RegionWithInnerBand final : public StiffnessOperator {
 std::vector<RegionSchedule> ScheduleRegions(
     const RegionPartition& p, const Scene& scene,
     const std::vector<std::unique_ptr<ElementSetStiffness>>& bands, bool displacement_coupling,
-    double substep_safety) {
+    double substep_safety, double primary_spring_omega2_per_s2) {
   const int n = p.mesh().num_dofs();
   const int count = p.num_regions();
   std::vector<RegionSchedule> schedules(static_cast<size_t>(count));
@@ -73,6 +73,16 @@ std::vector<RegionSchedule> ScheduleRegions(
                                          p.dof_mass(), owned, options);
     } else {
       schedule.alone = EstimateStability(p.stiffness(a), p.dof_mass(), owned);
+    }
+    if (a == kPrimaryRegion && primary_spring_omega2_per_s2 > 0) {
+      const double omega = schedule.alone.omega_max_rad_s;
+      schedule.alone.omega_max_rad_s = std::sqrt(omega * omega + primary_spring_omega2_per_s2);
+      schedule.alone.critical_dt_s = 2.0 / schedule.alone.omega_max_rad_s;
+      if (schedule.alone.element_bound_dt_s > 0) {
+        const double omega_e = 2.0 / schedule.alone.element_bound_dt_s;
+        schedule.alone.element_bound_dt_s =
+            2.0 / std::sqrt(omega_e * omega_e + primary_spring_omega2_per_s2);
+      }
     }
     schedule.substeps =
         std::max(1, static_cast<int>(std::ceil(1.0 / schedule.rate_hz /

@@ -26,10 +26,14 @@ struct RegionSchedule {
  * bands[a]: region a's elements next to its outer Γ (none for the outermost). With the
  * displacement exchange a region evaluates its inner neighbour's band on its own Γ within its
  * step, so that band's stiffness counts in its own limit.
+ *
+ * primary_spring_omega2_per_s2: k/m of a contact spring on the primary's lightest loaded node
+ * (a stroke's proxy, 1/s²; 0 for a driven contact node). It adds at most that to the primary's
+ * ω² (positive semi-definite, of norm ≤ k/m), so the primary's limit is 2 / √(ω² + k/m).
  */
 std::vector<RegionSchedule> ScheduleRegions(
     const RegionPartition& partition, const Scene& scene,
     const std::vector<std::unique_ptr<ElementSetStiffness>>& bands, bool displacement_coupling,
-    double substep_safety);
+    double substep_safety, double primary_spring_omega2_per_s2 = 0);
 
 }  // namespace hapticsim

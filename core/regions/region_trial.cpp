@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/regions/async_regions.hpp"
 #include "core/regions/async_regions_region.hpp"
 #include "core/scene/contact_trajectory.hpp"
@@ -30,6 +31,8 @@ TrialResult AsyncRegions::RunTrial(const TrialFrames& frames) {
 
 TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
                                                    const TrialFrames& frames) {
+  HAPTICSIM_THROW_UNLESS(!partition_.proxy_contact(),
+                         "a stroke on the regions runs through RunRegionStroke");
   TrialResult result;
   result.stability = regions_[kPrimaryRegion]->schedule.alone;
   const ContactTrajectory trajectory(input, partition_.contact_normal());

@@ -8,10 +8,42 @@
 
 namespace hapticsim {
 
+ProxySurface ProxySurfaceOf(const ElasticModel& model) {
+  const HexGrid& grid = model.grid();
+  ProxySurface surface;
+  surface.lattice_nodes = {grid.nx(), grid.ny(), grid.nz()};
+  surface.spacing_m = grid.spacing();
+  const MaterialField& field = model.field();
+  surface.occupied.resize(static_cast<std::size_t>(field.num_elements()));
+  for (int e = 0; e < field.num_elements(); ++e) surface.occupied[e] = field.occupied(e) ? 1 : 0;
+  std::vector<bool> held(static_cast<std::size_t>(grid.num_dofs()), false);
+  for (int dof : model.constraints().fixed_dofs) held[static_cast<std::size_t>(dof)] = true;
+  const auto nodes = static_cast<std::size_t>(grid.num_nodes());
+  surface.dof.assign(nodes, -1);
+  surface.loadable.assign(nodes, -1);
+  surface.mass_kg.assign(nodes, 0.0);
+  surface.component_stride = grid.num_nodes();
+  for (int node = 0; node < grid.num_nodes(); ++node) {
+    const int dof = grid.Dof(node, 0);
+    const double mass = model.dof_mass()[dof];
+    if (mass <= 0) continue;  // not the object's
+    surface.dof[node] = dof;
+    surface.mass_kg[node] = mass;
+    surface.loadable[node] = held[static_cast<std::size_t>(dof)] ? 0 : 1;
+  }
+  return surface;
+}
+
 ProxyContact::ProxyContact(const ElasticModel& model, int contact_node,
                            const std::array<double, 3>& inward_normal,
                            const ContactSettings& contact)
-    : model_(model), contact_(contact) {
+    : ProxyContact(ProxySurfaceOf(model), model.grid().NodeIndices(contact_node), inward_normal,
+                   contact) {}
+
+ProxyContact::ProxyContact(ProxySurface surface, const LatticeIndex& contact_node,
+                           const std::array<double, 3>& inward_normal,
+                           const ContactSettings& contact)
+    : contact_(contact) {
   axis_ = -1;
   for (int c = 0; c < 3; ++c) {
     if (std::abs(inward_normal[c]) == 1.0) {
@@ -24,31 +56,36 @@ ProxyContact::ProxyContact(const ElasticModel& model, int contact_node,
                          "inward normal is along x, y or z (not on an edge or a corner)");
   t1_ = (axis_ + 1) % 3;
   t2_ = (axis_ + 2) % 3;
-  const HexGrid& grid = model.grid();
-  const std::array<int, 3> at = grid.NodeIndices(contact_node);
-  plane_ = at[axis_];
-  proxy_ = {static_cast<double>(at[t1_]), static_cast<double>(at[t2_])};
-  start_m_ = grid.NodePosition(contact_node);
-  // Every node of the face's plane on the object and not held may be loaded.
-  slot_of_node_.assign(static_cast<std::size_t>(grid.num_nodes()), -1);
+  plane_ = contact_node[axis_];
+  proxy_ = {static_cast<double>(contact_node[t1_]), static_cast<double>(contact_node[t2_])};
+  for (int c = 0; c < 3; ++c) start_m_[c] = contact_node[c] * surface.spacing_m;
+  Rebind(std::move(surface));
+}
+
+void ProxyContact::Rebind(ProxySurface surface) {
+  HAPTICSIM_THROW_UNLESS(
+      surface_.num_nodes() == 0 || surface.lattice_nodes == surface_.lattice_nodes,
+      "internal: a proxy moved onto another lattice");
+  surface_ = std::move(surface);
+  // Every node of the face's plane the surface lets the proxy push may be loaded.
+  loaded_dofs_.clear();
+  slot_of_node_.assign(static_cast<std::size_t>(surface_.num_nodes()), -1);
   lightest_mass_kg_ = std::numeric_limits<double>::infinity();
-  std::vector<bool> held(static_cast<std::size_t>(grid.num_dofs()), false);
-  for (int dof : model.constraints().fixed_dofs) held[static_cast<std::size_t>(dof)] = true;
-  for (int node = 0; node < grid.num_nodes(); ++node) {
-    const double mass = model.dof_mass()[grid.Dof(node, 0)];
-    if (grid.NodeIndices(node)[axis_] != plane_ || mass <= 0 ||
-        held[static_cast<std::size_t>(grid.Dof(node, 0))]) {
-      continue;
-    }
+  const int stride = surface_.component_stride;
+  for (int node = 0; node < surface_.num_nodes(); ++node) {
+    const std::array<int, 3>& n = surface_.lattice_nodes;
+    const std::array<int, 3> at = {node % n[0], node / n[0] % n[1], node / (n[0] * n[1])};
+    const int along = at[axis_];
+    if (along != plane_ || surface_.loadable[static_cast<std::size_t>(node)] != 1) continue;
     slot_of_node_[static_cast<std::size_t>(node)] = static_cast<int>(loaded_dofs_.size() / 3);
-    for (int c = 0; c < 3; ++c) loaded_dofs_.push_back(grid.Dof(node, c));
-    lightest_mass_kg_ = std::min(lightest_mass_kg_, mass);
+    for (int c = 0; c < 3; ++c) loaded_dofs_.push_back(surface_.dof[node] + c * stride);
+    lightest_mass_kg_ = std::min(lightest_mass_kg_, surface_.mass_kg[node]);
   }
 }
 
 bool ProxyContact::ExposedFace(int i1, int i2) const {
-  const HexGrid& grid = model_.grid();
-  const std::array<int, 3> counts = {grid.nx() - 1, grid.ny() - 1, grid.nz() - 1};
+  const std::array<int, 3>& n = surface_.lattice_nodes;
+  const std::array<int, 3> counts = {n[0] - 1, n[1] - 1, n[2] - 1};
   if (i1 < 0 || i2 < 0 || i1 >= counts[t1_] || i2 >= counts[t2_]) return false;
   // The voxel inside the face must be the object's, the one outside it not.
   auto occupied = [&](int along) {
@@ -57,7 +94,9 @@ bool ProxyContact::ExposedFace(int i1, int i2) const {
     e[axis_] = along;
     e[t1_] = i1;
     e[t2_] = i2;
-    return model_.field().occupied(model_.field().Element(e[0], e[1], e[2]));
+    return surface_
+               .occupied[static_cast<std::size_t>(e[0] + counts[0] * (e[1] + counts[1] * e[2]))] !=
+           0;
   };
   const int inside = sign_ > 0 ? plane_ : plane_ - 1;
   const int outside = sign_ > 0 ? plane_ - 1 : plane_;
@@ -65,8 +104,8 @@ bool ProxyContact::ExposedFace(int i1, int i2) const {
 }
 
 bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corners) const {
-  const HexGrid& grid = model_.grid();
-  const std::array<int, 3> counts = {grid.nx() - 1, grid.ny() - 1, grid.nz() - 1};
+  const std::array<int, 3>& n = surface_.lattice_nodes;
+  const std::array<int, 3> counts = {n[0] - 1, n[1] - 1, n[2] - 1};
   // A proxy exactly on the lattice's last node line belongs to the cell below it.
   const auto cell = [](double at, int count) {
     const int i = static_cast<int>(std::floor(at));
@@ -80,31 +119,48 @@ bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corner
     at[axis_] = plane_;
     at[t1_] = i1 + (k & 1);
     at[t2_] = i2 + (k >> 1);
-    corners->nodes[static_cast<std::size_t>(k)] = grid.Node(at[0], at[1], at[2]);
+    corners->nodes[static_cast<std::size_t>(k)] = surface_.Node(at);
     corners->weights[static_cast<std::size_t>(k)] = ((k & 1) ? a : 1 - a) * ((k >> 1) ? b : 1 - b);
+  }
+  return true;
+}
+
+bool ProxyContact::Reachable(const Corners& corners) const {
+  for (int node : corners.nodes) {
+    if (surface_.loadable[static_cast<std::size_t>(node)] < 0) return false;
   }
   return true;
 }
 
 std::array<double, 3> ProxyContact::SurfacePoint(const Corners& corners,
                                                  const Eigen::VectorXd& u) const {
-  const HexGrid& grid = model_.grid();
   std::array<double, 3> point = proxy_rest_m();
   for (int k = 0; k < 4; ++k) {
-    const int node = corners.nodes[static_cast<std::size_t>(k)];
+    const int dof =
+        surface_.dof[static_cast<std::size_t>(corners.nodes[static_cast<std::size_t>(k)])];
     const double w = corners.weights[static_cast<std::size_t>(k)];
-    for (int c = 0; c < 3; ++c) point[c] += w * u[grid.Dof(node, c)];
+    for (int c = 0; c < 3; ++c) point[c] += w * u[dof + c * surface_.component_stride];
   }
   return point;
 }
 
 std::array<double, 3> ProxyContact::proxy_rest_m() const {
-  const double h = model_.grid().spacing();
+  const double h = surface_.spacing_m;
   std::array<double, 3> rest{};
   rest[axis_] = plane_ * h;
   rest[t1_] = proxy_[0] * h;
   rest[t2_] = proxy_[1] * h;
   return rest;
+}
+
+LatticeIndex ProxyContact::NearestNode() const {
+  LatticeIndex at{};
+  at[axis_] = plane_;
+  at[t1_] =
+      std::clamp(static_cast<int>(std::lround(proxy_[0])), 0, surface_.lattice_nodes[t1_] - 1);
+  at[t2_] =
+      std::clamp(static_cast<int>(std::lround(proxy_[1])), 0, surface_.lattice_nodes[t2_] - 1);
+  return at;
 }
 
 ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
@@ -117,9 +173,13 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     return std::array<double, 3>{tool_m[0] - s[0], tool_m[1] - s[1], tool_m[2] - s[2]};
   };
   // Over no face of the object, the tool has left the surface this contact can render.
-  const double h = model_.grid().spacing();
+  const double h = surface_.spacing_m;
   if (!CornersAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !CornersAt(proxy_, &corners)) {
     result.left_surface = true;
+    return result;
+  }
+  if (!Reachable(corners)) {
+    result.left_region = true;
     return result;
   }
   std::array<double, 3> d = offset_to_tool();
@@ -140,6 +200,10 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     proxy_[1] += move * d[t2_] / h;
     if (!CornersAt(proxy_, &corners)) {
       result.left_surface = true;
+      return result;
+    }
+    if (!Reachable(corners)) {
+      result.left_region = true;
       return result;
     }
     d = offset_to_tool();

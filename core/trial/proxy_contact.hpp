@@ -11,6 +11,31 @@
 namespace hapticsim {
 
 /**
+ * The object as a proxy touches it: its fine lattice, the cells it fills, and for each lattice
+ * node where its displacement is in the state vector the proxy reads and whether the proxy may
+ * push it. Nodes and cells are numbered x fastest (HexGrid::Node, MaterialField::Element).
+ */
+struct ProxySurface {
+  std::array<int, 3> lattice_nodes{};
+  double spacing_m = 0;
+  std::vector<char> occupied;  ///< per lattice cell: the object fills it
+  std::vector<int> dof;        ///< per lattice node: its x DOF in the state vector, −1 if none
+  int component_stride = 0;    ///< its y and z DOFs: dof + stride, dof + 2·stride
+  /// Per lattice node: 1 the proxy may push it; 0 a support holds it (the support takes the
+  /// proxy's share); −1 neither: it is not the object's, or another region steps it.
+  std::vector<signed char> loadable;
+  std::vector<double> mass_kg;  ///< per lattice node, its lumped mass (0 off the object)
+
+  int num_nodes() const { return lattice_nodes[0] * lattice_nodes[1] * lattice_nodes[2]; }
+  int Node(const std::array<int, 3>& at) const {
+    return at[0] + lattice_nodes[0] * (at[1] + lattice_nodes[1] * at[2]);
+  }
+};
+
+/** The full-resolution object's surface: every node on it, every free one pushable. */
+ProxySurface ProxySurfaceOf(const ElasticModel& model);
+
+/**
  * A sliding tool contact (god-object) on one flat face of the object: a proxy point stays on the
  * deformed surface, joined to the tool tip by a spring of contact.stiffness k. Where the tool is
  * inside, the spring pushes the surface at the proxy (spread over the face cell's 4 nodes with
@@ -29,15 +54,26 @@ namespace hapticsim {
 class ProxyContact {
  public:
   /**
-   * @param contact_node   where the proxy starts (a node on the face)
+   * @param contact_node   where the proxy starts (a lattice node on the face)
    * @param inward_normal  ±e_axis: the face's inward normal
    * @throws Error when the normal is not along a lattice axis.
    */
+  ProxyContact(ProxySurface surface, const LatticeIndex& contact_node,
+               const std::array<double, 3>& inward_normal, const ContactSettings& contact);
+  /** On the full-resolution object (ProxySurfaceOf), from its grid node `contact_node`. */
   ProxyContact(const ElasticModel& model, int contact_node,
                const std::array<double, 3>& inward_normal, const ContactSettings& contact);
 
+  /**
+   * The same proxy (where it is on the face, whether it slides) over another state vector: the
+   * object's regions moved (the primary re-centred under the proxy). The lattice must be the
+   * same. Allocates.
+   * @throws Error for a surface of another lattice.
+   */
+  void Rebind(ProxySurface surface);
+
   /** The DOFs the contact loads, in the order Update() writes loads: x, y, z of each node of the
-   *  face that is on the object and not held. */
+   *  face the proxy may push (ProxySurface::loadable). */
   const std::vector<int>& loaded_dofs() const { return loaded_dofs_; }
   /** The lightest of those nodes' masses, kg: the spring's share of the step limit. */
   double lightest_loaded_mass_kg() const { return lightest_mass_kg_; }
@@ -49,6 +85,9 @@ class ProxyContact {
     bool in_contact = false;
     bool sliding = false;       ///< the proxy slid this period
     bool left_surface = false;  ///< the proxy reached the face's edge: no surface under it
+    /// The proxy's face cell has a node this surface can neither push nor leave to a support
+    /// (another region steps it): nothing was loaded. The regions must move under the proxy.
+    bool left_region = false;
   };
   /** One period: the proxy moved for the tool at `tool_m` (grid frame, m) over the state `u`,
    *  and the loads on loaded_dofs() written to `loads`. */
@@ -56,6 +95,8 @@ class ProxyContact {
                 std::span<double> loads);
   /** The proxy's rest position on the face, m (grid frame). */
   std::array<double, 3> proxy_rest_m() const;
+  /** The lattice node of the face nearest the proxy. */
+  LatticeIndex NearestNode() const;
 
  private:
   struct Corners {
@@ -67,8 +108,10 @@ class ProxyContact {
   // The deformed surface point at the proxy.
   std::array<double, 3> SurfacePoint(const Corners& corners, const Eigen::VectorXd& u) const;
   bool ExposedFace(int i1, int i2) const;
+  // Whether every corner is pushable or held (ProxySurface::loadable ≥ 0).
+  bool Reachable(const Corners& corners) const;
 
-  const ElasticModel& model_;
+  ProxySurface surface_;
   ContactSettings contact_;
   int axis_ = 2, sign_ = 1, plane_ = 0, t1_ = 0, t2_ = 1;
   std::array<double, 3> start_m_{};
