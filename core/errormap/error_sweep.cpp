@@ -209,6 +209,10 @@ std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
 ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
                   SweepStats* stats_out) {
   ValidateGrid(grid);
+  HAPTICSIM_THROW_UNLESS(base.input.waveform != Waveform::kStroke,
+                         "input.waveform = \"stroke\": an error map is swept over presses and "
+                         "sines; set input.waveform = \"press\" (or \"sine\") for the sweep, and "
+                         "compare a stroke with `hapticsim simulate`");
   HAPTICSIM_THROW_UNLESS(options.shard_count >= 1 && options.shard_index >= 0 &&
                              options.shard_index < options.shard_count,
                          "--shard I/N needs 1 ≤ I ≤ N");

@@ -87,9 +87,13 @@ void ValidateGeometryScene(const Scene& scene) {
 }
 
 void ValidateStroke(const Scene& scene) {
-  if (scene.adaptivity.enabled()) {
-    throw Error("input.waveform = \"stroke\" is not available with the asynchronous regions yet: "
-                "set adaptivity.primary_size = 0 for the full-resolution reference");
+  // The proxy's face cell lies within one node of the primary's centre (it follows the proxy):
+  // a primary of two nodes each way keeps the cell off its interface.
+  if (scene.adaptivity.enabled() && scene.adaptivity.primary_size < 2) {
+    throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
+                " is too small for a stroke: the primary region follows the proxy and must reach "
+                "two nodes from it; set adaptivity.primary_size >= 2 (or 0 for the "
+                "full-resolution reference)");
   }
   if (scene.contact.kinetic_friction > scene.contact.static_friction) {
     throw Error("contact.kinetic_friction = " + FormatReal(scene.contact.kinetic_friction) +

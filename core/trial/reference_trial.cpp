@@ -44,6 +44,8 @@ std::string_view TrialOutcomeName(TrialOutcome outcome) {
       return "diverged: energy growth";
     case TrialOutcome::kLeftSurface:
       return "stopped: the stroke left the face it slides on";
+    case TrialOutcome::kDivergedContact:
+      return "diverged: the proxy slid out of the primary region within one period";
   }
   return "unknown";
 }

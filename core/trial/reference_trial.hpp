@@ -18,6 +18,9 @@ enum class TrialOutcome {
   kDivergedNonFinite,  ///< detected during the run: a non-finite value
   kDivergedEnergy,     ///< detected during the run: energy beyond the passivity budget
   kLeftSurface,        ///< a stroke's proxy reached the edge of the face it slides on
+  /// detected during a stroke on the regions: the proxy slid out of the primary region within
+  /// one period, farther than any tool moves in a millisecond (the contact diverging)
+  kDivergedContact,
 };
 
 std::string_view TrialOutcomeName(TrialOutcome outcome);
@@ -43,7 +46,8 @@ struct TrialResult {
   double wall_time_s = 0;            ///< compute time of the stepping loop, s
 
   bool diverged() const {
-    return outcome == TrialOutcome::kDivergedNonFinite || outcome == TrialOutcome::kDivergedEnergy;
+    return outcome == TrialOutcome::kDivergedNonFinite ||
+           outcome == TrialOutcome::kDivergedEnergy || outcome == TrialOutcome::kDivergedContact;
   }
 };
 

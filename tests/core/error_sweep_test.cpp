@@ -60,6 +60,19 @@ TEST(ErrorSweep, EverySampleIsComputedAndTheResultDoesNotDependOnTheJobCount) {
   }
 }
 
+TEST(ErrorSweep, AStrokeSceneIsRefusedSayingWhatToSweep) {
+  Scene stroke = SmallScene();
+  stroke.input.waveform = Waveform::kStroke;
+  SweepStats stats;
+  try {
+    RunSweep(stroke, SmallGrid(), {}, &stats);
+    FAIL() << "a stroke scene was swept";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("set input.waveform = \"press\""), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ErrorSweep, EqualRatesAtFullResolutionReproduceTheReference) {
   SweepGrid grid = SmallGrid();
   grid.axes[6] = {1};

@@ -135,9 +135,12 @@ TEST(StrokeTrial, AStrokeIntoTheFaceIsRefusedSayingWhichWaysItCanGo) {
 TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
   Scene scene = Stroke(0.3, 0.4);
   EXPECT_THROW(ValidateScene(scene), Error);
+  // On the regions, the primary must reach two nodes from the proxy it follows.
   scene = Stroke(0.5, 0.4);
-  scene.adaptivity.primary_size = 3;
+  scene.adaptivity.primary_size = 1;
   EXPECT_THROW(ValidateScene(scene), Error);
+  scene.adaptivity.primary_size = 2;
+  EXPECT_NO_THROW(ValidateScene(scene));
 }
 
 }  // namespace

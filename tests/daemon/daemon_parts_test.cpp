@@ -221,6 +221,15 @@ TEST(DaemonConfig, AGeometryThatFillsItsBoxPassesTheCheck) {
   EXPECT_NE(error.find("needs [[support]] tables"), std::string::npos) << error;
 }
 
+// A stroke's sliding proxy runs offline only (RunRegionStroke): a daemon scene asking for one is
+// refused, not served as a press.
+TEST(DaemonConfig, AStrokeSceneIsRefusedSayingTheProxyIsNotServed) {
+  const std::string scene = ConfigTestPath() + ".stroke.toml";
+  std::ofstream(scene) << "[input]\nwaveform = \"stroke\"\n[adaptivity]\nprimary_size = 3\n";
+  const std::string error = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
+  EXPECT_NE(error.find("sliding proxy is not served yet"), std::string::npos) << error;
+}
+
 TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {
   const std::string scene_path = ::testing::TempDir() + "hapticsimd_outer_rate_scene.toml";
   std::ofstream(scene_path) << "[adaptivity]\nprimary_size = 2\nsecondary_lod = 2\n"

@@ -6,10 +6,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "core/regions/async_regions.hpp"
 #include "core/error.hpp"
-#include "core/trial/force_error.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/regions/realtime_schedule.hpp"
+#include "core/regions/region_stroke_trial.hpp"
+#include "core/trial/force_error.hpp"
 #include "core/trial/reference_trial.hpp"
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
@@ -91,6 +92,7 @@ struct AdaptiveReport {
   EnergyAccount energy;      // the run's energy balance (AsyncRegions::Energies)
   std::vector<std::optional<DeadlineStats>> deadlines;  // per region, with --threads
   std::optional<ForceError> threaded_vs_virtual;
+  std::optional<std::size_t> stroke_moves;  // a stroke: how often the primary followed the proxy
 };
 
 nlohmann::json DeadlineJson(const DeadlineStats& d) {
@@ -108,6 +110,21 @@ nlohmann::json ErrorJson(const ForceError& e) {
           {"max_magnitude_percent", e.max_magnitude_percent},
           {"max_direction_deg", e.max_direction_deg},
           {"direction_threshold_fraction_of_peak", ForceError::kDirectionThreshold}};
+}
+
+// Each region's size, schedule and cost per simulated millisecond (`compute_s` over
+// `simulated_s`, > 0).
+void ReportRegions(const AsyncRegions& regions, const std::vector<double>& compute_s,
+                   double simulated_s, AdaptiveReport* report) {
+  const double simulated_ms = simulated_s * 1e3;
+  const auto& p = regions.partition();
+  report->deadlines.resize(static_cast<size_t>(regions.num_regions()));
+  for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
+    report->regions.push_back({p.RegionName(r), p.num_nodes(r), p.num_elements(r),
+                               regions.schedule(r).substeps, regions.schedule(r).rate_hz,
+                               regions.schedule(r).alone.critical_dt_s,
+                               compute_s[r] * 1e6 / simulated_ms});
+  }
 }
 
 // Nothing refused: each region takes the substeps its own limit asks for and the interface
@@ -142,16 +159,31 @@ TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report
     vtk->written.push_back(series->collection());
   }
   report->energy = regions.Energies();
-  const double simulated_ms = std::max<double>(result.steps, 1) * scene.solver.dt_s * 1e3;
-  const auto& p = regions.partition();
-  report->deadlines.resize(static_cast<size_t>(regions.num_regions()));
-  for (RegionIndex r = 0; r < regions.num_regions(); ++r) {
-    report->regions.push_back({p.RegionName(r), p.num_nodes(r), p.num_elements(r),
-                               regions.schedule(r).substeps, regions.schedule(r).rate_hz,
-                               regions.schedule(r).alone.critical_dt_s,
-                               regions.compute_seconds(r) * 1e6 / simulated_ms});
-  }
+  std::vector<double> compute_s;
+  for (RegionIndex r = 0; r < regions.num_regions(); ++r)
+    compute_s.push_back(regions.compute_seconds(r));
+  ReportRegions(regions, compute_s, std::max<long>(result.steps, 1) * scene.solver.dt_s, report);
   return result;
+}
+
+// A stroke on the regions: the primary follows the proxy across the face (RunRegionStroke), in
+// virtual time. The report's regions are those it started on.
+TrialResult RunAdaptiveStroke(const Scene& scene, bool threads, AdaptiveReport* report,
+                              const VtkOutput* vtk) {
+  HAPTICSIM_THROW_UNLESS(!threads,
+                         "--threads: a stroke on the regions runs in virtual time only (the "
+                         "primary follows the proxy by moving the regions); drop --threads");
+  HAPTICSIM_THROW_UNLESS(vtk == nullptr,
+                         "--vtk: a stroke on the regions writes no frames yet; drop --vtk, or set "
+                         "adaptivity.primary_size = 0 for the full-resolution stroke's");
+  AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
+  report->coupled = regions.EstimateCoupledStability();
+  const RegionStrokeResult run = RunRegionStroke(scene);
+  report->energy = run.energy;
+  report->stroke_moves = run.moves.size();
+  ReportRegions(regions, run.compute_s,
+                std::max<long>(run.stroke.trial.steps, 1) * scene.solver.dt_s, report);
+  return run.stroke.trial;
 }
 
 int Run(const SimulateOptions& options) {
@@ -168,8 +200,10 @@ int Run(const SimulateOptions& options) {
   std::optional<VtkOutput> vtk;
   if (!options.vtk_dir.empty()) vtk = VtkOutput{options.vtk_dir, options.vtk_rate_hz, {}};
   VtkOutput* frames = vtk ? &*vtk : nullptr;
-  const TrialResult result = adaptive ? RunAdaptive(scene, options.threads, &report, frames)
-                                      : RunReference(scene, trial_options, frames);
+  const bool stroke = scene.input.waveform == Waveform::kStroke;
+  const TrialResult result = !adaptive ? RunReference(scene, trial_options, frames)
+                             : stroke  ? RunAdaptiveStroke(scene, options.threads, &report, frames)
+                                       : RunAdaptive(scene, options.threads, &report, frames);
   std::optional<ForceError> error;
   std::optional<TrialResult> reference;
   // The full-resolution reference: to compare against, and beside an adaptive run in --vtk.
@@ -254,6 +288,7 @@ int Run(const SimulateOptions& options) {
       if (report.threaded_vs_virtual) {
         out["threaded_vs_virtual"] = ErrorJson(*report.threaded_vs_virtual);
       }
+      if (report.stroke_moves) out["primary_moves"] = *report.stroke_moves;
     }
     if (error) {
       out["error"] = ErrorJson(*error);
@@ -290,6 +325,11 @@ int Run(const SimulateOptions& options) {
       if (report.threaded_vs_virtual) {
         std::cout << "  threaded run against the virtual-time run: relative L2 "
                   << Quantity(report.threaded_vs_virtual->l2_percent, "%") << "\n";
+      }
+      if (report.stroke_moves) {
+        std::cout << "  the primary region followed the proxy " << *report.stroke_moves
+                  << " time(s) (rebuilt around the node nearest it, the motion carried over; "
+                     "the regions above are where it started)\n";
       }
       const EnergyAccount& e = report.energy;
       std::cout << "  coupled stability of the bare exchange: spectral radius "

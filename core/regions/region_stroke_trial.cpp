@@ -1,0 +1,193 @@
+#include "core/regions/region_stroke_trial.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "core/error.hpp"
+#include "core/regions/async_regions.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "core/trial/proxy_contact.hpp"
+#include "core/trial/trial_recorder.hpp"
+
+namespace hapticsim {
+namespace {
+
+// The node the primary should be centred on for a proxy nearest `node`: one node inside the rim
+// of the face along its two tangents, where a node's inward normal is the face's own.
+LatticeIndex CentreFor(LatticeIndex node, const std::array<int, 3>& lattice_nodes,
+                       const std::array<double, 3>& normal) {
+  for (int c = 0; c < 3; ++c) {
+    if (normal[c] == 0 && lattice_nodes[c] > 2)
+      node[c] = std::clamp(node[c], 1, lattice_nodes[c] - 2);
+  }
+  return node;
+}
+
+// Regions around `centre`, started from `state` (or from rest).
+std::unique_ptr<AsyncRegions> RegionsAround(Scene scene, const LatticeIndex& centre,
+                                            const ObjectState* state) {
+  scene.input.contact_node = centre;
+  auto regions = std::make_unique<AsyncRegions>(scene);
+  if (state != nullptr) regions->RestoreState(*state);
+  return regions;
+}
+
+// The proxy and the regions must agree on the loads' order: one list, two owners.
+void CheckAgree(const ProxyContact& proxy, const AsyncRegions& regions) {
+  HAPTICSIM_THROW_UNLESS(proxy.loaded_dofs() == regions.proxy_loaded_dofs(),
+                         "internal: the proxy and the primary region load different nodes");
+}
+
+// Adds what `regions` spent and balanced to the stroke's totals.
+void Accumulate(AsyncRegions& regions, RegionStrokeResult* out) {
+  out->compute_s.resize(static_cast<std::size_t>(regions.num_regions()), 0.0);
+  for (RegionIndex r = 0; r < regions.num_regions(); ++r)
+    out->compute_s[r] += regions.compute_seconds(r);
+  const EnergyAccount e = regions.Energies();
+  EnergyAccount& sum = out->energy;
+  sum.stored_j = e.stored_j;
+  sum.input_work_j += e.input_work_j;
+  sum.damping_dissipated_j += e.damping_dissipated_j;
+  sum.credited_damping_j += e.credited_damping_j;
+  sum.interface_created_j += e.interface_created_j;
+  sum.interface_dissipated_j += e.interface_dissipated_j;
+  sum.port_refused_j += e.port_refused_j;
+}
+
+// One stroke in progress: the regions it runs on now, the proxy and the periods' bookkeeping.
+class StrokeRun {
+ public:
+  explicit StrokeRun(const Scene& scene)
+      : scene_(scene),
+        regions_(std::make_unique<AsyncRegions>(scene)),
+        normal_(regions_->partition().contact_normal()),
+        centre_(regions_->partition().contact_node()),
+        lattice_nodes_(regions_->partition().mesh().options().lattice_nodes),
+        proxy_(regions_->partition().PrimaryProxySurface(), centre_, normal_, scene.contact),
+        trajectory_(scene.input, normal_),
+        dt_(1.0 / regions_->schedule(kPrimaryRegion).rate_hz),
+        steps_(std::lround(scene.input.periods / scene.input.frequency_hz / scene.solver.dt_s)),
+        recorder_(trajectory_, dt_, steps_, &out_.stroke.trial) {
+    const auto stroke_axis = static_cast<std::size_t>(scene.input.stroke_axis);
+    HAPTICSIM_THROW_UNLESS(
+        normal_[stroke_axis] == 0,
+        "input.stroke_direction = " + GetSceneValue(scene, "input.stroke_direction") +
+            " points into the contact's face: a stroke moves along the face, "
+            "choose one of the other two axes");
+    CheckAgree(proxy_, *regions_);
+    out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
+    out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
+    loads_.assign(proxy_.loaded_dofs().size(), 0.0);
+    budget_j_ = regions_->Energy();
+  }
+
+  RegionStrokeResult Run() && {
+    for (long n = 0; n <= steps_ && StepPeriod(n) && WithinBudget(); ++n) {
+      const LatticeIndex next = CentreFor(proxy_.NearestNode(), lattice_nodes_, normal_);
+      if (next != centre_) MoveTo(next, n);
+    }
+    out_.stroke.trial.wall_time_s = recorder_.ElapsedS();
+    Accumulate(*regions_, &out_);
+    return std::move(out_);
+  }
+
+ private:
+  // Period n: the proxy touched and the primary stepped once per substep, the tool on its path at
+  // each substep's start (the spring is as stiff as the primary's own limit allows for a
+  // substep, not for a period held). The period's sample is its first substep's force. False
+  // when the trial ends in it.
+  bool StepPeriod(long n) {
+    const int substeps = regions_->schedule(kPrimaryRegion).substeps;
+    for (int q = 0; q < substeps; ++q) {
+      std::array<double, 3> tool = proxy_.start_m();
+      const std::array<double, 3> moved =
+          trajectory_.DisplacementAt((n + double(q) / substeps) * dt_);
+      for (int c = 0; c < 3; ++c) tool[c] += moved[c];
+      const ProxyContact::Result touch = proxy_.Update(tool, regions_->primary_state(), loads_);
+      if (touch.left_surface) {
+        recorder_.Stop(TrialOutcome::kLeftSurface);
+        return false;
+      }
+      // The proxy's cell is within a node and a half of the primary's centre after each move;
+      // out of the primary within a period it slid faster than any hand moves a tool.
+      if (touch.left_region) {
+        recorder_.Stop(TrialOutcome::kDivergedContact);
+        return false;
+      }
+      if (q == 0) {
+        if (!recorder_.Record(n, touch.force_on_object_n)) return false;
+        out_.stroke.proxy.push_back({proxy_.proxy_rest_m(), touch.in_contact, touch.sliding});
+      }
+      regions_->AdvanceSecondariesTo(regions_->state_ticks(kPrimaryRegion) +
+                                     regions_->period_ticks(kPrimaryRegion));
+      regions_->StepPrimaryLoaded(loads_);
+    }
+    return true;
+  }
+
+  // The divergence checks of every trial (AsyncRegions::RunTrial), on the regions of now: false
+  // when the trial ends.
+  bool WithinBudget() {
+    const AsyncRegions::PublishedBalanceView balance = regions_->PublishedBalance();
+    const double work = work_before_j_ + regions_->Energies().input_work_j;
+    if (!std::isfinite(balance.state_energy_j)) {
+      recorder_.Stop(TrialOutcome::kDivergedNonFinite);
+      return false;
+    }
+    if (balance.state_energy_j > AsyncRegions::kEnergyGrowthFactor * (budget_j_ + work) &&
+        balance.state_energy_j > 0) {
+      recorder_.Stop(TrialOutcome::kDivergedEnergy);
+      return false;
+    }
+    if (regions_->RunawayHeld(balance, &runaway_periods_)) {
+      recorder_.Stop(TrialOutcome::kDivergedEnergy, /*runaway=*/true);
+      return false;
+    }
+    return true;
+  }
+
+  // The primary re-centred on `next` at the end of period n: new regions, the motion carried.
+  void MoveTo(const LatticeIndex& next, long n) {
+    const ObjectState state = regions_->CaptureState();
+    Accumulate(*regions_, &out_);
+    work_before_j_ += regions_->Energies().input_work_j;
+    regions_ = RegionsAround(scene_, next, &state);
+    proxy_.Rebind(regions_->partition().PrimaryProxySurface());
+    CheckAgree(proxy_, *regions_);
+    loads_.assign(proxy_.loaded_dofs().size(), 0.0);
+    budget_j_ = regions_->Energy();
+    runaway_periods_ = 0;
+    centre_ = next;
+    out_.moves.push_back({n, centre_});
+    StabilityEstimate& stability = out_.stroke.trial.stability;
+    const StabilityEstimate& primary = regions_->schedule(kPrimaryRegion).alone;
+    if (primary.critical_dt_s < stability.critical_dt_s) stability = primary;
+  }
+
+  const Scene& scene_;
+  RegionStrokeResult out_;
+  std::unique_ptr<AsyncRegions> regions_;
+  std::array<double, 3> normal_;
+  LatticeIndex centre_;
+  std::array<int, 3> lattice_nodes_;
+  ProxyContact proxy_;
+  ContactTrajectory trajectory_;
+  double dt_;
+  long steps_;
+  TrialRecorder recorder_;
+  std::vector<double> loads_;
+  double budget_j_ = 0;       // what the state held when the regions of now started, J
+  double work_before_j_ = 0;  // the contact's work on the regions before them, J
+  int runaway_periods_ = 0;
+};
+
+}  // namespace
+
+RegionStrokeResult RunRegionStroke(const Scene& scene) {
+  HAPTICSIM_THROW_UNLESS(scene.input.waveform == Waveform::kStroke,
+                         "internal: RunRegionStroke runs input.waveform = \"stroke\"");
+  return StrokeRun(scene).Run();
+}
+
+}  // namespace hapticsim

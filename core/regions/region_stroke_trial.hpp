@@ -1,0 +1,45 @@
+#pragma once
+
+#include <vector>
+
+#include "core/regions/async_regions.hpp"
+#include "core/scene/scene.hpp"
+#include "core/trial/stroke_trial.hpp"
+
+namespace hapticsim {
+
+/** A stroke on the asynchronous regions: what the reference's gives, and where the primary went. */
+struct RegionStrokeResult {
+  StrokeTrialResult stroke;  ///< forces on the user and the proxy, period by period
+  /** A move of the primary region under the proxy: at the end of period `period` the regions were
+   *  rebuilt around `centre` and the object's motion carried over (AsyncRegions::RestoreState). */
+  struct Move {
+    long period = 0;
+    LatticeIndex centre{};
+  };
+  std::vector<Move> moves;
+  /** Compute time in each region's steps over the stroke (every set of regions it ran on), s. */
+  std::vector<double> compute_s;
+  /** The energy balance summed over the sets of regions, each from its start (the input work,
+   *  damping, the interfaces' created and dissipated energy, the work the port limits refused;
+   *  stored_j: the last set's). */
+  EnergyAccount energy;
+};
+
+/**
+ * A stroke (input.waveform = "stroke") on the scene's asynchronous regions, in virtual time: the
+ * tool moved by the ContactTrajectory from the contact node's rest position, touching through a
+ * ProxyContact on the primary region (AsyncRegions::StepPrimaryLoaded), its spring force held
+ * over the primary's substeps of a period. Whenever the lattice node nearest the proxy is no
+ * longer the one the primary is centred on, the primary follows it: new regions around that node
+ * (clamped one node inside the face's rim, so that its normal stays the face's), started from the
+ * object's motion as the old regions had it. The proxy's surface point lies in both primaries,
+ * so the force does not step at a move.
+ *
+ * Ends as the reference does (TrialOutcome): the proxy at the face's edge (kLeftSurface), a state
+ * that is not finite, energy beyond the passivity budget or the runaway watch (kDivergedEnergy).
+ * @throws Error for a scene whose regions cannot be made (ValidateScene; adaptivity off).
+ */
+RegionStrokeResult RunRegionStroke(const Scene& scene);
+
+}  // namespace hapticsim

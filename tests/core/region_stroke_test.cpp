@@ -1,0 +1,200 @@
+// A tool stroked across the surface through the sliding proxy on the asynchronous regions
+// (RunRegionStroke): the primary region follows the proxy, rebuilt around the node nearest it and
+// started from the object's motion. Checked against what the contact model promises and what
+// does not depend on the regions: once sliding, the lateral force is the kinetic friction times
+// the normal force (within 5 %); without friction there is no lateral force; the force never
+// steps by more than 0.1 N from one period to the next, at the primary's moves included; the
+// stroke follows the full-resolution reference's (RunStrokeTrial); and a held press settles on
+// the contact spring in series with the object's stiffness from the static solve.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.hpp"
+#include "core/fem/static_solver.hpp"
+#include "core/regions/region_stroke_trial.hpp"
+#include "core/scene/scene_model.hpp"
+#include "core/trial/force_error.hpp"
+
+namespace hapticsim {
+namespace {
+
+Scene Stroke(double static_mu, double kinetic_mu, double length_m = 0.03) {
+  Scene scene;
+  scene.input.waveform = Waveform::kStroke;
+  scene.input.amplitude_m = 0.005;  // 5 mm deep
+  scene.input.stroke_length_m = length_m;
+  scene.contact.static_friction = static_mu;
+  scene.contact.kinetic_friction = kinetic_mu;
+  scene.adaptivity.primary_size = 3;
+  return scene;
+}
+
+double Normal(const ForceSample& s) { return -s.feedback_force_n[2]; }
+double Lateral(const ForceSample& s) {
+  return std::hypot(s.feedback_force_n[0], s.feedback_force_n[1]);
+}
+
+double LargestStep(const std::vector<ForceSample>& samples) {
+  double largest = 0;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    const auto& a = samples[i - 1].feedback_force_n;
+    const auto& b = samples[i].feedback_force_n;
+    largest = std::max(largest, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+  }
+  return largest;
+}
+
+// The reference stroke on the full-resolution cube: the same scene without regions.
+StrokeTrialResult Reference(Scene scene) {
+  scene.adaptivity.primary_size = 0;
+  return RunStrokeTrial(SceneModel(scene));
+}
+
+// 80 mm from the middle of the front face (20.8 mm spacing): the proxy crosses four nodes, so
+// the primary moves four times.
+constexpr double kLongStroke = 0.08;
+
+TEST(RegionStroke, ThePrimaryFollowsTheProxyAcrossTheFace) {
+  const RegionStrokeResult run = RunRegionStroke(Stroke(0.5, 0.4, kLongStroke));
+  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  ASSERT_EQ(run.stroke.proxy.size(), run.stroke.trial.samples.size());
+  ASSERT_GE(run.moves.size(), 3u);
+  // Each move is one node along the stroke, to the node the proxy was nearest then.
+  const double h = 0.25 / 12;
+  for (std::size_t i = 0; i < run.moves.size(); ++i) {
+    const RegionStrokeResult::Move& move = run.moves[i];
+    EXPECT_EQ(move.centre[0], 7 + static_cast<int>(i));
+    EXPECT_EQ(move.centre[1], 6);
+    EXPECT_EQ(move.centre[2], 0);
+    const double proxy_x =
+        run.stroke.proxy[static_cast<std::size_t>(move.period)].rest_position_m[0];
+    EXPECT_NEAR(proxy_x / h, move.centre[0], 0.5 + 1e-9) << "move " << i;
+  }
+}
+
+TEST(RegionStroke, OnceSlidingTheLateralForceIsTheKineticFrictionTimesTheNormal) {
+  const RegionStrokeResult run = RunRegionStroke(Stroke(0.5, 0.4, kLongStroke));
+  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  int sliding = 0;
+  double worst = 0;
+  const auto& samples = run.stroke.trial.samples;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    if (!run.stroke.proxy[i].sliding) continue;
+    ++sliding;
+    worst = std::max(worst, Lateral(samples[i]) / Normal(samples[i]));
+  }
+  std::printf("sliding in %d of %zu periods: lateral at most %.4f × normal\n", sliding,
+              samples.size(), worst);
+  EXPECT_GT(sliding, 300);
+  EXPECT_LE(worst, 0.4 * 1.05);
+}
+
+TEST(RegionStroke, WithoutFrictionThereIsNoLateralForce) {
+  const RegionStrokeResult run = RunRegionStroke(Stroke(0.0, 0.0, kLongStroke));
+  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  double largest = 0, largest_normal = 0;
+  for (const ForceSample& s : run.stroke.trial.samples) {
+    largest = std::max(largest, Lateral(s));
+    largest_normal = std::max(largest_normal, Normal(s));
+  }
+  std::printf(
+      "frictionless on the regions: largest lateral %.5f N, largest normal %.4f N, "
+      "%zu moves\n",
+      largest, largest_normal, run.moves.size());
+  EXPECT_GE(run.moves.size(), 3u);
+  EXPECT_LT(largest, 0.05);
+  EXPECT_GT(largest_normal, 0.3);  // the tool did press
+}
+
+// The change of the force vector from period i to i + 1, N.
+double StepAt(const std::vector<ForceSample>& samples, std::size_t i) {
+  const auto& a = samples[i].feedback_force_n;
+  const auto& b = samples[i + 1].feedback_force_n;
+  return std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+}
+
+TEST(RegionStroke, TheForceDoesNotStepWhereThePrimaryMoves) {
+  for (const double mu : {0.0, 0.4}) {
+    const Scene scene = Stroke(mu + 0.1, mu, kLongStroke);
+    const RegionStrokeResult run = RunRegionStroke(scene);
+    const StrokeTrialResult reference = Reference(scene);
+    ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+    const auto& samples = run.stroke.trial.samples;
+    // Across each move (the period it ended and the next) the force changes as the reference's,
+    // which never moves anything, changes over the same period.
+    double at_moves = 0, beyond_reference = 0;
+    for (const RegionStrokeResult::Move& move : run.moves) {
+      const auto i = static_cast<std::size_t>(move.period);
+      at_moves = std::max(at_moves, StepAt(samples, i));
+      beyond_reference =
+          std::max(beyond_reference, StepAt(samples, i) - StepAt(reference.trial.samples, i));
+    }
+    // … and no more than it does anywhere else in the stroke, where nothing moves.
+    double elsewhere = 0;
+    for (std::size_t i = 0; i + 1 < samples.size(); ++i) {
+      elsewhere = std::max(elsewhere, StepAt(samples, i) - StepAt(reference.trial.samples, i));
+    }
+    const double largest = LargestStep(samples);
+    std::printf(
+        "mu_k %.1f: largest step %.4f N (reference stroke %.4f N); across the %zu moves "
+        "%.4f N, at most %.5f N more than the reference's there (%.5f N anywhere)\n",
+        mu, largest, LargestStep(reference.trial.samples), run.moves.size(), at_moves,
+        beyond_reference, elsewhere);
+    EXPECT_LT(largest, 0.1) << "mu_k " << mu;
+    EXPECT_LT(beyond_reference, 0.005) << "mu_k " << mu;
+  }
+}
+
+TEST(RegionStroke, FollowsTheFullResolutionStroke) {
+  for (const double mu : {0.0, 0.4}) {
+    const Scene scene = Stroke(mu + 0.1, mu, kLongStroke);
+    const RegionStrokeResult run = RunRegionStroke(scene);
+    const StrokeTrialResult reference = Reference(scene);
+    ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+    ASSERT_EQ(reference.trial.outcome, TrialOutcome::kCompleted);
+    const ForceError e = CompareForces(run.stroke.trial.samples, reference.trial.samples);
+    std::printf(
+        "mu_k %.1f against the reference: relative L2 %.3f %%, largest %.3f %% of its peak\n", mu,
+        e.l2_percent, e.max_magnitude_percent);
+    EXPECT_LT(e.l2_percent, 3.0) << "mu_k " << mu;
+  }
+}
+
+TEST(RegionStroke, AHeldPressSettlesOnTheSpringInSeriesWithTheObject) {
+  Scene scene = Stroke(0.5, 0.4, 0.0);  // press 5 mm and hold
+  scene.input.periods = 4;              // 1 s of press, 3 s of hold: the damping settles it
+  const RegionStrokeResult run = RunRegionStroke(scene);
+  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  EXPECT_TRUE(run.moves.empty());
+  const SceneModel object([&] {
+    Scene full = scene;
+    full.adaptivity.primary_size = 0;
+    return full;
+  }());
+  const std::array<double, 3> unit = {0, 0, 1e-3};
+  const double k_object = SolveStatic(object.model(), unit).driven_reaction[2] / 1e-3;
+  const double k_spring = scene.contact.stiffness_n_per_m;
+  const double expected = 0.005 * k_object * k_spring / (k_object + k_spring);
+  const double settled = Normal(run.stroke.trial.samples.back());
+  std::printf("held press on the regions: %.5f N against %.5f N\n", settled, expected);
+  // The coarse secondary is stiffer than the full-resolution object: within the error map's
+  // few per cent.
+  EXPECT_NEAR(settled / expected, 1.0, 0.03);
+}
+
+TEST(RegionStroke, ThePrimaryMustReachTwoNodesFromTheProxy) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.adaptivity.primary_size = 1;
+  try {
+    RunRegionStroke(scene);
+    FAIL() << "a primary of one node was accepted for a stroke";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("adaptivity.primary_size >= 2"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hapticsim
