@@ -76,6 +76,7 @@ class StrokeRun {
             " points into the contact's face: a stroke moves along the face, "
             "choose one of the other two axes");
     CheckAgree(proxy_, *regions_);
+    CheckReach(scene);
     out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
     out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
     loads_.assign(proxy_.loaded_dofs().size(), 0.0);
@@ -93,6 +94,22 @@ class StrokeRun {
   }
 
  private:
+  // After each move the proxy is within half a node of the primary's centre, and its tip reaches
+  // r = max(1, contact.radius / h) nodes from it (the cell under it: 1): the primary must reach
+  // ⌈r + ½⌉ nodes, the last of them not on its interface.
+  void CheckReach(const Scene& scene) const {
+    const double spacing_m = regions_->partition().mesh().options().spacing_m;
+    const double reach = std::max(1.0, scene.contact.radius_m / spacing_m);
+    const int needed = static_cast<int>(std::ceil(reach + 0.5));
+    HAPTICSIM_THROW_UNLESS(scene.adaptivity.primary_size >= needed,
+                           "contact.radius = " + GetSceneValue(scene, "contact.radius") +
+                               " m reaches " + std::to_string(reach) + " lattice spacings of " +
+                               std::to_string(spacing_m) +
+                               " m from the proxy, and the primary region follows the proxy: set "
+                               "adaptivity.primary_size >= " +
+                               std::to_string(needed));
+  }
+
   // Period n: the proxy touched and the primary stepped once per substep, the tool on its path at
   // each substep's start (the spring is as stiff as the primary's own limit allows for a
   // substep, not for a period held). The period's sample is its first substep's force. False

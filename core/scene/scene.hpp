@@ -96,6 +96,9 @@ struct ContactSettings {
   double static_friction = 0.5;      ///< μ_s (contact.static_friction)
   double kinetic_friction = 0.4;     ///< μ_k ≤ μ_s (contact.kinetic_friction)
   double stiffness_n_per_m = 1000;   ///< the proxy spring (contact.stiffness), N/m
+  /// The tool tip's radius (contact.radius), m: the spring's push spread over the face nodes
+  /// within it; 0, or less than a lattice spacing: the face cell under the proxy (bilinear).
+  double radius_m = 0;
 };
 
 struct SolverSettings {

@@ -265,6 +265,11 @@ void AddContactKeys(std::vector<KeyAccess>& keys) {
        "the spring joining the tool to the proxy on the surface"},
       [](Scene& s) -> double& { return s.contact.stiffness_n_per_m; },
       [](double v) { return v > 0; }));
+  keys.push_back(Real(
+      {"contact.radius", "m", "finite and >= 0 (at most 8 lattice spacings)",
+       "the tool tip's radius: the spring pushes the face nodes within it (tent weights) and "
+       "reads the surface there; 0: the face cell under the proxy alone (bilinear)"},
+      [](Scene& s) -> double& { return s.contact.radius_m; }, [](double v) { return v >= 0; }));
 }
 
 // The asynchronous regions.

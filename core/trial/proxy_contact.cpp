@@ -59,6 +59,13 @@ ProxyContact::ProxyContact(ProxySurface surface, const LatticeIndex& contact_nod
   plane_ = contact_node[axis_];
   proxy_ = {static_cast<double>(contact_node[t1_]), static_cast<double>(contact_node[t2_])};
   for (int c = 0; c < 3; ++c) start_m_[c] = contact_node[c] * surface.spacing_m;
+  reach_ = std::max(1.0, contact.radius_m / surface.spacing_m);
+  if (reach_ > kMaxReach) {
+    throw Error("contact.radius = " + std::to_string(contact.radius_m) + " m is " +
+                std::to_string(reach_) + " lattice spacings of " +
+                std::to_string(surface.spacing_m) + " m; a tool tip may reach at most " +
+                std::to_string(kMaxReach) + ": lower contact.radius");
+  }
   Rebind(std::move(surface));
 }
 
@@ -103,7 +110,7 @@ bool ProxyContact::ExposedFace(int i1, int i2) const {
   return occupied(inside) && !occupied(outside);
 }
 
-bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corners) const {
+bool ProxyContact::PatchAt(const std::array<double, 2>& proxy, Patch* corners) const {
   const std::array<int, 3>& n = surface_.lattice_nodes;
   const std::array<int, 3> counts = {n[0] - 1, n[1] - 1, n[2] - 1};
   // A proxy exactly on the lattice's last node line belongs to the cell below it.
@@ -113,7 +120,9 @@ bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corner
   };
   const int i1 = cell(proxy[0], counts[t1_]), i2 = cell(proxy[1], counts[t2_]);
   if (!std::isfinite(proxy[0] + proxy[1]) || !ExposedFace(i1, i2)) return false;
+  if (reach_ > 1.0) return TentPatch(proxy, corners);
   const double a = proxy[0] - i1, b = proxy[1] - i2;
+  corners->count = 4;
   for (int k = 0; k < 4; ++k) {
     std::array<int, 3> at{};
     at[axis_] = plane_;
@@ -125,17 +134,48 @@ bool ProxyContact::CornersAt(const std::array<double, 2>& proxy, Corners* corner
   return true;
 }
 
-bool ProxyContact::Reachable(const Corners& corners) const {
-  for (int node : corners.nodes) {
-    if (surface_.loadable[static_cast<std::size_t>(node)] < 0) return false;
+// A tip wider than a cell: every face node of the object within reach_ of the proxy, weighted
+// (1 − |Δ1|/r)(1 − |Δ2|/r) (r = reach_ in spacings), the weights normalised to sum 1.
+bool ProxyContact::TentPatch(const std::array<double, 2>& proxy, Patch* patch) const {
+  const std::array<int, 3>& n = surface_.lattice_nodes;
+  const int lo1 = std::max(0, static_cast<int>(std::ceil(proxy[0] - reach_)));
+  const int hi1 = std::min(n[t1_] - 1, static_cast<int>(std::floor(proxy[0] + reach_)));
+  const int lo2 = std::max(0, static_cast<int>(std::ceil(proxy[1] - reach_)));
+  const int hi2 = std::min(n[t2_] - 1, static_cast<int>(std::floor(proxy[1] + reach_)));
+  patch->count = 0;
+  double sum = 0;
+  for (int i2 = lo2; i2 <= hi2; ++i2) {
+    for (int i1 = lo1; i1 <= hi1; ++i1) {
+      const double w =
+          (1.0 - std::abs(i1 - proxy[0]) / reach_) * (1.0 - std::abs(i2 - proxy[1]) / reach_);
+      std::array<int, 3> at{};
+      at[axis_] = plane_;
+      at[t1_] = i1;
+      at[t2_] = i2;
+      const int node = surface_.Node(at);
+      if (!(w > 0) || surface_.dof[static_cast<std::size_t>(node)] < 0) continue;
+      patch->nodes[static_cast<std::size_t>(patch->count)] = node;
+      patch->weights[static_cast<std::size_t>(patch->count)] = w;
+      ++patch->count;
+      sum += w;
+    }
+  }
+  for (int k = 0; k < patch->count; ++k) patch->weights[static_cast<std::size_t>(k)] /= sum;
+  return patch->count > 0;
+}
+
+bool ProxyContact::Reachable(const Patch& patch) const {
+  for (int k = 0; k < patch.count; ++k) {
+    if (surface_.loadable[static_cast<std::size_t>(patch.nodes[static_cast<std::size_t>(k)])] < 0)
+      return false;
   }
   return true;
 }
 
-std::array<double, 3> ProxyContact::SurfacePoint(const Corners& corners,
+std::array<double, 3> ProxyContact::SurfacePoint(const Patch& corners,
                                                  const Eigen::VectorXd& u) const {
   std::array<double, 3> point = proxy_rest_m();
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < corners.count; ++k) {
     const int dof =
         surface_.dof[static_cast<std::size_t>(corners.nodes[static_cast<std::size_t>(k)])];
     const double w = corners.weights[static_cast<std::size_t>(k)];
@@ -167,14 +207,14 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           const Eigen::VectorXd& u, std::span<double> loads) {
   std::fill(loads.begin(), loads.end(), 0.0);
   Result result;
-  Corners corners;
+  Patch corners;
   const auto offset_to_tool = [&] {
     const std::array<double, 3> s = SurfacePoint(corners, u);
     return std::array<double, 3>{tool_m[0] - s[0], tool_m[1] - s[1], tool_m[2] - s[2]};
   };
   // Over no face of the object, the tool has left the surface this contact can render.
   const double h = surface_.spacing_m;
-  if (!CornersAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !CornersAt(proxy_, &corners)) {
+  if (!PatchAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !PatchAt(proxy_, &corners)) {
     result.left_surface = true;
     return result;
   }
@@ -198,7 +238,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     const double move = (tangential - contact_.kinetic_friction * depth) / tangential;
     proxy_[0] += move * d[t1_] / h;
     proxy_[1] += move * d[t2_] / h;
-    if (!CornersAt(proxy_, &corners)) {
+    if (!PatchAt(proxy_, &corners)) {
       result.left_surface = true;
       return result;
     }
@@ -211,7 +251,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   result.in_contact = true;
   result.sliding = sliding_;
   for (int c = 0; c < 3; ++c) result.force_on_object_n[c] = k * d[c];
-  for (int j = 0; j < 4; ++j) {
+  for (int j = 0; j < corners.count; ++j) {
     const int slot = slot_of_node_[static_cast<std::size_t>(corners.nodes[static_cast<std::size_t>(j)])];
     if (slot < 0) continue;  // a held node: the support takes that share
     for (int c = 0; c < 3; ++c) {

@@ -41,6 +41,11 @@ ProxySurface ProxySurfaceOf(const ElasticModel& model);
  * inside, the spring pushes the surface at the proxy (spread over the face cell's 4 nodes with
  * the bilinear weights of where the proxy is in it) and the user feels the opposite force.
  *
+ * A tip of contact.radius r wider than a cell spreads the push over the face nodes within r of the
+ * proxy instead, with tent weights (1 − |Δ1|/r)(1 − |Δ2|/r), and reads the surface there: on a
+ * lattice finer than the press is deep, a push on one cell's nodes dimples the surface under the
+ * proxy, and sliding over its own dimple the proxy was measured to diverge.
+ *
  * Friction (Coulomb, on the spring's pull): with g the tool's depth below the proxy along the
  * inward normal and d_t the tangential offset, the normal force is k·g and the tangential k·|d_t|.
  * The proxy sticks (stays at its material point of the surface) while k·|d_t| ≤ μ_s·k·g; past
@@ -99,23 +104,31 @@ class ProxyContact {
   LatticeIndex NearestNode() const;
 
  private:
-  struct Corners {
-    std::array<int, 4> nodes{};
-    std::array<double, 4> weights{};
+  // The widest tip, in lattice spacings, and the most nodes it can touch.
+  static constexpr int kMaxReach = 8;
+  static constexpr int kMaxPatch = (2 * kMaxReach + 1) * (2 * kMaxReach + 1);
+  // The face nodes the spring pushes and reads, with their weights (summing to 1).
+  struct Patch {
+    int count = 0;
+    std::array<int, kMaxPatch> nodes{};
+    std::array<double, kMaxPatch> weights{};
   };
-  // The face cell under the proxy and its bilinear weights; false off the surface.
-  bool CornersAt(const std::array<double, 2>& proxy, Corners* corners) const;
-  // The deformed surface point at the proxy.
-  std::array<double, 3> SurfacePoint(const Corners& corners, const Eigen::VectorXd& u) const;
+  // The face nodes at the proxy: the cell under it with its bilinear weights (a tip within a
+  // cell), or TentPatch; false off the surface.
+  bool PatchAt(const std::array<double, 2>& proxy, Patch* patch) const;
+  bool TentPatch(const std::array<double, 2>& proxy, Patch* patch) const;
+  // The deformed surface point at the proxy: the patch's weighted displacement.
+  std::array<double, 3> SurfacePoint(const Patch& patch, const Eigen::VectorXd& u) const;
   bool ExposedFace(int i1, int i2) const;
-  // Whether every corner is pushable or held (ProxySurface::loadable ≥ 0).
-  bool Reachable(const Corners& corners) const;
+  // Whether every node of the patch is pushable or held (ProxySurface::loadable ≥ 0).
+  bool Reachable(const Patch& patch) const;
 
   ProxySurface surface_;
   ContactSettings contact_;
   int axis_ = 2, sign_ = 1, plane_ = 0, t1_ = 0, t2_ = 1;
   std::array<double, 3> start_m_{};
   std::array<double, 2> proxy_{};  // along t1, t2 in node spacings
+  double reach_ = 1;               // the tip's radius in node spacings, at least one
   bool sliding_ = false;
   std::vector<int> loaded_dofs_;
   std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded

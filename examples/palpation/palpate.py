@@ -28,8 +28,9 @@ def press(hapticsim, scene, node=None):
     return json.loads(result.stdout)
 
 
-def svg(points, path, band_mm):
+def svg(points, path, band_mm, title=None):
     """A line chart of (x mm, force N), the inclusion's extent shaded: the standard library only."""
+    title = title or "Palpation: force against position (%d static presses)" % len(points)
     width, height, left, bottom, top, right = 640, 360, 70, 50, 30, 20
     xs = [p[0] for p in points]
     ys = [p[1] for p in points]
@@ -44,8 +45,7 @@ def svg(points, path, band_mm):
     parts = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" '
              'font-family="sans-serif" font-size="12">' % (width, height),
              '<rect width="100%" height="100%" fill="white"/>',
-             '<text x="%d" y="18" font-size="14">Palpation: force against position '
-             '(%d static presses)</text>' % (left, len(points))]
+             '<text x="%d" y="18" font-size="14">%s</text>' % (left, title)]
     parts.append('<rect x="%.1f" y="%d" width="%.1f" height="%d" fill="#f4d03f" opacity="0.3"/>'
                  % (px(band_mm[0]), top, px(band_mm[1]) - px(band_mm[0]), height - top - bottom))
     parts.append('<text x="%.1f" y="%d" text-anchor="middle">inclusion</text>'
@@ -70,13 +70,19 @@ def svg(points, path, band_mm):
         f.write("\n".join(parts) + "\n")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def parse_args(doc, out):
+    """The examples' command line: which hapticsim, which scene, where to write (made)."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     parser.add_argument("--hapticsim", default=os.path.join(ROOT, "build", "tools", "hapticsim"))
     parser.add_argument("--scene", default=os.path.join(HERE, "palpation.toml"))
-    parser.add_argument("--out", default="palpation-out")
+    parser.add_argument("--out", default=out)
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    return args
+
+
+def main():
+    args = parse_args(__doc__, "palpation-out")
 
     first = press(args.hapticsim, args.scene)
     nx, ny, _ = first["lattice_nodes"]

@@ -184,6 +184,65 @@ TEST(RegionStroke, AHeldPressSettlesOnTheSpringInSeriesWithTheObject) {
   EXPECT_NEAR(settled / expected, 1.0, 0.03);
 }
 
+// A block as soft as the palpation phantom's tissue (10 kPa) on a lattice finer than the press is
+// deep: 4 cm, 2.5 mm voxels, pressed 3 mm and stroked 20 mm without friction.
+Scene SoftFineStroke(double radius_m) {
+  Scene scene = Stroke(0.0, 0.0, 0.02);
+  scene.mesh.nodes = 17;
+  scene.mesh.edge_m = 0.04;
+  scene.material.youngs_modulus_pa = 10000;
+  scene.material.poisson_ratio = 0.45;
+  scene.input.amplitude_m = 0.003;
+  scene.contact.radius_m = radius_m;
+  return scene;
+}
+
+TEST(RegionStroke, OnALatticeFinerThanThePressIsDeepAWideTipSlidesWhereOneCellDiverges) {
+  // The tip on one cell's nodes dimples the surface under the proxy, and the proxy sliding over
+  // its own dimple diverges — on the regions and on the full-resolution object alike.
+  const RegionStrokeResult cell = RunRegionStroke(SoftFineStroke(0.0));
+  EXPECT_TRUE(cell.stroke.trial.diverged()) << TrialOutcomeName(cell.stroke.trial.outcome);
+  // A tip of 5 mm (two spacings) spreads the push and reads the surface over 16 nodes.
+  const Scene wide = SoftFineStroke(0.005);
+  const RegionStrokeResult run = RunRegionStroke(wide);
+  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  Scene full = wide;
+  full.solver.dt_s = 5e-5;  // the full-resolution object's limit with the spring: 77 µs
+  const StrokeTrialResult reference = Reference(full);
+  ASSERT_EQ(reference.trial.outcome, TrialOutcome::kCompleted);
+  double lateral = 0, normal = 0;
+  for (const ForceSample& s : run.stroke.trial.samples) {
+    lateral = std::max(lateral, Lateral(s));
+    normal = std::max(normal, Normal(s));
+  }
+  // The reference's samples every 50 µs, the regions' every 1 ms: compare at the same times.
+  std::vector<ForceSample> matched;
+  for (std::size_t i = 0; i < run.stroke.trial.samples.size(); ++i)
+    matched.push_back(reference.trial.samples[20 * i]);
+  const ForceError e = CompareForces(run.stroke.trial.samples, matched);
+  std::printf(
+      "soft fine block, 5 mm tip: %zu moves, largest lateral %.5f N, normal %.4f N, "
+      "largest step %.4f N; against the full-resolution stroke relative L2 %.2f %%\n",
+      run.moves.size(), lateral, normal, LargestStep(run.stroke.trial.samples), e.l2_percent);
+  EXPECT_GE(run.moves.size(), 5u);
+  EXPECT_LT(lateral, 0.05);
+  EXPECT_GT(normal, 0.03);
+  EXPECT_LT(LargestStep(run.stroke.trial.samples), 0.1);
+  EXPECT_LT(e.l2_percent, 5.0);
+}
+
+TEST(RegionStroke, AWideTipNeedsAPrimaryThatReachesIt) {
+  Scene scene = SoftFineStroke(0.005);  // two spacings: the primary must reach three nodes
+  scene.adaptivity.primary_size = 2;
+  try {
+    RunRegionStroke(scene);
+    FAIL() << "a primary of two nodes was accepted for a 5 mm tip on 2.5 mm voxels";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("adaptivity.primary_size >= 3"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RegionStroke, ThePrimaryMustReachTwoNodesFromTheProxy) {
   Scene scene = Stroke(0.5, 0.4);
   scene.adaptivity.primary_size = 1;
