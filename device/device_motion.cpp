@@ -4,6 +4,7 @@
 #include <cmath>
 #include <lcm/lcm-cpp.hpp>
 #include <numbers>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "hapticsim/device_input_t.hpp"
@@ -47,17 +48,30 @@ std::vector<std::optional<std::array<double, 3>>> ReadReplay(const std::string& 
   return positions;
 }
 
+// A length as a user wrote it: 0.04, not 0.040000.
+std::string Metres(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
 }  // namespace
 
 DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.seed) {
-  if (!(s.edge_m > 0)) throw Error("--edge must be positive, m");
-  if (!(s.amplitude_m >= 0 && s.amplitude_m < s.edge_m)) {
-    throw Error("--amplitude must be in [0, edge), m");
+  for (double e : s.extent_m) {
+    if (!(e > 0 && std::isfinite(e))) throw Error("--edge must be positive, m");
+  }
+  if (!(s.amplitude_m >= 0 && s.amplitude_m < s.extent_m[2])) {
+    throw Error("--amplitude must be in [0, the object's depth along z = " + Metres(s.extent_m[2]) +
+                "), m");
   }
   if (!(s.frequency_hz > 0)) throw Error("--frequency must be positive, Hz");
   if (!(s.walk_speed_m_per_s > 0)) throw Error("--walk-speed must be positive, m/s");
-  for (double c : s.at_m) {
-    if (!(c >= 0 && c <= s.edge_m)) throw Error("--at must lie on the front face: 0 ≤ x, y ≤ edge");
+  for (int c = 0; c < 2; ++c) {
+    if (!(s.at_m[c] >= 0 && s.at_m[c] <= s.extent_m[c])) {
+      throw Error("--at must lie on the front face: 0 ≤ x ≤ " + Metres(s.extent_m[0]) +
+                  " and 0 ≤ y ≤ " + Metres(s.extent_m[1]) + " m");
+    }
   }
   if (s.kind == "replay") {
     replay_ = ReadReplay(s.replay_path, s.replay_channel, s.rate_hz);
@@ -76,9 +90,9 @@ std::array<double, 3> DeviceMotion::NewWaypoint(bool inside) {
   std::uniform_real_distribution<double> step(-0.03, 0.03);
   std::uniform_real_distribution<double> depth(0.2 * settings_.amplitude_m, settings_.amplitude_m);
   std::uniform_real_distribution<double> height(0.001, 0.01);
-  const double lo = 0.1 * settings_.edge_m, hi = 0.9 * settings_.edge_m;
-  const double x = std::clamp(to_[0] + step(random_), lo, hi);
-  const double y = std::clamp(to_[1] + step(random_), lo, hi);
+  const std::array<double, 3>& e = settings_.extent_m;
+  const double x = std::clamp(to_[0] + step(random_), 0.1 * e[0], 0.9 * e[0]);
+  const double y = std::clamp(to_[1] + step(random_), 0.1 * e[1], 0.9 * e[1]);
   return {x, y, inside ? depth(random_) : -height(random_)};
 }
 

@@ -12,7 +12,9 @@ namespace hapticsim::device {
 /** What the simulated device does with its tool tip (object frame, m; see device_input_t). */
 struct MotionSettings {
   std::string kind = "press";                ///< press | sine | walk | replay
-  double edge_m = 0.25;                      ///< the daemon's cube edge
+  /// The daemon's object as the device meets it: its box's extent along x, y, z, m (the cube's
+  /// edge three times; --edge, or --scene). The front face is z = 0, x and y from 0 to theirs.
+  std::array<double, 3> extent_m{0.25, 0.25, 0.25};
   double amplitude_m = 0.01;                 ///< press depth / sine amplitude / deepest walk press
   double frequency_hz = 1.0;                 ///< press and sine
   std::array<double, 2> at_m{0.125, 0.125};  ///< press and sine: the point on the front face

@@ -28,6 +28,35 @@ TEST(DeviceMotion, ThePressGoesFromAboveTheSurfaceToItsDepthAndBack) {
   EXPECT_DOUBLE_EQ(tips[300][1], 0.125);
 }
 
+// A block, not the cube (hapticsim device --scene): the walk stays on its front face per axis, and
+// a press point or a depth outside it is refused naming the block's extent.
+TEST(DeviceMotion, OnABlockTheWalkStaysOnItsFaceAndAPressOffItIsRefused) {
+  MotionSettings s;
+  s.kind = "walk";
+  s.extent_m = {0.08, 0.04, 0.03};  // the palpation phantom
+  s.at_m = {0.04, 0.02};
+  s.amplitude_m = 0.003;
+  DeviceMotion walk(s);
+  for (int n = 0; n < 20000; ++n) {
+    const std::array<double, 3> tip = walk.Next().value();
+    for (int c = 0; c < 2; ++c) {
+      ASSERT_GE(tip[c], 0.1 * s.extent_m[c] - 1e-12) << "axis " << c << " period " << n;
+      ASSERT_LE(tip[c], 0.9 * s.extent_m[c] + 1e-12) << "axis " << c << " period " << n;
+    }
+  }
+  s.kind = "press";
+  s.at_m = {0.06, 0.05};  // y past the block's 40 mm
+  try {
+    DeviceMotion refused(s);
+    FAIL() << "a press off the block's face was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("0 ≤ y ≤ 0.04"), std::string::npos) << e.what();
+  }
+  s.at_m = {0.04, 0.02};
+  s.amplitude_m = 0.03;  // as deep as the block
+  EXPECT_THROW(DeviceMotion deep(s), Error);
+}
+
 TEST(DeviceMotion, TheWalkIsReproducibleAndTouchesDownSomewhereNewEachTime) {
   MotionSettings s;
   s.kind = "walk";
@@ -49,8 +78,8 @@ TEST(DeviceMotion, TheWalkIsReproducibleAndTouchesDownSomewhereNewEachTime) {
       touch_points.insert({std::lround(tip[0] * 1000), std::lround(tip[1] * 1000)});  // mm
     }
     for (int c = 0; c < 2; ++c) {
-      ASSERT_GE(tip[c], 0.1 * s.edge_m - 1e-12);
-      ASSERT_LE(tip[c], 0.9 * s.edge_m + 1e-12);
+      ASSERT_GE(tip[c], 0.1 * s.extent_m[c] - 1e-12);
+      ASSERT_LE(tip[c], 0.9 * s.extent_m[c] + 1e-12);
     }
     ASSERT_LE(tip[2], s.amplitude_m + 1e-12);
     fastest = std::max(

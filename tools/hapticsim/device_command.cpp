@@ -6,6 +6,8 @@
 #include <iostream>
 
 #include "core/error.hpp"
+#include "core/scene/scene_model.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "device/cpu_load.hpp"
 #include "device/device_link.hpp"
 #include "device/device_session.hpp"
@@ -24,6 +26,8 @@ struct DeviceOptions {
               status_channel = "HAPTIC_STATUS";
   device::MotionSettings motion;
   std::vector<double> at;
+  double edge_m = 0;       // --edge: the cube's edge
+  std::string scene_file;  // --scene: the daemon's scene, for its object's box
   double duration_s = 10;
   int cpu_load = 0;
   std::vector<double> bad_input_at_s;
@@ -31,12 +35,24 @@ struct DeviceOptions {
   DeviceLimits limits;
 };
 
+// The object's box as the daemon's scene makes it (ContactBox): its extent along x, y, z, m.
+std::array<double, 3> SceneExtent(const std::string& path) {
+  const SceneObject object = DescribeSceneObject(LoadSceneFile(path));
+  const HexGrid& grid = object.grid;
+  return {(grid.nx() - 1) * grid.spacing(), (grid.ny() - 1) * grid.spacing(),
+          (grid.nz() - 1) * grid.spacing()};
+}
+
 int Run(DeviceOptions o) {
+  HAPTICSIM_THROW_UNLESS(o.edge_m == 0 || o.scene_file.empty(),
+                         "--edge and --scene both give the object: use one");
+  if (o.edge_m != 0) o.motion.extent_m = {o.edge_m, o.edge_m, o.edge_m};
+  if (!o.scene_file.empty()) o.motion.extent_m = SceneExtent(o.scene_file);
   if (!o.at.empty()) {
     HAPTICSIM_THROW_UNLESS(o.at.size() == 2, "--at takes two numbers: X,Y on the front face, m");
     o.motion.at_m = {o.at[0], o.at[1]};
   } else {
-    o.motion.at_m = {o.motion.edge_m / 2, o.motion.edge_m / 2};
+    o.motion.at_m = {o.motion.extent_m[0] / 2, o.motion.extent_m[1] / 2};
   }
   HAPTICSIM_THROW_UNLESS(o.duration_s > 0, "--duration must be positive, s");
   device::DeviceMotion motion(o.motion);
@@ -146,8 +162,10 @@ Command AddDeviceCommand(CLI::App& parent) {
                   "(default: its middle)")
       ->delimiter(',')
       ->expected(2);
-  app->add_option("--edge", options->motion.edge_m, "The daemon's cube edge, m")
-      ->capture_default_str();
+  app->add_option("--edge", options->edge_m, "The daemon's cube edge, m (default 0.25)");
+  app->add_option("--scene", options->scene_file,
+                  "The daemon's scene file ([scene] file in its config): the device presses, "
+                  "sines and walks on its object's front face, z = 0 (instead of --edge)");
   app->add_option("--seed", options->motion.seed, "Random walk seed")->capture_default_str();
   app->add_option("--walk-speed", options->motion.walk_speed_m_per_s, "Random walk top speed, m/s")
       ->capture_default_str();
