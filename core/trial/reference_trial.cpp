@@ -52,7 +52,9 @@ std::string_view TrialOutcomeName(TrialOutcome outcome) {
 
 TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& options) {
   const Scene& scene = cube.scene();
-  if (scene.input.waveform == Waveform::kStroke) return RunStrokeTrial(cube).trial;
+  if (scene.input.waveform == Waveform::kStroke) {
+    return RunStrokeTrial(cube, options.substep_to_stability).trial;
+  }
   const ElasticModel& model = cube.model();
   TrialResult result;
   result.stability = EstimateStability(model);

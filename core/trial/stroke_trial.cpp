@@ -25,7 +25,7 @@ std::vector<int> OwnedDofs(const ElasticModel& model) {
 
 }  // namespace
 
-StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
+StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability) {
   const Scene& scene = object.scene();
   const ElasticModel& model = object.model();
   StrokeTrialResult out;
@@ -45,13 +45,16 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
       2.0 / std::sqrt(omega * omega +
                       scene.contact.stiffness_n_per_m / contact.lightest_loaded_mass_kg());
   const double dt = scene.solver.dt_s;
-  if (!result.stability.IsStable(dt)) {
+  if (!result.stability.IsStable(dt) && substep_to_stability) {
+    result.substeps = static_cast<int>(std::ceil(dt / (0.95 * result.stability.critical_dt_s)));
+  } else if (!result.stability.IsStable(dt)) {
     result.outcome = TrialOutcome::kPredictedUnstable;
     return out;
   }
+  const double h = dt / result.substeps;
   const std::vector<int>& fixed = model.constraints().fixed_dofs;
   RegionIntegrator integrator(model.stiffness(), model.dof_mass(), model.dof_damping(),
-                              OwnedDofs(model), fixed, contact.loaded_dofs(), dt);
+                              OwnedDofs(model), fixed, contact.loaded_dofs(), h);
   integrator.SetEnergyTerms(false);
   const std::vector<double> held_at_rest(fixed.size(), 0.0);
   std::vector<double> loads(contact.loaded_dofs().size(), 0.0);
@@ -59,22 +62,31 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object) {
   const long steps = scene.num_steps();
   TrialRecorder recorder(trajectory, dt, steps, &result);
   out.proxy.reserve(static_cast<std::size_t>(steps) + 1);
-  for (long n = 0; n <= steps; ++n) {
-    std::array<double, 3> tool = contact.start_m();
-    const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt);
-    for (int c = 0; c < 3; ++c) tool[c] += moved[c];
-    const ProxyContact::Result touch = contact.Update(tool, integrator.u(), loads);
-    if (touch.left_surface) {
-      recorder.Stop(TrialOutcome::kLeftSurface);
-      break;
+  // Each substep: the proxy touched with the tool on its path, then one step; the period's sample
+  // is its first substep's force. False when the trial ends.
+  const auto step_period = [&](long n) {
+    for (int q = 0; q < result.substeps; ++q) {
+      std::array<double, 3> tool = contact.start_m();
+      const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt + q * h);
+      for (int c = 0; c < 3; ++c) tool[c] += moved[c];
+      const ProxyContact::Result touch = contact.Update(tool, integrator.u(), loads);
+      if (touch.left_surface) {
+        recorder.Stop(TrialOutcome::kLeftSurface);
+        return false;
+      }
+      if (q == 0) {
+        if (!recorder.Record(n, touch.force_on_object_n)) return false;
+        out.proxy.push_back({contact.proxy_rest_m(), touch.in_contact, touch.sliding});
+      }
+      integrator.Step(held_at_rest, loads);
+      if (!std::isfinite(integrator.OwnedStateMaxAbs())) {
+        recorder.Stop(TrialOutcome::kDivergedNonFinite);
+        return false;
+      }
     }
-    if (!recorder.Record(n, touch.force_on_object_n)) break;
-    out.proxy.push_back({contact.proxy_rest_m(), touch.in_contact, touch.sliding});
-    integrator.Step(held_at_rest, loads);
-    if (!std::isfinite(integrator.OwnedStateMaxAbs())) {
-      recorder.Stop(TrialOutcome::kDivergedNonFinite);
-      break;
-    }
+    return true;
+  };
+  for (long n = 0; n <= steps && step_period(n); ++n) {
   }
   result.wall_time_s = recorder.ElapsedS();
   return out;

@@ -27,9 +27,11 @@ struct StrokeTrialResult {
  *
  * Refused as predicted unstable (TrialOutcome::kPredictedUnstable) when solver.dt is past the
  * limit of the object with the contact spring on its lightest face node: 2 / √(ω_max² + k/m),
- * which TrialResult::stability.critical_dt_s then reports. A proxy that reaches the edge of the
- * face ends the trial (kLeftSurface).
+ * which TrialResult::stability.critical_dt_s then reports — unless `substep_to_stability`, as
+ * TrialOptions asks of a reference: then each period takes the substeps that keep within 95 % of
+ * that limit, the proxy touching at each (the tool on its path), as the regions' primary does.
+ * A proxy that reaches the edge of the face ends the trial (kLeftSurface).
  */
-StrokeTrialResult RunStrokeTrial(const SceneModel& object);
+StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability = false);
 
 }  // namespace hapticsim

@@ -15,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/fem/static_solver.hpp"
+#include "core/trial/force_error.hpp"
 
 namespace hapticsim {
 namespace {
@@ -130,6 +131,34 @@ TEST(StrokeTrial, AStrokeIntoTheFaceIsRefusedSayingWhichWaysItCanGo) {
   } catch (const Error& error) {
     EXPECT_NE(std::string(error.what()).find("points into the contact's face"), std::string::npos);
   }
+}
+
+// As a reference for the regions (simulate --compare-reference): a period past the limit with
+// the spring is taken in substeps, the proxy touching at each, and gives what a run at a fine
+// step gives. A 4 cm block of 2.5 mm voxels, 3 mm deep, a 5 mm tip, 20 mm with friction.
+TEST(StrokeTrial, APeriodPastTheLimitIsSubsteppedWhenAReferenceAsksAndMatchesAFineStep) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.mesh.nodes = 17;
+  scene.mesh.edge_m = 0.04;
+  scene.input.amplitude_m = 0.003;
+  scene.input.stroke_length_m = 0.02;
+  scene.contact.radius_m = 0.005;
+  const StrokeTrialResult refused = RunStrokeTrial(SceneModel(scene));  // 1 ms: past 77 µs
+  EXPECT_EQ(refused.trial.outcome, TrialOutcome::kPredictedUnstable);
+  const StrokeTrialResult substepped = RunStrokeTrial(SceneModel(scene), true);
+  ASSERT_EQ(substepped.trial.outcome, TrialOutcome::kCompleted);
+  EXPECT_EQ(substepped.trial.substeps,
+            static_cast<int>(std::ceil(1e-3 / (0.95 * substepped.trial.stability.critical_dt_s))));
+  scene.solver.dt_s = 2.5e-5;
+  const StrokeTrialResult fine = RunStrokeTrial(SceneModel(scene));
+  ASSERT_EQ(fine.trial.outcome, TrialOutcome::kCompleted);
+  std::vector<ForceSample> matched;
+  for (std::size_t i = 0; i < substepped.trial.samples.size(); ++i)
+    matched.push_back(fine.trial.samples[40 * i]);
+  const ForceError e = CompareForces(substepped.trial.samples, matched);
+  std::printf("%d substeps of a 1 ms period against 25 µs steps: relative L2 %.3f %%\n",
+              substepped.trial.substeps, e.l2_percent);
+  EXPECT_LT(e.l2_percent, 2.0);
 }
 
 TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
