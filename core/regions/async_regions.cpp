@@ -1,6 +1,7 @@
 #include "core/regions/async_regions.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -329,9 +330,8 @@ std::array<double, 3> AsyncRegions::StepPrimary(
 
 void AsyncRegions::StepPrimaryLoaded(std::span<const double> loads) noexcept {
   std::vector<double>& values = regions_[kPrimaryRegion]->load_values;
-  const std::size_t count = std::min(values.size(), loads.size());
-  std::copy_n(loads.begin(), count, values.begin());
-  std::fill(values.begin() + static_cast<std::ptrdiff_t>(count), values.end(), 0.0);
+  assert(partition_.proxy_contact() && loads.size() == values.size());
+  std::copy_n(loads.begin(), std::min(values.size(), loads.size()), values.begin());
   StepRegionAt(kPrimaryRegion, nullptr, nullptr);
 }
 

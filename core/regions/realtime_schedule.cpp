@@ -7,6 +7,7 @@
 #include <random>
 #include <thread>
 
+#include "core/error.hpp"
 #include "core/trial/trial_recorder.hpp"
 #include "rt/deadline_monitor.hpp"
 #include "rt/monotonic_clock.hpp"
@@ -118,6 +119,8 @@ void RunSecondary(AsyncRegions& regions, const RunGrid& grid, int a, const Timin
 }  // namespace
 
 TrialResult RealTimeSchedule::RunTrial() {
+  HAPTICSIM_THROW_UNLESS(!regions_.partition().proxy_contact(),
+                         "a stroke on the regions runs in virtual time only (RunRegionStroke)");
   const Scene& scene = regions_.partition().scene();
   const ContactTrajectory trajectory(scene.input, regions_.partition().contact_normal());
   const int count = regions_.num_regions();

@@ -13,17 +13,6 @@
 namespace hapticsim {
 namespace {
 
-// The node the primary should be centred on for a proxy nearest `node`: one node inside the rim
-// of the face along its two tangents, where a node's inward normal is the face's own.
-LatticeIndex CentreFor(LatticeIndex node, const std::array<int, 3>& lattice_nodes,
-                       const std::array<double, 3>& normal) {
-  for (int c = 0; c < 3; ++c) {
-    if (normal[c] == 0 && lattice_nodes[c] > 2)
-      node[c] = std::clamp(node[c], 1, lattice_nodes[c] - 2);
-  }
-  return node;
-}
-
 // Regions around `centre`, started from `state` (or from rest).
 std::unique_ptr<AsyncRegions> RegionsAround(Scene scene, const LatticeIndex& centre,
                                             const ObjectState* state) {
@@ -63,7 +52,6 @@ class StrokeRun {
         regions_(std::make_unique<AsyncRegions>(scene)),
         normal_(regions_->partition().contact_normal()),
         centre_(regions_->partition().contact_node()),
-        lattice_nodes_(regions_->partition().mesh().options().lattice_nodes),
         proxy_(regions_->partition().PrimaryProxySurface(), centre_, normal_, scene.contact),
         trajectory_(scene.input, normal_),
         dt_(1.0 / regions_->schedule(kPrimaryRegion).rate_hz),
@@ -85,8 +73,7 @@ class StrokeRun {
 
   RegionStrokeResult Run() && {
     for (long n = 0; n <= steps_ && StepPeriod(n) && WithinBudget(); ++n) {
-      const LatticeIndex next = CentreFor(proxy_.NearestNode(), lattice_nodes_, normal_);
-      if (next != centre_) MoveTo(next, n);
+      if (n < steps_ && FarFromCentre()) MoveTo(proxy_.NearestNode(), n);
     }
     out_.stroke.trial.wall_time_s = recorder_.ElapsedS();
     Accumulate(*regions_, &out_);
@@ -94,13 +81,29 @@ class StrokeRun {
   }
 
  private:
-  // After each move the proxy is within half a node of the primary's centre, and its tip reaches
-  // r = max(1, contact.radius / h) nodes from it (the cell under it: 1): the primary must reach
-  // ⌈r + ½⌉ nodes, the last of them not on its interface.
+  // Whether the primary should follow the proxy: it is more than kFollowAfter nodes from the
+  // centre along a tangent (a band above the half node a move leaves it at, so a proxy sliding
+  // on a node line does not move the regions to and fro), and the node nearest it is inside the
+  // face (its inward normal the face's: at the rim the primary stays, and a proxy that leaves it
+  // reaches the face's edge).
+  bool FarFromCentre() const {
+    const double spacing_m = regions_->partition().mesh().options().spacing_m;
+    const std::array<double, 3> at = proxy_.proxy_rest_m();
+    bool far = false;
+    for (int c = 0; c < 3; ++c)
+      far = far || std::abs(at[c] / spacing_m - centre_[c]) > kFollowAfter;
+    return far && proxy_.InsideFace(proxy_.NearestNode());
+  }
+  static constexpr double kFollowAfter = 0.75;  // nodes
+
+  // The proxy is within kFollowAfter nodes of the primary's centre at a period's start, and its
+  // tip reaches r = max(1, contact.radius / h) nodes from it (the cell under it: 1): a primary of
+  // ⌈r⌉ + 1 nodes keeps every node the tip touches off its interface with a quarter node to spare
+  // for the proxy's slide within the period.
   void CheckReach(const Scene& scene) const {
     const double spacing_m = regions_->partition().mesh().options().spacing_m;
     const double reach = std::max(1.0, scene.contact.radius_m / spacing_m);
-    const int needed = static_cast<int>(std::ceil(reach + 0.5));
+    const int needed = static_cast<int>(std::ceil(reach)) + 1;
     HAPTICSIM_THROW_UNLESS(scene.adaptivity.primary_size >= needed,
                            "contact.radius = " + GetSceneValue(scene, "contact.radius") +
                                " m reaches " + std::to_string(reach) + " lattice spacings of " +
@@ -126,10 +129,11 @@ class StrokeRun {
         recorder_.Stop(TrialOutcome::kLeftSurface);
         return false;
       }
-      // The proxy's cell is within a node and a half of the primary's centre after each move;
-      // out of the primary within a period it slid faster than any hand moves a tool.
       if (touch.left_region) {
-        recorder_.Stop(TrialOutcome::kDivergedContact);
+        // At the face's rim the primary stayed: the stroke reached the edge of its face. Inside
+        // it the proxy slid farther in a period than any tool moves.
+        recorder_.Stop(proxy_.InsideFace(proxy_.NearestNode()) ? TrialOutcome::kDivergedContact
+                                                               : TrialOutcome::kLeftSurface);
         return false;
       }
       if (q == 0) {
@@ -173,7 +177,6 @@ class StrokeRun {
     proxy_.Rebind(regions_->partition().PrimaryProxySurface());
     CheckAgree(proxy_, *regions_);
     loads_.assign(proxy_.loaded_dofs().size(), 0.0);
-    budget_j_ = regions_->Energy();
     runaway_periods_ = 0;
     centre_ = next;
     out_.moves.push_back({n, centre_});
@@ -187,14 +190,13 @@ class StrokeRun {
   std::unique_ptr<AsyncRegions> regions_;
   std::array<double, 3> normal_;
   LatticeIndex centre_;
-  std::array<int, 3> lattice_nodes_;
   ProxyContact proxy_;
   ContactTrajectory trajectory_;
   double dt_;
   long steps_;
   TrialRecorder recorder_;
   std::vector<double> loads_;
-  double budget_j_ = 0;       // what the state held when the regions of now started, J
+  double budget_j_ = 0;       // what the state held when the stroke started, J
   double work_before_j_ = 0;  // the contact's work on the regions before them, J
   int runaway_periods_ = 0;
 };

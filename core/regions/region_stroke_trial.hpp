@@ -29,16 +29,19 @@ struct RegionStrokeResult {
 /**
  * A stroke (input.waveform = "stroke") on the scene's asynchronous regions, in virtual time: the
  * tool moved by the ContactTrajectory from the contact node's rest position, touching through a
- * ProxyContact on the primary region (AsyncRegions::StepPrimaryLoaded), its spring force held
- * over the primary's substeps of a period. Whenever the lattice node nearest the proxy is no
- * longer the one the primary is centred on, the primary follows it: new regions around that node
- * (clamped one node inside the face's rim, so that its normal stays the face's), started from the
- * object's motion as the old regions had it. The proxy's surface point lies in both primaries,
- * so the force does not step at a move.
+ * ProxyContact on the primary region (AsyncRegions::StepPrimaryLoaded), the proxy updated at each
+ * of the primary's substeps with the tool on its path. Whenever the proxy is more than ¾ of a node
+ * from the node the primary is centred on, the primary follows it: new regions around the node
+ * nearest the proxy (if that node is inside the face, so its normal is the face's), started from
+ * the object's motion as the old regions had it. The nodes the proxy's tip touches lie in both
+ * primaries, so the force does not step at a move.
  *
  * Ends as the reference does (TrialOutcome): the proxy at the face's edge (kLeftSurface), a state
- * that is not finite, energy beyond the passivity budget or the runaway watch (kDivergedEnergy).
- * @throws Error for a scene whose regions cannot be made (ValidateScene; adaptivity off).
+ * that is not finite, energy beyond the passivity budget or the runaway watch (kDivergedEnergy);
+ * and a proxy that slid out of the primary within one period, inside the face (kDivergedContact).
+ * @throws Error for a scene whose regions cannot be made (ValidateScene; adaptivity off), or
+ * whose adaptivity.primary_size cannot reach the tip's nodes (⌈contact.radius / h⌉ + 1, at least
+ * 2).
  */
 RegionStrokeResult RunRegionStroke(const Scene& scene);
 

@@ -134,7 +134,7 @@ bool ProxyContact::PatchAt(const std::array<double, 2>& proxy, Patch* corners) c
   return true;
 }
 
-// A tip wider than a cell: every face node of the object within reach_ of the proxy, weighted
+// A tip wider than a cell: every face node within reach_ of the proxy along both tangents, weighted
 // (1 − |Δ1|/r)(1 − |Δ2|/r) (r = reach_ in spacings), the weights normalised to sum 1.
 bool ProxyContact::TentPatch(const std::array<double, 2>& proxy, Patch* patch) const {
   const std::array<int, 3>& n = surface_.lattice_nodes;
@@ -152,8 +152,10 @@ bool ProxyContact::TentPatch(const std::array<double, 2>& proxy, Patch* patch) c
       at[axis_] = plane_;
       at[t1_] = i1;
       at[t2_] = i2;
+      // The face's nodes: a corner of one of its exposed cells (one with no displacement in this
+      // state vector, hanging on another region's cells, makes the patch unreadable).
+      if (!(w > 0) || !OnFace(i1, i2, /*every=*/false)) continue;
       const int node = surface_.Node(at);
-      if (!(w > 0) || surface_.dof[static_cast<std::size_t>(node)] < 0) continue;
       patch->nodes[static_cast<std::size_t>(patch->count)] = node;
       patch->weights[static_cast<std::size_t>(patch->count)] = w;
       ++patch->count;
@@ -162,6 +164,24 @@ bool ProxyContact::TentPatch(const std::array<double, 2>& proxy, Patch* patch) c
   }
   for (int k = 0; k < patch->count; ++k) patch->weights[static_cast<std::size_t>(k)] /= sum;
   return patch->count > 0;
+}
+
+bool ProxyContact::Readable(const Patch& patch) const {
+  for (int k = 0; k < patch.count; ++k) {
+    if (surface_.dof[static_cast<std::size_t>(patch.nodes[static_cast<std::size_t>(k)])] < 0)
+      return false;
+  }
+  return true;
+}
+
+bool ProxyContact::OnFace(int i1, int i2, bool every) const {
+  int exposed = 0;
+  for (int k = 0; k < 4; ++k) exposed += ExposedFace(i1 - 1 + (k & 1), i2 - 1 + (k >> 1)) ? 1 : 0;
+  return every ? exposed == 4 : exposed > 0;
+}
+
+bool ProxyContact::InsideFace(const LatticeIndex& node) const {
+  return node[axis_] == plane_ && OnFace(node[t1_], node[t2_], /*every=*/true);
 }
 
 bool ProxyContact::Reachable(const Patch& patch) const {
@@ -204,7 +224,8 @@ LatticeIndex ProxyContact::NearestNode() const {
 }
 
 ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
-                                          const Eigen::VectorXd& u, std::span<double> loads) {
+                                          const Eigen::VectorXd& u,
+                                          std::span<double> loads) noexcept {
   std::fill(loads.begin(), loads.end(), 0.0);
   Result result;
   Patch corners;
@@ -218,7 +239,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     result.left_surface = true;
     return result;
   }
-  if (!Reachable(corners)) {
+  if (!Readable(corners)) {
     result.left_region = true;
     return result;
   }
@@ -227,6 +248,10 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   if (depth <= 0) {  // out of contact: the proxy waits under the tool
     proxy_ = {tool_m[t1_] / h, tool_m[t2_] / h};
     sliding_ = false;
+    return result;
+  }
+  if (!Reachable(corners)) {  // in contact where this surface cannot push
+    result.left_region = true;
     return result;
   }
   const double k = contact_.stiffness_n_per_m;
@@ -242,7 +267,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
       result.left_surface = true;
       return result;
     }
-    if (!Reachable(corners)) {
+    if (!Readable(corners) || !Reachable(corners)) {
       result.left_region = true;
       return result;
     }

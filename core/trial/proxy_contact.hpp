@@ -41,8 +41,9 @@ ProxySurface ProxySurfaceOf(const ElasticModel& model);
  * inside, the spring pushes the surface at the proxy (spread over the face cell's 4 nodes with
  * the bilinear weights of where the proxy is in it) and the user feels the opposite force.
  *
- * A tip of contact.radius r wider than a cell spreads the push over the face nodes within r of the
- * proxy instead, with tent weights (1 − |Δ1|/r)(1 − |Δ2|/r), and reads the surface there: on a
+ * A tip of contact.radius r wider than a cell spreads the push over the face nodes less than r from
+ * the proxy along both tangents (a square) instead, with tent weights (1 − |Δ1|/r)(1 − |Δ2|/r)
+ * normalised to sum 1, and reads the surface there: on a
  * lattice finer than the press is deep, a push on one cell's nodes dimples the surface under the
  * proxy, and sliding over its own dimple the proxy was measured to diverge.
  *
@@ -95,13 +96,16 @@ class ProxyContact {
     bool left_region = false;
   };
   /** One period: the proxy moved for the tool at `tool_m` (grid frame, m) over the state `u`,
-   *  and the loads on loaded_dofs() written to `loads`. */
+   *  and the loads on loaded_dofs() written to `loads`. Never allocates or throws. */
   Result Update(const std::array<double, 3>& tool_m, const Eigen::VectorXd& u,
-                std::span<double> loads);
+                std::span<double> loads) noexcept;
   /** The proxy's rest position on the face, m (grid frame). */
   std::array<double, 3> proxy_rest_m() const;
-  /** The lattice node of the face nearest the proxy. */
+  /** The lattice node of the face's plane nearest the proxy. */
   LatticeIndex NearestNode() const;
+  /** Whether `node` is inside the face: on its plane, each of the four cells around it an
+   *  exposed face of the object (its inward normal is the face's, not a rim's). */
+  bool InsideFace(const LatticeIndex& node) const;
 
  private:
   // The widest tip, in lattice spacings, and the most nodes it can touch.
@@ -120,8 +124,12 @@ class ProxyContact {
   // The deformed surface point at the proxy: the patch's weighted displacement.
   std::array<double, 3> SurfacePoint(const Patch& patch, const Eigen::VectorXd& u) const;
   bool ExposedFace(int i1, int i2) const;
-  // Whether every node of the patch is pushable or held (ProxySurface::loadable ≥ 0).
+  // Whether every node of the patch has its displacement in the state vector (ProxySurface::dof),
+  // and whether every one is pushable or held (ProxySurface::loadable ≥ 0).
+  bool Readable(const Patch& patch) const;
   bool Reachable(const Patch& patch) const;
+  // Whether the face cells around node (i1, i2) of the plane are exposed: any one, or `every`.
+  bool OnFace(int i1, int i2, bool every) const;
 
   ProxySurface surface_;
   ContactSettings contact_;

@@ -8,7 +8,8 @@ Usage: stroke.py [--hapticsim PATH] [--scene FILE.toml] [--out DIR]
 
 Writes DIR/stroke.csv (the tool's x in mm, the normal and the lateral force on the user in N, one
 row per millisecond of the slide) and DIR/stroke.svg, and prints the normal force over the
-inclusion's centre against plain tissue (x = 15 and 65 mm), with the scene's friction.
+inclusion's centre against plain tissue (x = 15 and 65 mm; each the mean within 2.5 mm), with
+the scene's friction.
 Make the phantom first: python3 make_phantom.py phantom.nii (next to the scene)."""
 import csv
 import json
@@ -62,7 +63,9 @@ def main():
         "Stroke: normal force against the tool's position (a 5 mm tip sliding 60 mm)")
 
     def at(x_mm):
-        return min(points, key=lambda p: abs(p[0] - x_mm))[1]
+        # The mean over a voxel either side: one sample is one moment of stick and slip.
+        near = [force for x, force in points if abs(x - x_mm) <= 2.5]
+        return sum(near) / len(near)
 
     plain = (at(15.0) + at(65.0)) / 2
     print(json.dumps({"samples": len(points), "primary_moves": run.get("primary_moves"),

@@ -84,6 +84,7 @@ TEST(RegionStroke, OnceSlidingTheLateralForceIsTheKineticFrictionTimesTheNormal)
     if (!run.stroke.proxy[i].sliding) continue;
     ++sliding;
     worst = std::max(worst, Lateral(samples[i]) / Normal(samples[i]));
+    EXPECT_GE(Lateral(samples[i]), 0.95 * 0.4 * Normal(samples[i])) << "t = " << samples[i].t_s;
   }
   std::printf("sliding in %d of %zu periods: lateral at most %.4f × normal\n", sliding,
               samples.size(), worst);
@@ -241,6 +242,20 @@ TEST(RegionStroke, AWideTipNeedsAPrimaryThatReachesIt) {
     EXPECT_NE(std::string(e.what()).find("adaptivity.primary_size >= 3"), std::string::npos)
         << e.what();
   }
+}
+
+// A tip of one and a half spacings touches nodes up to two from a proxy that has slid up to ¾
+// of a node from the primary's centre: a primary of two nodes is refused, of three it strokes.
+TEST(RegionStroke, ATipOfOneAndAHalfSpacingsNeedsAPrimaryOfThreeNodes) {
+  Scene scene = Stroke(0.5, 0.4, kLongStroke);
+  scene.contact.radius_m = 1.5 * 0.25 / 12;
+  scene.adaptivity.primary_size = 2;
+  EXPECT_THROW(RunRegionStroke(scene), Error);
+  scene.adaptivity.primary_size = 3;
+  const RegionStrokeResult run = RunRegionStroke(scene);
+  EXPECT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted)
+      << TrialOutcomeName(run.stroke.trial.outcome);
+  EXPECT_GE(run.moves.size(), 3u);
 }
 
 TEST(RegionStroke, ThePrimaryMustReachTwoNodesFromTheProxy) {

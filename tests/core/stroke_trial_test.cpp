@@ -10,12 +10,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "core/error.hpp"
 #include "core/fem/static_solver.hpp"
 #include "core/trial/force_error.hpp"
+#include "core/trial/proxy_contact.hpp"
 
 namespace hapticsim {
 namespace {
@@ -47,6 +49,8 @@ TEST(StrokeTrial, OnceSlidingTheLateralForceIsTheKineticFrictionTimesTheNormal) 
     const ForceSample& s = run.trial.samples[i];
     worst = std::max(worst, Lateral(s) / Normal(s));
     EXPECT_LE(Lateral(s), 1.05 * 0.4 * Normal(s)) << "t = " << s.t_s;
+    // … and no less: a sliding proxy holds the pull at μ_k times the push.
+    EXPECT_GE(Lateral(s), 0.95 * 0.4 * Normal(s)) << "t = " << s.t_s;
   }
   std::printf("sliding in %d of %zu periods; largest lateral/normal while sliding %.4f\n",
               sliding, run.proxy.size(), worst);
@@ -159,6 +163,53 @@ TEST(StrokeTrial, APeriodPastTheLimitIsSubsteppedWhenAReferenceAsksAndMatchesAFi
   std::printf("%d substeps of a 1 ms period against 25 µs steps: relative L2 %.3f %%\n",
               substepped.trial.substeps, e.l2_percent);
   EXPECT_LT(e.l2_percent, 2.0);
+}
+
+// The tip's patch: its loads add up to the spring's force (the weights sum to one), a tip centred
+// on a node pushes the nodes around it symmetrically, and a tip narrower than a cell is the cell's
+// bilinear patch, to the bit. A still press, no friction in play: the first contact period.
+TEST(ProxyContact, ATipsLoadsSumToItsForceSymmetricallyAndANarrowTipIsTheCells) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.mesh.nodes = 9;
+  const SceneModel object(scene);
+  const ElasticModel& model = object.model();
+  const double h = model.grid().spacing();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(model.grid().num_dofs());
+  auto loads_of = [&](double radius_m, const std::array<double, 3>& tool) {
+    ContactSettings contact = scene.contact;
+    contact.radius_m = radius_m;
+    ProxyContact proxy(model, object.contact_node(), object.contact_normal(), contact);
+    std::vector<double> loads(proxy.loaded_dofs().size(), 0.0);
+    const ProxyContact::Result touch = proxy.Update(tool, u, loads);
+    EXPECT_TRUE(touch.in_contact);
+    std::array<double, 3> sum{};
+    for (std::size_t i = 0; i < loads.size(); ++i) sum[i % 3] += loads[i];
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], touch.force_on_object_n[c], 1e-12);
+    return loads;
+  };
+  const std::array<double, 3> start =
+      ProxyContact(model, object.contact_node(), object.contact_normal(), scene.contact).start_m();
+  const std::array<double, 3> pressed = {start[0], start[1], start[2] + 0.002};
+  // Centred on the node: 2.5 spacings reach 2 nodes each way, 25 nodes, mirror-symmetric.
+  const std::vector<double> wide = loads_of(2.5 * h, pressed);
+  int pushed = 0;
+  for (std::size_t i = 2; i < wide.size(); i += 3) pushed += wide[i] > 0 ? 1 : 0;
+  EXPECT_EQ(pushed, 25);
+  const LatticeIndex c = model.grid().NodeIndices(object.contact_node());
+  const auto z_load = [&](int dx, int dy) {
+    const int node = model.grid().Node(c[0] + dx, c[1] + dy, c[2]);
+    const auto& dofs =
+        ProxyContact(model, object.contact_node(), object.contact_normal(), scene.contact)
+            .loaded_dofs();
+    const auto at = std::find(dofs.begin(), dofs.end(), model.grid().Dof(node, 2));
+    return wide[static_cast<std::size_t>(at - dofs.begin())];
+  };
+  EXPECT_DOUBLE_EQ(z_load(1, 2), z_load(-1, -2));
+  EXPECT_DOUBLE_EQ(z_load(2, 1), z_load(-2, 1));
+  EXPECT_GT(z_load(0, 0), z_load(1, 0));
+  // Off the node, a tip of 0.9 spacings is the cell's bilinear patch: equal to the bit.
+  const std::array<double, 3> off = {start[0] + 0.3 * h, start[1] + 0.6 * h, start[2] + 0.002};
+  EXPECT_EQ(loads_of(0.9 * h, off), loads_of(0.0, off));
 }
 
 TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
