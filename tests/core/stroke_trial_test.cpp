@@ -187,8 +187,9 @@ TEST(ProxyContact, ATipsLoadsSumToItsForceSymmetricallyAndANarrowTipIsTheCells) 
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], touch.force_on_object_n[c], 1e-12);
     return loads;
   };
-  const std::array<double, 3> start =
-      ProxyContact(model, object.contact_node(), object.contact_normal(), scene.contact).start_m();
+  const ProxyContact narrow(model, object.contact_node(), object.contact_normal(), scene.contact);
+  const std::array<double, 3> start = narrow.start_m();
+  const std::vector<int>& dofs = narrow.loaded_dofs();  // every tip loads the face's nodes so
   const std::array<double, 3> pressed = {start[0], start[1], start[2] + 0.002};
   // Centred on the node: 2.5 spacings reach 2 nodes each way, 25 nodes, mirror-symmetric.
   const std::vector<double> wide = loads_of(2.5 * h, pressed);
@@ -198,9 +199,6 @@ TEST(ProxyContact, ATipsLoadsSumToItsForceSymmetricallyAndANarrowTipIsTheCells) 
   const LatticeIndex c = model.grid().NodeIndices(object.contact_node());
   const auto z_load = [&](int dx, int dy) {
     const int node = model.grid().Node(c[0] + dx, c[1] + dy, c[2]);
-    const auto& dofs =
-        ProxyContact(model, object.contact_node(), object.contact_normal(), scene.contact)
-            .loaded_dofs();
     const auto at = std::find(dofs.begin(), dofs.end(), model.grid().Dof(node, 2));
     return wide[static_cast<std::size_t>(at - dofs.begin())];
   };
