@@ -283,6 +283,8 @@ class AsyncRegions {
 
   /** The energy balance since Reset. One thread, while no steps run. */
   EnergyAccount Energies() noexcept;
+  /** Its input_work_j alone, without the stored energy's K·u. */
+  double InputWorkJ() const noexcept;
 
   /** The balance as the running threads see it (PublishedBalance). */
   struct PublishedBalanceView {

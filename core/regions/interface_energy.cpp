@@ -251,6 +251,12 @@ EnergyAccount AsyncRegions::Energies() noexcept {
   return account;
 }
 
+double AsyncRegions::InputWorkJ() const noexcept {
+  double work = 0;
+  for (const auto& region : regions_) work += region->input_work;
+  return work;
+}
+
 AsyncRegions::PublishedBalanceView AsyncRegions::PublishedBalance() const noexcept {
   PublishedBalanceView view;
   for (int a = 0; a < num_regions(); ++a) {

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/regions/async_regions.hpp"
+#include "core/regions/trial_divergence.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/trial/proxy_contact.hpp"
 #include "core/trial/trial_recorder.hpp"
@@ -13,12 +14,12 @@
 namespace hapticsim {
 namespace {
 
-// Regions around `centre`, started from `state` (or from rest).
+// Regions around `centre`, started from `state`.
 std::unique_ptr<AsyncRegions> RegionsAround(Scene scene, const LatticeIndex& centre,
-                                            const ObjectState* state) {
+                                            const ObjectState& state) {
   scene.input.contact_node = centre;
   auto regions = std::make_unique<AsyncRegions>(scene);
-  if (state != nullptr) regions->RestoreState(*state);
+  regions->RestoreState(state);
   return regions;
 }
 
@@ -151,18 +152,10 @@ class StrokeRun {
   // when the trial ends.
   bool WithinBudget() {
     const AsyncRegions::PublishedBalanceView balance = regions_->PublishedBalance();
-    const double work = work_before_j_ + regions_->Energies().input_work_j;
-    if (!std::isfinite(balance.state_energy_j)) {
-      recorder_.Stop(TrialOutcome::kDivergedNonFinite);
-      return false;
-    }
-    if (balance.state_energy_j > AsyncRegions::kEnergyGrowthFactor * (budget_j_ + work) &&
-        balance.state_energy_j > 0) {
-      recorder_.Stop(TrialOutcome::kDivergedEnergy);
-      return false;
-    }
-    if (regions_->RunawayHeld(balance, &runaway_periods_)) {
-      recorder_.Stop(TrialOutcome::kDivergedEnergy, /*runaway=*/true);
+    const double work = work_before_j_ + regions_->InputWorkJ();
+    if (const auto stop = DivergedAfterPeriod(*regions_, balance, balance.state_energy_j,
+                                              budget_j_ + work, &runaway_periods_)) {
+      recorder_.Stop(stop->outcome, stop->runaway);
       return false;
     }
     return true;
@@ -172,8 +165,8 @@ class StrokeRun {
   void MoveTo(const LatticeIndex& next, long n) {
     const ObjectState state = regions_->CaptureState();
     Accumulate(*regions_, &out_);
-    work_before_j_ += regions_->Energies().input_work_j;
-    regions_ = RegionsAround(scene_, next, &state);
+    work_before_j_ += regions_->InputWorkJ();
+    regions_ = RegionsAround(scene_, next, state);
     proxy_.Rebind(regions_->partition().PrimaryProxySurface());
     CheckAgree(proxy_, *regions_);
     loads_.assign(proxy_.loaded_dofs().size(), 0.0);

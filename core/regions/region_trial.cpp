@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/regions/async_regions.hpp"
 #include "core/regions/async_regions_region.hpp"
+#include "core/regions/trial_divergence.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/trial/trial_recorder.hpp"
 
@@ -69,18 +70,13 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
     const PublishedBalanceView balance = PublishedBalance();
     const double energy =
         control_ != InterfaceControl::kOff ? balance.state_energy_j : KineticEnergy();
-    if (!std::isfinite(energy) || !std::isfinite(r[0] + r[1] + r[2])) {
+    if (!std::isfinite(r[0] + r[1] + r[2])) {
       recorder.Stop(TrialOutcome::kDivergedNonFinite);
       break;
     }
-    if (energy > kEnergyGrowthFactor * (budget + work) && energy > 0) {
-      recorder.Stop(TrialOutcome::kDivergedEnergy);
-      break;
-    }
-    // What the daemon watches for, with the same numbers: a trial it would have taken off these
-    // regions is not a sample of them.
-    if (RunawayHeld(balance, &runaway_periods)) {
-      recorder.Stop(TrialOutcome::kDivergedEnergy, /*runaway=*/true);
+    if (const auto stop =
+            DivergedAfterPeriod(*this, balance, energy, budget + work, &runaway_periods)) {
+      recorder.Stop(stop->outcome, stop->runaway);
       break;
     }
     recorder.Record(n, r);
