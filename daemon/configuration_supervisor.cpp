@@ -220,16 +220,18 @@ bool ConfigurationSupervisor::MoveRegions(std::int64_t now) {
   const std::optional<LatticeIndex> wanted = loop_.wanted_contact_node();
   if (wanted != hover_node_) hover_node_ = wanted, hover_since_ns_ = now;
   const bool waiting = loop_.contact_waiting();
+  const bool following = loop_.contact_following();  // a sliding tool: at once, motion carried
   // Where a pending configuration goes: a hovered node once the object has settled, else here.
   const LatticeIndex pending_node =
       settled ? wanted.value_or(loop_.centre_node()) : loop_.centre_node();
-  if (!mover_.busy() || (waiting && mover_.may_interrupt())) {
+  if (!mover_.busy() || ((waiting || following) && mover_.may_interrupt())) {
     std::optional<RegionsMover::Request> request;
-    if (pending_ && !waiting) {
+    if (pending_ && !waiting && !following) {
       request = {pending_->configuration, pending_node, true, false};
     } else if (wanted && *wanted != loop_.centre_node() &&
-               (waiting || (settled && (now - hover_since_ns_) * 1e-9 >= kHoverBeforeRecentre_s))) {
-      request = {decision_.configuration, *wanted, false, waiting};
+               (waiting || following ||
+                (settled && (now - hover_since_ns_) * 1e-9 >= kHoverBeforeRecentre_s))) {
+      request = {decision_.configuration, *wanted, false, waiting || following, following};
     }
     if (request && mover_.may_ask(*request)) mover_.Ask(*request, now);
   }

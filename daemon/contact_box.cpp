@@ -51,6 +51,28 @@ bool ContactBox::OnSurface(const LatticeIndex& node) const noexcept {
   return false;
 }
 
+bool ContactBox::Inside(const std::array<double, 3>& tip_m) const noexcept {
+  bool inside = true;
+  for (int c = 0; c < 3; ++c) inside = inside && tip_m[c] > 0 && tip_m[c] < extent_m_[c];
+  return inside;
+}
+
+ContactBox::Entry ContactBox::EntryOf(const std::array<double, 3>& tip_m) const noexcept {
+  int axis = 2;
+  double face = 0, depth = tip_m[2];
+  for (int c : {2, 0, 1}) {
+    if (tip_m[c] < depth) depth = tip_m[c], axis = c, face = 0;
+    if (extent_m_[c] - tip_m[c] < depth)
+      depth = extent_m_[c] - tip_m[c], axis = c, face = extent_m_[c];
+  }
+  Entry entry;
+  entry.point_m = tip_m;
+  entry.point_m[axis] = face;
+  entry.inward_normal[axis] = face == 0 ? 1.0 : -1.0;
+  entry.depth_m = depth;
+  return entry;
+}
+
 bool ContactBox::Drivable(const LatticeIndex& node) const noexcept {
   for (int c = 0; c < 3; ++c) {
     if (node[c] < 0 || node[c] >= nodes_[c]) return false;

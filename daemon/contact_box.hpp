@@ -33,6 +33,17 @@ class ContactBox {
   /** The box's size along each axis, m: (n − 1)·h. */
   const std::array<double, 3>& extent_m() const { return extent_m_; }
 
+  /** True for a tool tip strictly inside the box, m (object frame). */
+  bool Inside(const std::array<double, 3>& tip_m) const noexcept;
+  /** Where a tip inside the box came in: the face it is least deep behind (the front face first
+   *  on a tie), the tip projected onto it, its inward normal and the tip's depth behind it. */
+  struct Entry {
+    std::array<double, 3> point_m{};
+    std::array<double, 3> inward_normal{};
+    double depth_m = 0;
+  };
+  Entry EntryOf(const std::array<double, 3>& tip_m) const noexcept;
+
   /** True for a node on the box's surface (some index 0 or n − 1) that no support holds. */
   bool Drivable(const LatticeIndex& node) const noexcept;
 
@@ -46,6 +57,14 @@ class ContactBox {
    */
   std::optional<LatticeIndex> NearestDrivable(
       const std::array<double, 3>& surface_point_m) const noexcept;
+
+  /** NearestDrivable of the point of the box nearest to `tip_m` (a tip outside: the node it
+   *  hovers over). */
+  std::optional<LatticeIndex> NearestDrivableTo(const std::array<double, 3>& tip_m) const noexcept {
+    std::array<double, 3> nearest = tip_m;
+    for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, extent_m_[c]);
+    return NearestDrivable(nearest);
+  }
 
   /** A node as one integer, (ix · ny + iy) · nz + iz (the order of the regions' surface ids),
    *  for an atomic; Decode gives it back. */

@@ -27,31 +27,20 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   if (held_) fresh_tips_ = 0;  // a gap: its jump is the stale ramp's
   const bool after_gap = held_;
   held_ = false;
-  const std::array<double, 3>& edge = box_.extent_m();
-  bool inside = true;
-  for (int c = 0; c < 3; ++c) inside = inside && tip_m[c] > 0 && tip_m[c] < edge[c];
-  if (!inside) {
+  if (!box_.Inside(tip_m)) {
     state_ = State::kFree;
     fresh_tips_ = 0;
-    std::array<double, 3> nearest = tip_m;
-    for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, edge[c]);
-    wanted_ = NearestContactNode(nearest);
+    wanted_ = box_.NearestDrivableTo(tip_m);
     return {};
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
     // Touch-down through the face the tip is least deep behind (front face first on a tie, as
     // InwardNormal orders them).
-    int axis = 2;
-    double face = 0, depth = tip_m[2];
-    for (int c : {2, 0, 1}) {
-      if (tip_m[c] < depth) depth = tip_m[c], axis = c, face = 0;
-      if (edge[c] - tip_m[c] < depth) depth = edge[c] - tip_m[c], axis = c, face = edge[c];
-    }
-    entry_ = tip_m;
-    entry_[axis] = face;
-    inward_ = {0, 0, 0};
-    inward_[axis] = face == 0 ? 1.0 : -1.0;
+    const ContactBox::Entry entry = box_.EntryOf(tip_m);
+    entry_ = entry.point_m;
+    inward_ = entry.inward_normal;
+    const double depth = entry.depth_m;
     const std::optional<LatticeIndex> node = NearestContactNode(entry_);
     wanted_ = node;
     if (!node) {

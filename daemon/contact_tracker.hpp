@@ -50,6 +50,9 @@ class ContactTracker {
     std::array<double, 3> displacement_m{};  ///< of the contact node (zero unless engaged)
     std::array<double, 3> inward_normal{};   ///< the entry face's, into the object (0: none)
     std::array<double, 3> point_m{};  ///< where the driven node is: entry point + displacement
+    /// A sliding contact's (SlidingContact): the regions should follow the proxy onto the wanted
+    /// node, the object's motion carried, at once.
+    bool following = false;
   };
 
   /**

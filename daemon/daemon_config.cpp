@@ -15,6 +15,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "core/regions/proxy_following.hpp"
 #include "core/scene/scene_toml.hpp"
 #include "daemon/contact_box.hpp"
 #include "daemon/supervisor.hpp"
@@ -258,15 +259,14 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(url_problem.empty(), url_problem);
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
-  require(c.scene.input.waveform != Waveform::kStroke,
-          "the scene file's input.waveform = \"stroke\": hapticsimd drives the contact from the "
-          "device, and a stroke's sliding proxy is not served yet; remove input.waveform from "
-          "the scene (the daemon's contact is the device's)");
   ValidateScene(c.scene);
   // The contact tracker, the input guard and the deformation output take the object to be the
   // box of its lattice (ContactBox): a scene whose object leaves voxels empty is refused here.
   const std::string not_a_box = BoxObjectProblem(DescribeSceneObject(c.scene));
   require(not_a_box.empty(), not_a_box);
+  // A sliding tool's primary follows its proxy and must reach every node its tip touches.
+  if (UsesProxyContact(c.scene))
+    CheckPrimaryReachesTip(c.scene, ContactBox::Of(c.scene).spacing_m());
 }
 
 std::string LcmUrlProblem(const std::string& url, bool allow_network) {

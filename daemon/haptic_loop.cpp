@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/regions/proxy_following.hpp"
 #include "rt/monotonic_clock.hpp"
 
 namespace hapticsim {
@@ -30,6 +31,10 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
       box_(ContactBox::Of(scene)),
       contact_(box_, options.engage_ramp_s),
       guard_(options.port, 1e-3) {
+  if (UsesProxyContact(scene)) {
+    CheckPrimaryReachesTip(scene, box_.spacing_m());
+    sliding_.emplace(box_, scene.contact, options.engage_ramp_s);
+  }
   Install(scene, std::make_unique<AsyncRegions>(scene));
   guard_ =
       PortGuard(options.port, primary_period_ns_ * 1e-9,
@@ -113,9 +118,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   if (usable) held_centre_ = centre_;
   const std::optional<LatticeIndex> centre =
       usable || holding ? std::optional<LatticeIndex>(held_centre_) : std::nullopt;
-  const ContactTracker::Contact contact =
-      have && !stale ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
-                     : contact_.Hold(release_ns, centre);
+  const ContactTracker::Contact contact = TrackContact(have && !stale, release_ns, centre);
   const bool in_contact = contact.engaged && (usable || holding);
   if (usable) engaged_ = in_contact;
   if (!contact.engaged) holding_ = false;  // lifted off while held: a new touch is not held
@@ -134,9 +137,21 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   PublishPeriod(now_ns, sent.force_n, simulated_n, flags);
 }
 
+ContactTracker::Contact HapticLoop::TrackContact(
+    bool fresh, std::int64_t release_ns, const std::optional<LatticeIndex>& centre) noexcept {
+  if (sliding_) {
+    return fresh ? sliding_->Update(tip_.TipAt(release_ns), release_ns, centre)
+                 : sliding_->Hold(release_ns, centre);
+  }
+  return fresh ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
+               : contact_.Hold(release_ns, centre);
+}
+
 void HapticLoop::PublishContactRequest(const ContactTracker::Contact& contact) noexcept {
   counters_.contact_waiting.Set(contact.waiting);
-  const std::optional<LatticeIndex> wanted = contact_.wanted_node();
+  counters_.contact_following.Set(contact.following);
+  const std::optional<LatticeIndex> wanted =
+      sliding_ ? sliding_->wanted_node() : contact_.wanted_node();
   counters_.wanted_node_code.Set(wanted ? box_.Code(*wanted) : -1);
 }
 
@@ -151,7 +166,8 @@ std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,
   // period, with the secondaries restarted on this release.
   if (sleep_state_ == kAsleep && contact.engaged) WakeSecondaries(release_ns);
   if (sleep_state_ != kAsleep) {
-    reaction = StepPrimaryPeriod(contact.displacement_m);
+    reaction = sliding_ ? sliding_->StepPeriod(*regions_, release_ns)
+                        : StepPrimaryPeriod(contact.displacement_m);
     // Only here: while paused for a reconfiguration the regions are not the primary's to read.
     if (regions_->primary_boundary_age_s() > kStaleBoundary_s) {
       *flags |= force_flags::kBoundaryStale;
@@ -208,17 +224,21 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
   switch (handover_.TakeRestart()) {
     case RegionRestart::kFromRest:
       contact_.RestartFromRest();
+      if (sliding_) sliding_->RestartFromRest();
       restarted_since_fault_ = guard_.latched();
       guard_.Reengage();
       break;
     case RegionRestart::kKeepingContact:
       contact_.RestartKeepingContact();
+      if (sliding_) sliding_->RestartKeepingContact();
       guard_.Reengage();
       break;
     case RegionRestart::kCarryingMotion:
-      // The new regions hold the contact where the last period before the pause left it.
-      contact_.CatchUpFrom(regions_->primary_contact_m(),
-                           release_ns - static_cast<std::int64_t>(primary_period_ns_));
+      // The new regions hold the contact where the last period before the pause left it (a
+      // sliding tool's proxy goes on where it was: Install bound it to them).
+      if (!sliding_)
+        contact_.CatchUpFrom(regions_->primary_contact_m(),
+                             release_ns - static_cast<std::int64_t>(primary_period_ns_));
       break;
     case RegionRestart::kNone:
       return;
@@ -294,7 +314,8 @@ void HapticLoop::UpdateFaultState(const PortGuard::Output& sent) noexcept {
     counters_.force_faults.Add();  // the supervisor restarts the regions
   }
   // Re-armed only from rest with the tool out of the object: the next touch engages from zero.
-  if (guard_.latched() && restarted_since_fault_ && contact_.outside()) {
+  const bool outside = sliding_ ? sliding_->outside() : contact_.outside();
+  if (guard_.latched() && restarted_since_fault_ && outside) {
     guard_.Rearm();
     restarted_since_fault_ = false;
     counters_.fault_latched.Set(false);

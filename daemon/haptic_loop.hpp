@@ -19,6 +19,7 @@
 #include "daemon/port_guard.hpp"
 #include "daemon/region_handover.hpp"
 #include "daemon/secondary_parking.hpp"
+#include "daemon/sliding_contact.hpp"
 #include "rt/deadline_monitor.hpp"
 #include "rt/spsc_ring.hpp"
 
@@ -130,7 +131,8 @@ class HapticLoop {
     /** Around the same centre, from the old regions' motion (AsyncRegions::CaptureState and
      *  RestoreState): a tool inside feels the force it felt, held for the periods the regions
      *  are being installed, and the contact node catches up with the tip from where it was held
-     *  (ContactTracker::CatchUpFrom). A configuration switched in contact. */
+     *  (ContactTracker::CatchUpFrom). A configuration switched in contact. With a sliding tool
+     *  also around another node: the regions following its proxy, which goes on where it was. */
     kCarryMotion,
   };
   /**
@@ -174,6 +176,11 @@ class HapticLoop {
   std::optional<LatticeIndex> wanted_contact_node() const;
   /** True while the tip is inside on a node the regions are not centred on (force zero). */
   bool contact_waiting() const { return counters_.contact_waiting.value(); }
+  /** True while a sliding tool's regions should follow its proxy onto wanted_contact_node(), the
+   *  object's motion carried (Handover::kCarryMotion onto another node). */
+  bool contact_following() const { return counters_.contact_following.value(); }
+  /** Whether the tool touches through a sliding proxy (contact.model = "proxy", SlidingContact). */
+  bool sliding_contact() const { return sliding_.has_value(); }
   /** The object as the tool meets it (its box and drivable nodes): fixed for the loop's life. */
   const ContactBox& contact_box() const { return box_; }
   /** The node the regions are centred on. Supervisor thread only. */
@@ -329,6 +336,10 @@ class HapticLoop {
   // Primary thread: one period's steps, the contact moved to `contact_m` over its substeps; the
   // reaction at the period's start, N.
   std::array<double, 3> StepPrimaryPeriod(const std::array<double, 3>& contact_m) noexcept;
+  // Primary thread: the period's contact, from the tip (fresh) or held — the node's or the
+  // sliding tool's.
+  ContactTracker::Contact TrackContact(bool fresh, std::int64_t release_ns,
+                                       const std::optional<LatticeIndex>& centre) noexcept;
   // Primary thread: the node the contact wants the regions on, for the supervisor.
   void PublishContactRequest(const ContactTracker::Contact& contact) noexcept;
   // Primary thread: the period's reaction at its start — stepped on regions that are its own,
@@ -412,8 +423,10 @@ class HapticLoop {
   // this many periods past the newest input and then held.
   static constexpr int kMaxPredictedPeriods = 10;
 
-  // Primary thread state.
+  // Primary thread state. A sliding tool (contact.model = "proxy") touches through sliding_
+  // instead of contact_; sliding_ is bound to the regions by Install.
   ContactTracker contact_;
+  std::optional<SlidingContact> sliding_;
   PortGuard guard_;
   bool restarted_since_fault_ = false;  // the regions restarted from rest after the latch
   InputResampler tip_{1e-3, kMaxPredictedPeriods * 1e-3};  // re-made for the primary's period

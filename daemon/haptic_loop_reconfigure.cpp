@@ -6,8 +6,9 @@
 #include <memory>
 
 #include "core/error.hpp"
-#include "rt/monotonic_clock.hpp"
+#include "core/regions/proxy_following.hpp"
 #include "daemon/haptic_loop.hpp"
+#include "rt/monotonic_clock.hpp"
 
 namespace hapticsim {
 
@@ -19,6 +20,7 @@ void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regio
     ++installs_;
   }
   centre_ = regions_->partition().contact_node();
+  if (sliding_) sliding_->Bind(*regions_);  // the primary leaves the regions alone meanwhile
   const int count = regions_->num_regions();
   tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
   auto nominal_ns = [&](int a) {
@@ -49,6 +51,7 @@ std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
 }
 
 void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
+  if (sliding_) CheckPrimaryReachesTip(scene, box_.spacing_m());  // the proxy's tip in the primary
   auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
   const auto& lattice = regions->partition().mesh().options();
   if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || lattice.lattice_nodes != box_.nodes() ||
@@ -56,7 +59,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
   }
   const bool carry = handover == Handover::kCarryMotion;
-  if (carry && regions->partition().contact_node() != centre_) {
+  if (carry && !sliding_ && regions->partition().contact_node() != centre_) {
     throw Error("the motion can be carried only to regions around the same contact node");
   }
   ++reconfigurations_;

@@ -72,6 +72,7 @@ struct LoopCounters {
   // The supervisor's requests from the primary.
   Relaxed<std::int64_t> wanted_node_code{-1};  ///< (ix · n + iy) · n + iz, −1: none
   Relaxed<bool> contact_waiting;
+  Relaxed<bool> contact_following;  ///< a sliding tool's regions should follow its proxy
 
   // Per secondary region, written by its own thread.
   std::array<RelaxedCount, kMaxRegions> stalls, skipped_periods;

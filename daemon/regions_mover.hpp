@@ -40,6 +40,9 @@ class RegionsMover {
     LatticeIndex node{};
     bool applies_pending = false;  ///< the supervisor's pending configuration change
     bool touch_waits = false;      ///< a touch waits for it: move at once, verify behind
+    /// A sliding tool's regions following its proxy (HapticLoop::contact_following): moved at
+    /// once like a waiting touch, the object's motion carried onto the new node.
+    bool follows_proxy = false;
   };
   /** Where the regions run: a configuration, centred on a node. */
   struct Placement {
@@ -65,10 +68,13 @@ class RegionsMover {
     /**
      * Whether the new regions start from the object's motion (HapticLoop::Handover::
      * kCarryMotion, a switch in contact): a verified configuration on the node they are centred
-     * on now. Onto another node, or demoted or moved back from a configuration that ran away or
-     * cannot run (whose motion is not to be kept), they start from rest, a touch ramped in.
+     * on now, or a move that follows a sliding tool's proxy. Onto another node otherwise, or
+     * demoted or moved back from a configuration that ran away or cannot run (whose motion is not
+     * to be kept), they start from rest, a touch ramped in.
      */
     bool CarriesMotionFrom(const LatticeIndex& centre) const {
+      if (request.follows_proxy)
+        return kind == Kind::kMoveVerified || kind == Kind::kMoveUnverified;
       return kind == Kind::kMoveVerified && to.node == centre;
     }
     /** The log line that says what happened. */

@@ -206,8 +206,12 @@ ModelTraits CurrentModel() {
 
 std::string CodeVersion() { return HAPTICSIM_CODE_VERSION; }
 
-ErrorMap RunSweep(const Scene& base, const SweepGrid& grid, const SweepOptions& options,
+ErrorMap RunSweep(const Scene& scene, const SweepGrid& grid, const SweepOptions& options,
                   SweepStats* stats_out) {
+  // The map is of the regions' error under a pressed node: a scene for hapticsimd's sliding tool
+  // (contact.model = "proxy") is swept with the node contact, its object and regions the same.
+  Scene base = scene;
+  base.contact.model = ContactModel::kNode;
   ValidateGrid(grid);
   HAPTICSIM_THROW_UNLESS(base.input.waveform != Waveform::kStroke,
                          "input.waveform = \"stroke\": an error map is swept over presses and "

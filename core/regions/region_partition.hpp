@@ -64,11 +64,12 @@ class RegionPartition {
   const std::vector<int>& outer_band_elements(RegionIndex region) const { return band_[region]; }
 
   /**
-   * Whether the tool touches through a sliding proxy (input.waveform = "stroke"): then the
+   * Whether the tool touches through a sliding proxy (SlidingContact: a stroke, or hapticsimd's
+   * contact.model = "proxy"): then the
    * contact node is free, one of the primary's owned nodes, and the proxy pushes the primary's
    * nodes on the contact's face (primary_proxy_surface) instead of a node being driven.
    */
-  bool proxy_contact() const { return scene_.input.waveform == Waveform::kStroke; }
+  bool proxy_contact() const { return UsesProxyContact(scene_); }
   /** The surface as the primary region's proxy touches it: the primary's own nodes (not Γ, not
    *  held) pushable, held nodes taking their share, every other node out of its reach. In the
    *  primary's state vector. Allocates. */

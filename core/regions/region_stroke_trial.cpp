@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/regions/async_regions.hpp"
+#include "core/regions/proxy_following.hpp"
 #include "core/regions/trial_divergence.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/trial/proxy_contact.hpp"
@@ -65,7 +66,7 @@ class StrokeRun {
             " points into the contact's face: a stroke moves along the face, "
             "choose one of the other two axes");
     CheckAgree(proxy_, *regions_);
-    CheckReach(scene);
+    CheckPrimaryReachesTip(scene, regions_->partition().mesh().options().spacing_m);
     out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
     out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
     loads_.assign(proxy_.loaded_dofs().size(), 0.0);
@@ -74,7 +75,8 @@ class StrokeRun {
 
   RegionStrokeResult Run() && {
     for (long n = 0; n <= steps_ && StepPeriod(n) && WithinBudget(); ++n) {
-      if (n < steps_ && FarFromCentre()) MoveTo(proxy_.NearestNode(), n);
+      if (n >= steps_) continue;
+      if (const std::optional<LatticeIndex> next = FollowTo()) MoveTo(*next, n);
     }
     out_.stroke.trial.wall_time_s = recorder_.ElapsedS();
     Accumulate(*regions_, &out_);
@@ -82,36 +84,9 @@ class StrokeRun {
   }
 
  private:
-  // Whether the primary should follow the proxy: it is more than kFollowAfter nodes from the
-  // centre along a tangent (a band above the half node a move leaves it at, so a proxy sliding
-  // on a node line does not move the regions to and fro), and the node nearest it is inside the
-  // face (its inward normal the face's: at the rim the primary stays, and a proxy that leaves it
-  // reaches the face's edge).
-  bool FarFromCentre() const {
-    const double spacing_m = regions_->partition().mesh().options().spacing_m;
-    const std::array<double, 3> at = proxy_.proxy_rest_m();
-    bool far = false;
-    for (int c = 0; c < 3; ++c)
-      far = far || std::abs(at[c] / spacing_m - centre_[c]) > kFollowAfter;
-    return far && proxy_.InsideFace(proxy_.NearestNode());
-  }
-  static constexpr double kFollowAfter = 0.75;  // nodes
-
-  // The proxy is within kFollowAfter nodes of the primary's centre at a period's start, and its
-  // tip reaches r = max(1, contact.radius / h) nodes from it (the cell under it: 1): a primary of
-  // ⌈r⌉ + 1 nodes keeps every node the tip touches off its interface with a quarter node to spare
-  // for the proxy's slide within the period.
-  void CheckReach(const Scene& scene) const {
-    const double spacing_m = regions_->partition().mesh().options().spacing_m;
-    const double reach = std::max(1.0, scene.contact.radius_m / spacing_m);
-    const int needed = static_cast<int>(std::ceil(reach)) + 1;
-    HAPTICSIM_THROW_UNLESS(scene.adaptivity.primary_size >= needed,
-                           "contact.radius = " + GetSceneValue(scene, "contact.radius") +
-                               " m reaches " + std::to_string(reach) + " lattice spacings of " +
-                               std::to_string(spacing_m) +
-                               " m from the proxy, and the primary region follows the proxy: set "
-                               "adaptivity.primary_size >= " +
-                               std::to_string(needed));
+  // Where the primary should follow the proxy to (ProxyWantsPrimaryAt), if anywhere.
+  std::optional<LatticeIndex> FollowTo() const {
+    return ProxyWantsPrimaryAt(proxy_, centre_, regions_->partition().mesh().options().spacing_m);
   }
 
   // Period n: the proxy touched and the primary stepped once per substep, the tool on its path at

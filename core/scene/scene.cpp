@@ -91,8 +91,9 @@ void ValidateStroke(const Scene& scene) {
   // a primary of two nodes each way keeps the cell off its interface.
   if (scene.adaptivity.enabled() && scene.adaptivity.primary_size < 2) {
     throw Error("adaptivity.primary_size = " + std::to_string(scene.adaptivity.primary_size) +
-                " is too small for a stroke: the primary region follows the proxy and must reach "
-                "two nodes from it; set adaptivity.primary_size >= 2 (or 0 for the "
+                " is too small for a sliding contact (a stroke, or contact.model = \"proxy\"): the "
+                "primary region follows the proxy and must reach two nodes from it; set "
+                "adaptivity.primary_size >= 2 (or 0 for the "
                 "full-resolution reference)");
   }
   if (scene.contact.kinetic_friction > scene.contact.static_friction) {
@@ -139,6 +140,10 @@ std::string_view WaveformName(Waveform waveform) {
   return "unknown";
 }
 
+bool UsesProxyContact(const Scene& scene) {
+  return scene.input.waveform == Waveform::kStroke || scene.contact.model == ContactModel::kProxy;
+}
+
 void ValidateScene(const Scene& scene) {
   // Each key alone: re-set it from its own value, which runs the key's range check.
   Scene copy = scene;
@@ -159,7 +164,7 @@ void ValidateScene(const Scene& scene) {
                 " steps for the trial of input.periods / input.frequency = " +
                 FormatReal(scene.duration_s()) + " s: solver.dt must give between 1 and 1e8 steps");
   }
-  if (scene.input.waveform == Waveform::kStroke) ValidateStroke(scene);
+  if (UsesProxyContact(scene)) ValidateStroke(scene);
   if (scene.adaptivity.enabled()) ValidateAdaptivity(scene);
 }
 

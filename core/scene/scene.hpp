@@ -92,7 +92,14 @@ struct InputSettings {
  * stays on it, joined to the tool by a spring; the proxy sticks until the spring's tangential
  * pull exceeds static_friction × its normal push, then slides keeping it at kinetic_friction ×.
  */
+/** How hapticsimd's contact meets the device's tool (contact.model). */
+enum class ContactModel {
+  kNode,   ///< the paper's: the touched surface node follows the tool tip, stuck until lift-off
+  kProxy,  ///< a tool that slides: a proxy on the surface, a spring and friction (as a stroke)
+};
+
 struct ContactSettings {
+  ContactModel model = ContactModel::kNode;  ///< hapticsimd's contact (contact.model)
   double static_friction = 0.5;      ///< μ_s (contact.static_friction)
   double kinetic_friction = 0.4;     ///< μ_k ≤ μ_s (contact.kinetic_friction)
   double stiffness_n_per_m = 1000;   ///< the proxy spring (contact.stiffness), N/m
@@ -152,6 +159,9 @@ struct Scene {
 };
 
 std::string_view WaveformName(Waveform waveform);
+/** Whether the tool touches `scene`'s object through a sliding proxy: a stroke always does, and
+ *  hapticsimd's device does with contact.model = "proxy". */
+bool UsesProxyContact(const Scene& scene);
 
 /** The shortest text that reads back to exactly `value` ("10000.0", "0.45", "1e-05"). */
 std::string FormatReal(double value);

@@ -248,8 +248,15 @@ void AddInputKeys(std::vector<KeyAccess>& keys) {
       [](Scene& s) -> double& { return s.solver.dt_s; }, [](double v) { return v > 0; }));
 }
 
-// The sliding contact of a stroke.
+// The sliding contact of a stroke, and of hapticsimd's tool with contact.model = "proxy".
 void AddContactKeys(std::vector<KeyAccess>& keys) {
+  keys.push_back(Choice(
+      {"contact.model", "", "\"node\" or \"proxy\"",
+       "hapticsimd's contact: node = the touched node follows the tool tip (the paper's); proxy = "
+       "a tool that slides (a proxy on the surface, a spring and friction; a stroke always "
+       "slides)"},
+      {"node", "proxy"}, [](const Scene& s) { return static_cast<int>(s.contact.model); },
+      [](Scene& s, int i) { s.contact.model = static_cast<ContactModel>(i); }));
   keys.push_back(Real(
       {"contact.static_friction", "", "finite and >= 0",
        "μ_s: the proxy sticks until the tangential force exceeds μ_s × the normal force"},

@@ -258,9 +258,10 @@ std::string FormatSceneToml(const Scene& scene) {
     // The cube's scene is written as it always was; [[material]] tables replace [material].
     if (section == "geometry" && !scene.geometry.from_file()) continue;
     if (section == "material" && !scene.materials.empty()) continue;
-    // A stroke's keys act only on a stroke: the press and the sine are written as they were.
+    // A stroke's keys act only on a sliding contact: the press and the sine are written as they
+    // were.
     const bool stroke_key = section == "contact" || name.rfind("input.stroke_", 0) == 0;
-    if (stroke_key && scene.input.waveform != Waveform::kStroke) continue;
+    if (stroke_key && !UsesProxyContact(scene)) continue;
     if (section != current_section) {
       out << (current_section.empty() ? "" : "\n") << "[" << section << "]\n";
       current_section = section;

@@ -204,6 +204,11 @@ std::array<double, 3> ProxyContact::SurfacePoint(const Patch& corners,
   return point;
 }
 
+void ProxyContact::PlaceUnder(const std::array<double, 3>& tool_m) noexcept {
+  proxy_ = {tool_m[t1_] / surface_.spacing_m, tool_m[t2_] / surface_.spacing_m};
+  sliding_ = false;
+}
+
 std::array<double, 3> ProxyContact::proxy_rest_m() const {
   const double h = surface_.spacing_m;
   std::array<double, 3> rest{};

@@ -99,6 +99,16 @@ class ProxyContact {
    *  and the loads on loaded_dofs() written to `loads`. Never allocates or throws. */
   Result Update(const std::array<double, 3>& tool_m, const Eigen::VectorXd& u,
                 std::span<double> loads) noexcept;
+  /** The proxy put under the tool at `tool_m` (a touch-down), sticking. Never allocates. */
+  void PlaceUnder(const std::array<double, 3>& tool_m) noexcept;
+  /** The face's inward normal (±e_axis). */
+  std::array<double, 3> inward_normal() const noexcept {
+    std::array<double, 3> normal{};
+    normal[static_cast<std::size_t>(axis_)] = sign_;
+    return normal;
+  }
+  /** Whether the proxy slides (it slid in the last update in contact). */
+  bool sliding() const noexcept { return sliding_; }
   /** The proxy's rest position on the face, m (grid frame). */
   std::array<double, 3> proxy_rest_m() const;
   /** The lattice node of the face's plane nearest the proxy. */

@@ -73,6 +73,22 @@ TEST(ErrorSweep, AStrokeSceneIsRefusedSayingWhatToSweep) {
   }
 }
 
+// The daemon's sliding tool (contact.model = "proxy") shares the press's map: its scene sweeps
+// to the same map as the node contact's.
+TEST(ErrorSweep, ASlidingToolsSceneSweepsThePressesOfItsObject) {
+  Scene proxy = SmallScene();
+  proxy.contact.model = ContactModel::kProxy;
+  SweepStats stats;
+  const ErrorMap sliding = RunSweep(proxy, SmallGrid(), {}, &stats);
+  const ErrorMap node = RunSweep(SmallScene(), SmallGrid(), {}, &stats);
+  ASSERT_EQ(sliding.samples.size(), node.samples.size());
+  for (std::size_t i = 0; i < node.samples.size(); ++i) {
+    EXPECT_TRUE(node.samples[i].computed()) << "sample " << i;
+    EXPECT_EQ(sliding.samples[i].l2_percent, node.samples[i].l2_percent) << "sample " << i;
+    EXPECT_EQ(sliding.samples[i].status, node.samples[i].status) << "sample " << i;
+  }
+}
+
 TEST(ErrorSweep, EqualRatesAtFullResolutionReproduceTheReference) {
   SweepGrid grid = SmallGrid();
   grid.axes[6] = {1};

@@ -223,11 +223,19 @@ TEST(DaemonConfig, AGeometryThatFillsItsBoxPassesTheCheck) {
 
 // A stroke's sliding proxy runs offline only (RunRegionStroke): a daemon scene asking for one is
 // refused, not served as a press.
-TEST(DaemonConfig, AStrokeSceneIsRefusedSayingTheProxyIsNotServed) {
-  const std::string scene = ConfigTestPath() + ".stroke.toml";
+// A sliding tool is served (contact.model = "proxy", or a stroke's scene); its primary must reach
+// the tip's nodes, and a scene whose primary cannot is refused saying what to set.
+TEST(DaemonConfig, ASlidingToolIsServedAndAPrimaryTooSmallForItIsRefused) {
+  const std::string scene = ConfigTestPath() + ".proxy.toml";
+  std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\n[adaptivity]\nprimary_size = 3\n";
+  const std::string path = ConfigTestPath();
+  std::ofstream(path) << "[scene]\nfile = \"" << scene << "\"\n";
+  EXPECT_EQ(LoadDaemonConfig(path).scene.contact.model, ContactModel::kProxy);
   std::ofstream(scene) << "[input]\nwaveform = \"stroke\"\n[adaptivity]\nprimary_size = 3\n";
+  EXPECT_EQ(ConfigError("[scene]\nfile = \"" + scene + "\"\n"), "");
+  std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\n[adaptivity]\nprimary_size = 1\n";
   const std::string error = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
-  EXPECT_NE(error.find("sliding proxy is not served yet"), std::string::npos) << error;
+  EXPECT_NE(error.find("adaptivity.primary_size >= 2"), std::string::npos) << error;
 }
 
 TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {

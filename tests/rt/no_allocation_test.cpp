@@ -169,6 +169,42 @@ TEST(DaemonPrimaryPeriod, NeverAllocates) {
   EXPECT_TRUE(record.flags & force_flags::kInputStale);
 }
 
+// A sliding tool (contact.model = "proxy") in the primary period: touching down, pressing,
+// sticking, sliding 70 mm across the face and out of the primary region it is bound to (nothing
+// moves the regions here: the proxy leaves them and asks them to follow), then lifting off.
+TEST(DaemonPrimaryPeriod, NeverAllocatesWithASlidingTool) {
+  Scene scene;
+  scene.adaptivity.primary_size = 3;
+  scene.contact.model = ContactModel::kProxy;
+  HapticLoop loop(scene, HapticLoop::Options{});
+  std::int64_t now = HapticLoop::NowNs();
+  ForceRecord record;
+  std::int32_t flags = 0;
+  double largest_lateral = 0;
+  testing::ScopedAllocationCount count;
+  for (int n = 0; n < 1200; ++n, now += 1'000'000) {
+    const double z = n < 100    ? -0.002
+                     : n < 1100 ? std::min(0.005, 0.005 * (n - 100) / 200.0)
+                                : -0.002;
+    const double x = 0.125 + (n < 300 ? 0.0 : 0.07 * std::min(1.0, (n - 300) / 700.0));
+    loop.OfferInput(DeviceSample{n, now, {x, 0.125, z}, false});
+    loop.PrimaryPeriod(now, now);
+    for (int r = 1; r < loop.regions().num_regions(); ++r) {
+      if (loop.SecondaryMayStep(r)) const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+    }
+    while (loop.forces().Pop(&record)) {
+      flags |= record.flags;
+      largest_lateral = std::max(largest_lateral, std::abs(record.force_n[0]));
+    }
+    if (loop.contact_following()) flags |= 1 << 30;
+  }
+  EXPECT_EQ(count.count(), 0u);
+  EXPECT_TRUE(flags & force_flags::kInContact);
+  EXPECT_GT(largest_lateral, 0.1) << "it pulled and slid";
+  EXPECT_TRUE(flags & (1 << 30)) << "it asked the regions to follow";
+  EXPECT_TRUE(flags & force_flags::kReconfiguring) << "it slid out of the regions and waited";
+}
+
 // The port guard acting in the primary period: the envelope saturating, the engagement ramp and a
 // fault latching (a fault_force_n below the press's force) cost no allocation either. (Its
 // passivity controller dissipating: PortGuardPeriod.NeverAllocatesWhileDissipating, below.)

@@ -201,6 +201,10 @@ int Run(const SimulateOptions& options) {
   if (!options.vtk_dir.empty()) vtk = VtkOutput{options.vtk_dir, options.vtk_rate_hz, {}};
   VtkOutput* frames = vtk ? &*vtk : nullptr;
   const bool stroke = scene.input.waveform == Waveform::kStroke;
+  HAPTICSIM_THROW_UNLESS(stroke || scene.contact.model != ContactModel::kProxy,
+                         "contact.model = \"proxy\" is hapticsimd's sliding tool; simulate drives "
+                         "the node for a press or a sine: set input.waveform = \"stroke\" to "
+                         "simulate the sliding tool, or contact.model = \"node\"");
   const TrialResult result = !adaptive ? RunReference(scene, trial_options, frames)
                              : stroke  ? RunAdaptiveStroke(scene, options.threads, &report, frames)
                                        : RunAdaptive(scene, options.threads, &report, frames);

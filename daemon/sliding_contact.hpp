@@ -1,0 +1,110 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/regions/async_regions.hpp"
+#include "core/trial/proxy_contact.hpp"
+#include "daemon/contact_box.hpp"
+#include "daemon/contact_tracker.hpp"
+
+namespace hapticsim {
+
+/**
+ * hapticsimd's tool that slides (contact.model = "proxy"): the primary thread's contact state
+ * when the device touches through a proxy (ProxyContact) instead of driving the touched node.
+ * The proxy stays on the deformed surface, joined to the tool tip by the contact.stiffness spring;
+ * it sticks and slides by Coulomb friction, and the primary region follows it across the face
+ * (ProxyWantsPrimaryAt: the supervisor moves the regions with the object's motion carried).
+ *
+ * Touch-down is ContactTracker's — the face the tip is least deep behind — and the node it wants
+ * is the one nearest the entry point inside that face (a rim node's normal is not the face's). The
+ * proxy engages when the regions are centred on that node and bound on that face; otherwise it
+ * waits (zero force, "waiting") until the supervisor has moved them there. Its force ramps in over
+ * `engage_ramp_s` (the spring's pull scaled by a smoothstep) wherever it would step: a touch deeper
+ * than ContactTracker::kDeepTouchDown_m, after waiting, after regions that restarted from rest, and
+ * when the proxy comes back into a primary it slid out of. The spring itself starts from zero at
+ * the surface: a touch from outside needs no ramp.
+ *
+ * A proxy that slides out of the primary (the regions did not follow in time) pushes nothing
+ * (zero force, "waiting") and asks for the regions at once; one that slides off the face's rim
+ * releases the contact, and the tip must leave the object before it touches again.
+ *
+ * Threads: Bind is the supervisor's, while the primary leaves the regions alone (HapticLoop::
+ * Install); everything else is the primary thread's and never allocates.
+ */
+class SlidingContact {
+ public:
+  using Contact = ContactTracker::Contact;
+
+  SlidingContact(const ContactBox& box, const ContactSettings& settings, double engage_ramp_s);
+
+  /**
+   * The proxy over `regions`' primary (RegionPartition::PrimaryProxySurface). On the face it was
+   * on it stays where it is, sliding or not (the regions followed it); on another face it starts
+   * at their centre. Allocates.
+   * @throws Error when the regions are not a proxy's (RegionPartition::proxy_contact) or their
+   *         centre is not on a flat face.
+   */
+  void Bind(const AsyncRegions& regions);
+
+  /** One period with the tip at `tip_m` (object frame, m). `centre`: the node the regions are
+   *  centred on, or none while they are being replaced. */
+  Contact Update(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                 const std::optional<LatticeIndex>& centre) noexcept;
+  /** One period without fresh input: the tool held where it was. */
+  Contact Hold(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
+
+  /**
+   * One primary period on the bound regions, engaged: the tool moved from the last period's tip
+   * to this one's over the primary's substeps, the proxy touched at each and the primary stepped
+   * with its push. Returns the push on the object at the period's first substep, N (the user
+   * feels its opposite). Out of contact the regions step unloaded.
+   */
+  std::array<double, 3> StepPeriod(AsyncRegions& regions, std::int64_t now_ns) noexcept;
+
+  /** The node the regions should be centred on: the proxy's node when they should follow it, the
+   *  touched node while inside, else the node the tip hovers over. None before the first input. */
+  std::optional<LatticeIndex> wanted_node() const { return wanted_; }
+  /** True while the tip is outside the object (or before the first input). */
+  bool outside() const { return state_ == State::kFree; }
+  /** Whether the proxy slid in the last period. */
+  bool sliding() const { return proxy_ && proxy_->sliding(); }
+
+  /** The regions restart from rest: any contact is released and must lift off first. */
+  void RestartFromRest() noexcept;
+  /** The regions restart from rest around a new centre: an engaged or waiting contact engages
+   *  again under the tip, its force ramped in from zero. */
+  void RestartKeepingContact() noexcept;
+
+ private:
+  enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
+  Contact Answer() const noexcept;
+  // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
+  // normal the face's, as a proxy needs; never a rim node), none on a held face.
+  std::optional<LatticeIndex> NodeInsideFace(const ContactBox::Entry& entry) const noexcept;
+  // Engages a waiting touch when the regions are centred on its node and bound on its face.
+  void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
+  double RampScale(std::int64_t now_ns) const noexcept;
+  // After a period's steps: where the regions should go (following the proxy).
+  void AfterPeriod() noexcept;
+
+  ContactBox box_;
+  ContactSettings settings_;
+  std::int64_t ramp_ns_ = 0;
+  State state_ = State::kAwaitLiftOff;
+  std::optional<ProxyContact> proxy_;           // on the bound regions' primary
+  LatticeIndex bound_centre_{};                 // the bound regions' centre
+  std::vector<double> loads_;                   // on the bound primary's proxy_loaded_dofs()
+  std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
+  std::array<double, 3> inward_{};              // the touched face's
+  LatticeIndex node_{};                         // the touched node
+  std::optional<LatticeIndex> wanted_;
+  bool following_ = false;           // the regions should follow the proxy (onto wanted_)
+  bool out_of_region_ = false;       // the proxy slid out of the primary: nothing pushed
+  std::int64_t ramp_start_ns_ = -1;  // the force ramps in from here (−1: no ramp)
+};
+
+}  // namespace hapticsim

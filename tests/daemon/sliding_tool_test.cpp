@@ -1,0 +1,132 @@
+// hapticsimd's tool that slides (contact.model = "proxy"), played through the real primary period
+// (the sliding contact, the regions, the port guard) on one thread, with a supervisor that moves
+// the regions whenever the loop asks them to follow the proxy (HapticLoop::contact_following),
+// the motion carried. The device draws the offline stroke's own path, so the daemon's force is
+// checked against RunRegionStroke on the same scene — and against what the contact promises
+// whatever the regions do: once sliding, the lateral force is μ_k times the normal (±5 %);
+// without friction there is none; no step over 0.1 N between periods, across the moves too.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "core/regions/region_stroke_trial.hpp"
+#include "core/scene/contact_trajectory.hpp"
+#include "daemon/haptic_loop.hpp"
+#include "daemon/supervisor.hpp"
+#include "tests/support/play_device.hpp"
+
+namespace hapticsim {
+namespace {
+
+// The offline stroke of tests/core/region_stroke_test.cpp: 5 mm into the front face's middle,
+// then 80 mm along x (the proxy crosses four nodes of 20.8 mm).
+Scene Stroke(double static_mu, double kinetic_mu) {
+  Scene scene;
+  scene.input.waveform = Waveform::kStroke;
+  scene.input.amplitude_m = 0.005;
+  scene.input.stroke_length_m = 0.08;
+  scene.contact.static_friction = static_mu;
+  scene.contact.kinetic_friction = kinetic_mu;
+  scene.adaptivity.primary_size = 3;
+  return scene;
+}
+
+struct Served {
+  std::vector<std::array<double, 3>> force_n;  // sent to the device, one per period
+  int moves = 0;                               // the regions followed the proxy
+  double largest_step_n = 0;
+};
+
+// The stroke's path played as device input, one period each, the regions moved (motion carried)
+// before any period the loop asks them to follow.
+Served Serve(const Scene& scene) {
+  HapticLoop loop(scene, HapticLoop::Options{});
+  const ContactTrajectory path(scene.input);
+  const long periods = std::lround(scene.duration_s() / scene.solver.dt_s);
+  const RegionConfiguration configuration{scene.adaptivity.primary_size,
+                                          scene.adaptivity.secondary_lod,
+                                          scene.adaptivity.secondary_rate_hz};
+  Served served;
+  std::int64_t release = 1'000'000'000;
+  for (long n = 0; n <= periods; ++n, release += 1'000'000) {
+    if (loop.contact_following() && loop.wanted_contact_node() != loop.centre_node()) {
+      loop.Reconfigure(SceneWith(scene, configuration, *loop.wanted_contact_node()),
+                       HapticLoop::Handover::kCarryMotion);
+      ++served.moves;
+    }
+    std::array<double, 3> tip = {0.125, 0.125, 0.0};
+    const std::array<double, 3> moved = path.DisplacementAt(static_cast<double>(n) * 1e-3);
+    for (int c = 0; c < 3; ++c) tip[c] += moved[c];
+    testing::PlayPeriodInVirtualTime(loop, release, DeviceSample{n, release, tip, false});
+    ForceRecord record;
+    while (loop.forces().Pop(&record)) {
+      if (!served.force_n.empty()) {
+        const auto& a = served.force_n.back();
+        const auto& b = record.force_n;
+        served.largest_step_n =
+            std::max(served.largest_step_n, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+      }
+      served.force_n.push_back(record.force_n);
+    }
+  }
+  return served;
+}
+
+TEST(SlidingTool, TheDaemonServesTheOfflineStrokeAndItsRegionsFollowTheProxy) {
+  const Scene scene = Stroke(0.5, 0.4);
+  const Served served = Serve(scene);
+  const RegionStrokeResult offline = RunRegionStroke(scene);
+  ASSERT_EQ(offline.stroke.trial.outcome, TrialOutcome::kCompleted);
+  const std::vector<ForceSample>& samples = offline.stroke.trial.samples;
+  ASSERT_GE(served.force_n.size(), samples.size());
+  EXPECT_EQ(served.moves, static_cast<int>(offline.moves.size()));
+  EXPECT_LE(served.largest_step_n, 0.1);
+  double error2 = 0, norm2 = 0, worst_ratio = 0;
+  int sliding = 0;
+  for (std::size_t n = 0; n < samples.size(); ++n) {
+    const std::array<double, 3>& f = served.force_n[n];
+    for (int c = 0; c < 3; ++c) {
+      error2 += std::pow(f[c] - samples[n].feedback_force_n[c], 2);
+      norm2 += std::pow(samples[n].feedback_force_n[c], 2);
+    }
+    const double normal = -f[2], lateral = std::hypot(f[0], f[1]);
+    // Coulomb: never more than μ_s × the normal; once sliding (the offline stroke slid in this
+    // period and the two before: the daemon may break loose a period later), μ_k × the normal.
+    EXPECT_LE(lateral, 1.05 * 0.5 * normal + 1e-6) << "period " << n;
+    const auto slid = [&](std::size_t m) { return offline.stroke.proxy[m].sliding; };
+    if (n >= 2 && slid(n) && slid(n - 1) && slid(n - 2) && normal > 0.05) {
+      ++sliding;
+      worst_ratio = std::max(worst_ratio, lateral / normal);
+      EXPECT_GE(lateral, 0.95 * 0.4 * normal) << "period " << n;
+    }
+  }
+  const double relative_l2 = std::sqrt(error2 / norm2);
+  EXPECT_LT(relative_l2, 0.02);
+  EXPECT_GT(sliding, 300);
+  EXPECT_LE(worst_ratio, 0.4 * 1.05);
+  std::printf(
+      "daemon stroke: %d moves (offline %zu), largest step %.4f N, relative L2 against the "
+      "offline stroke %.3f %%, lateral/normal once sliding at most %.4f (%d periods)\n",
+      served.moves, offline.moves.size(), served.largest_step_n, 100 * relative_l2, worst_ratio,
+      sliding);
+}
+
+TEST(SlidingTool, WithoutFrictionTheDaemonSendsNoLateralForce) {
+  const Served served = Serve(Stroke(0.0, 0.0));
+  double lateral = 0, normal = 0;
+  for (const auto& f : served.force_n) {
+    lateral = std::max(lateral, std::hypot(f[0], f[1]));
+    normal = std::max(normal, -f[2]);
+  }
+  EXPECT_GE(served.moves, 3);
+  EXPECT_GT(normal, 0.5);
+  EXPECT_LT(lateral, 0.05);
+  EXPECT_LE(served.largest_step_n, 0.1);
+  std::printf("frictionless: lateral at most %.4f N, normal up to %.3f N, %d moves\n", lateral,
+              normal, served.moves);
+}
+
+}  // namespace
+}  // namespace hapticsim
