@@ -73,14 +73,20 @@ DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.se
                   " and 0 ≤ y ≤ " + Metres(s.extent_m[1]) + " m");
     }
   }
+  if (s.kind == "stroke" &&
+      !(s.stroke_length_m >= 0 && s.at_m[0] + s.stroke_length_m <= s.extent_m[0])) {
+    throw Error("--length " + Metres(s.stroke_length_m) + " from --at x = " + Metres(s.at_m[0]) +
+                " leaves the front face (0 ≤ x ≤ " + Metres(s.extent_m[0]) +
+                " m): a stroke slides along +x on it; shorten it or start further left");
+  }
   if (s.kind == "replay") {
     replay_ = ReadReplay(s.replay_path, s.replay_channel, s.rate_hz);
   } else if (s.kind == "walk") {
     to_ = {s.at_m[0], s.at_m[1], 0.0};  // the walk starts above --at
     from_ = to_ = NewWaypoint(false);
     inside_next_ = true;
-  } else if (s.kind != "press" && s.kind != "sine") {
-    throw Error("--input " + s.kind + ": use press, sine, walk or replay");
+  } else if (s.kind != "press" && s.kind != "sine" && s.kind != "stroke") {
+    throw Error("--input " + s.kind + ": use press, sine, walk, stroke or replay");
   }
 }
 
@@ -114,6 +120,25 @@ std::array<double, 3> DeviceMotion::NextWalk() {
   return tip;
 }
 
+std::array<double, 3> DeviceMotion::StrokeAt(double t_s) const {
+  // The legs' ends as shares of the period: in, along, out, back.
+  static constexpr std::array<double, 5> kEnds = {0.0, 0.2, 0.7, 0.8, 1.0};
+  const double phase = t_s * settings_.frequency_hz - std::floor(t_s * settings_.frequency_hz);
+  const std::array<double, 3> start{settings_.at_m[0], settings_.at_m[1], -settings_.hover_m};
+  std::array<std::array<double, 3>, 5> corners{start, start, start, start, start};
+  corners[1][2] = corners[2][2] = settings_.amplitude_m;
+  corners[2][0] = corners[3][0] = settings_.at_m[0] + settings_.stroke_length_m;
+  int leg = 0;
+  while (leg < 3 && phase >= kEnds[static_cast<std::size_t>(leg) + 1]) ++leg;
+  const auto k = static_cast<std::size_t>(leg);
+  const double tau = (phase - kEnds[k]) / (kEnds[k + 1] - kEnds[k]);
+  const double w = tau * tau * (3 - 2 * tau);
+  std::array<double, 3> tip{};
+  for (std::size_t c = 0; c < 3; ++c)
+    tip[c] = corners[k][c] + w * (corners[k + 1][c] - corners[k][c]);
+  return tip;
+}
+
 std::optional<std::array<double, 3>> DeviceMotion::Next() {
   if (settings_.kind == "replay") {
     // Past the end, the last input held (the log's last entry is an input, never a silence).
@@ -127,6 +152,8 @@ std::optional<std::array<double, 3>> DeviceMotion::Next() {
              (settings_.amplitude_m + settings_.hover_m) * 0.5 * (1 - std::cos(phase));
   } else if (settings_.kind == "sine") {
     tip[2] = settings_.amplitude_m * std::sin(phase);
+  } else if (settings_.kind == "stroke") {
+    tip = StrokeAt(t);
   } else {  // walk: the constructor refused any other kind
     tip = NextWalk();
   }

@@ -11,7 +11,7 @@ namespace hapticsim::device {
 
 /** What the simulated device does with its tool tip (object frame, m; see device_input_t). */
 struct MotionSettings {
-  std::string kind = "press";                ///< press | sine | walk | replay
+  std::string kind = "press";  ///< press | sine | walk | stroke | replay
   /// The daemon's object as the device meets it: its box's extent along x, y, z, m (the cube's
   /// edge three times; --edge, or --scene). The front face is z = 0, x and y from 0 to theirs.
   std::array<double, 3> extent_m{0.25, 0.25, 0.25};
@@ -20,6 +20,7 @@ struct MotionSettings {
   std::array<double, 2> at_m{0.125, 0.125};  ///< press and sine: the point on the front face
   double hover_m = 0.002;                    ///< press: how far above the surface it starts
   double walk_speed_m_per_s = 0.05;          ///< walk: top speed between waypoints
+  double stroke_length_m = 0.06;             ///< stroke: how far along +x it slides
   unsigned seed = 1;                         ///< walk
   std::string replay_path;                   ///< replay: an LCM log of device_input_t
   std::string replay_channel = "HAPTIC_DEVICE";
@@ -36,6 +37,10 @@ struct MotionSettings {
  *   apart, alternately above the surface and pressed into it (up to `amplitude_m`), joined at up to
  *   `walk_speed_m_per_s` with smooth starts and stops, so it touches down and lifts off at a
  *   different surface point each time;
+ * - stroke: a palpation stroke every 1/f: from `hover_m` above `at_m` in to `amplitude_m` deep
+ *   (the first 20 % of the period), along +x by `stroke_length_m` at that depth (50 %), out to
+ *   `hover_m` above (10 %) and back above the surface to `at_m` (20 %), each leg a smoothstep —
+ *   for a sliding tool (contact.model = "proxy");
  * - replay: a recorded LCM log's device inputs, in order and in time: where the device's own
  *   clock (utime) shows a pause of more than a period and a half, the replay is silent as long
  *   (up to kMaxReplaySilence_s each), as the recorded session was; then the last input held.
@@ -55,6 +60,7 @@ class DeviceMotion {
 
  private:
   std::array<double, 3> NextWalk();
+  std::array<double, 3> StrokeAt(double t_s) const;
   std::array<double, 3> NewWaypoint(bool inside);
 
   MotionSettings settings_;

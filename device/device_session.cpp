@@ -133,10 +133,16 @@ class AnswerTally {
     }
   }
 
-  /** Input `seq` went out at `sent_ns`; a bad one (or none) expects no answer of its own. */
-  void Sent(std::int64_t seq, std::int64_t sent_ns, bool bad) {
+  /** Input `seq` went out at `sent_ns` with the tip at `tip_m`; a bad one (or none) expects no
+   *  answer of its own. */
+  void Sent(std::int64_t seq, std::int64_t sent_ns, bool bad, const std::array<double, 3>& tip_m) {
     sent_ns_[seq] = sent_ns;
     bad_[seq] = bad ? 1 : 0;
+    if (settings_.keep_trace) {
+      if (first_sent_ns_ < 0) first_sent_ns_ = sent_ns;
+      tips_.resize(sent_ns_.size());
+      tips_[static_cast<std::size_t>(seq)] = tip_m;
+    }
   }
   void BurstEnded(std::int64_t seq) { last_burst_end_ = seq; }
 
@@ -149,6 +155,11 @@ class AnswerTally {
     if (!finite) ++report_.nonfinite_forces;
     if (contact) ++report_.contact_answers;
     if (finite) TakeForce(a, contact);
+    if (settings_.keep_trace && a.seq >= 1 && a.seq < static_cast<std::int64_t>(tips_.size())) {
+      const auto seq = static_cast<std::size_t>(a.seq);
+      report_.trace.push_back(
+          {(sent_ns_[seq] - first_sent_ns_) * 1e-9, tips_[seq], a.force_n, a.flags});
+    }
     previous_ = a;
     if (last_burst_end_ >= 0 && a.seq > last_burst_end_) ++report_.answers_after_last_burst;
     TakeRoundTrips(a);
@@ -191,6 +202,11 @@ class AnswerTally {
         report_.press_peaks_n[press] = std::max(report_.press_peaks_n[press], magnitude);
       }
     }
+    const double normal = -a.force_n[2], lateral = std::hypot(a.force_n[0], a.force_n[1]);
+    if (contact && !stale && normal > 0.05) {
+      report_.largest_lateral_n = std::max(report_.largest_lateral_n, lateral);
+      report_.largest_lateral_ratio = std::max(report_.largest_lateral_ratio, lateral / normal);
+    }
     if (!previous_) return;
     report_.largest_force_step_any_n =
         std::max(report_.largest_force_step_any_n, StepBetween(a, *previous_));
@@ -224,6 +240,8 @@ class AnswerTally {
   StreamCounter stream_;
   std::int64_t last_burst_end_ = -1;
   std::int64_t second_answers_ = 0;
+  std::vector<std::array<double, 3>> tips_;  // by seq, with keep_trace
+  std::int64_t first_sent_ns_ = -1;
   std::optional<Answer> previous_;
 };
 
@@ -278,7 +296,7 @@ SessionReport RunSession(DeviceMotion& motion, DeviceLink& link, DeviceLink* mon
       link.Send(seq, release / 1000, tip);
       ++report.inputs_sent;
     }
-    tally.Sent(seq, MonotonicNowNs(), silent || burst);
+    tally.Sent(seq, MonotonicNowNs(), silent || burst, tip);
     const std::int64_t next_release = start + std::llround((n + 1) * period_ns);
     if (link.needs_polling()) {
       // Shared memory: look for the answer every 50 µs until just before the next period.

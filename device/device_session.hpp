@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -20,6 +21,17 @@ struct SessionSettings {
   /// A repeating press: inputs per press (seq 1 … n the first); 0: none. Each press's peak force
   /// is reported (press_peaks_n).
   std::int64_t press_period_inputs = 0;
+  /// Keep every answer with the tip it answers (SessionReport::trace), for a plot of force
+  /// against position.
+  bool keep_trace = false;
+};
+
+/** One answer as the trace keeps it: the force and the tip position of the input it answers. */
+struct TracePoint {
+  double t_s = 0;                      ///< when the input it answers was sent, from the start
+  std::array<double, 3> position_m{};  ///< that input's tip, object frame
+  std::array<double, 3> force_n{};     ///< on the user
+  std::int32_t flags = 0;
 };
 
 /** Round-trip latency percentiles, µs (input sent → the first force answering it received). */
@@ -58,6 +70,12 @@ struct SessionReport {
   double largest_force_step_any_n = 0;    ///< between any consecutive answers
   double largest_force_n = 0;             ///< the largest force magnitude received
   std::vector<double> press_peaks_n;      ///< each whole press's largest force (a press input)
+  /// In contact with fresh input and a normal force (−z, the front face's) above 0.05 N: the
+  /// largest tangential force and its largest ratio to the normal (a sliding tool keeps it at
+  /// most μ_s, μ_k once sliding).
+  double largest_lateral_n = 0;
+  double largest_lateral_ratio = 0;
+  std::vector<TracePoint> trace;  ///< every answer, with keep_trace
   std::int64_t contact_answers = 0;
   std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
   std::int64_t answers_after_last_burst = 0;

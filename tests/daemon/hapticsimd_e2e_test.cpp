@@ -1147,6 +1147,126 @@ TEST(HapticsimdUnderLoad, TenPressesKeepTheirPeaksWithTwoBusyThreadsBeside) {
   EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
 }
 
+// What a device's --trace says about a stroke (--input stroke at --frequency 0.5) from its second
+// stroke on (a new session's first inputs reuse seqs the daemon took from the last session, which
+// it refuses until it sees the device restarted): in the middle of every slide (a phase of 0.35 to
+// 0.6 of the period) the ratio of the lateral force to the normal and the mean normal force, and
+// the largest force step between answers in contact.
+struct SlideTrace {
+  double lowest_ratio = 1e9, highest_ratio = 0, mean_normal_n = 0, largest_step_n = 0;
+  int periods = 0;
+};
+SlideTrace ReadSlides(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // the header
+  SlideTrace slides;
+  double normal_sum = 0;
+  std::array<double, 9> last{};
+  while (std::getline(in, line)) {
+    std::array<double, 9> v{};
+    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3],
+                    &v[4], &v[5], &v[6], &v[7], &v[8]) != 9 ||
+        v[0] < 2.0) {
+      continue;
+    }
+    if (v[7] == 1 && last[7] == 1) {
+      slides.largest_step_n = std::max(slides.largest_step_n,
+                                       std::hypot(v[4] - last[4], v[5] - last[5], v[6] - last[6]));
+    }
+    last = v;
+    const double phase = std::fmod(v[0] * 0.5, 1.0);
+    const double normal = -v[6], lateral = std::hypot(v[4], v[5]);
+    if (phase < 0.35 || phase > 0.6 || v[7] != 1 || normal < 0.05) continue;
+    slides.lowest_ratio = std::min(slides.lowest_ratio, lateral / normal);
+    slides.highest_ratio = std::max(slides.highest_ratio, lateral / normal);
+    normal_sum += normal;
+    ++slides.periods;
+  }
+  if (slides.periods > 0) slides.mean_normal_n = normal_sum / slides.periods;
+  return slides;
+}
+
+// A tool that slides (contact.model = "proxy", μ_s 0.5, μ_k 0.4), served by hapticsimd over LCM to
+// the simulated device's palpation stroke — 5 mm in, 60 mm along the face, out and back, four
+// times (the last three judged, see SlideTrace) — first on a quiet machine, then with two busy
+// threads beside the daemon (no real-time privileges). Both times: the primary region follows the
+// proxy across the face (the daemon's log names each node it moved to); once sliding, the lateral
+// force is μ_k times the normal within 5 %; it never exceeds μ_s times it; the force never steps by
+// more than 0.1 N between periods; and the loaded stroke presses as hard as the quiet one (a guard
+// that zeroed the force would fail that). The supervisor's map offers primary sizes 1 and 3: a
+// sliding tool's proxy needs 2 at least, so 3 runs.
+TEST(HapticsimdSlidingTool, AStrokeSlidesAtKineticFrictionAndTheRegionsFollowItUnderLoad) {
+  const std::string scene = Temp("proxy_scene.toml"), config = Temp("proxy.toml");
+  std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\nstatic_friction = 0.5\n"
+                          "kinetic_friction = 0.4\n[adaptivity]\nprimary_size = 3\n";
+  std::ofstream(config) << "[scene]\nfile = \"" << scene << "\"\n[supervisor]\nerror_map = \""
+                        << SmallMap() << "\"\nerror_target_percent = 7.0\n";
+  testing::BackgroundProcess daemon({HAPTICSIMD_PATH, "--config", config}, Temp("proxy.log"));
+  ASSERT_NO_FATAL_FAILURE(WaitUntilServing(daemon));
+  auto stroke = [&](const std::string& load) {
+    const std::string trace = Temp("stroke_" + load + ".csv");
+    const auto run = testing::RunCommand({HAPTICSIM_CLI_PATH,
+                                          "device",
+                                          "--scene",
+                                          scene,
+                                          "--input",
+                                          "stroke",
+                                          "--amplitude",
+                                          "0.005",
+                                          "--length",
+                                          "0.06",
+                                          "--frequency",
+                                          "0.5",
+                                          "--at",
+                                          "0.09,0.125",
+                                          "--duration",
+                                          "8",
+                                          "--cpu-load",
+                                          load,
+                                          "--trace",
+                                          trace,
+                                          "--json"});
+    EXPECT_EQ(run.exit_status, 0) << run.out << run.err;
+    return std::pair{nlohmann::json::parse(run.out), ReadSlides(trace)};
+  };
+  const auto [quiet, quiet_slides] = stroke("0");
+  const auto [loaded, loaded_slides] = stroke("2");
+  EXPECT_GT(loaded["cpu_load"]["cpu_s"].get<double>(), 3.0) << loaded.dump();
+  for (const auto& [report, slides] : {std::pair{quiet, quiet_slides}, {loaded, loaded_slides}}) {
+    const std::string what = report["cpu_load"].dump();
+    EXPECT_EQ(report["daemon"]["primary_size"], 3) << what;
+    EXPECT_EQ(report["lost_answers"], 0) << what;
+    EXPECT_EQ(report["nonfinite_forces"], 0) << what;
+    EXPECT_EQ(report["force_out_of_contact"], 0) << what;
+    EXPECT_GT(report["contact_answers"].get<int>(), 4000) << what;
+    EXPECT_LE(report["max_lateral_to_normal"].get<double>(), 0.5 * 1.05) << what;
+    EXPECT_LT(slides.largest_step_n, 0.1) << what;
+    EXPECT_GT(slides.periods, 1200) << what;
+    EXPECT_GE(slides.lowest_ratio, 0.4 * 0.95) << what;
+    EXPECT_LE(slides.highest_ratio, 0.4 * 1.05) << what;
+    EXPECT_GT(slides.mean_normal_n, 0.3) << what;
+    std::printf(
+        "stroke with %s: lateral/normal %.4f … %.4f while sliding, normal %.3f N, largest "
+        "step %.4f N, %d late answers\n",
+        what.c_str(), slides.lowest_ratio, slides.highest_ratio, slides.mean_normal_n,
+        slides.largest_step_n, report["late_answers"].get<int>());
+  }
+  EXPECT_NEAR(loaded_slides.mean_normal_n, quiet_slides.mean_normal_n,
+              0.05 * quiet_slides.mean_normal_n);
+  daemon.Signal(SIGTERM);
+  EXPECT_EQ(daemon.Wait(5), 0) << daemon.Log();
+  // The regions followed the proxy: nodes 5, 6 and 7 along the slide, on each of the 8 strokes.
+  const std::string log = daemon.Log();
+  int moves = 0;
+  for (std::size_t at = 0;
+       (at = log.find("regions centred on contact node (7, 6, 0)", at)) != std::string::npos;
+       ++at) {
+    ++moves;
+  }
+  EXPECT_GE(moves, 8) << log;
+}
+
 // One owner of the device input: with shared memory owning it, a process that publishes device
 // input on LCM changes nothing the shared-memory driver feels, and is refused and counted.
 TEST(HapticsimdInputOwner, LcmInputIsRefusedWhileSharedMemoryOwnsTheInput) {

@@ -30,6 +30,42 @@ TEST(DeviceMotion, ThePressGoesFromAboveTheSurfaceToItsDepthAndBack) {
 
 // A block, not the cube (hapticsim device --scene): the walk stays on its front face per axis, and
 // a press point or a depth outside it is refused naming the block's extent.
+// A stroke (a sliding tool's palpation): in from above, along +x at depth, out, and back above the
+// surface, each leg smooth; a stroke that would leave the face is refused, naming --length.
+TEST(DeviceMotion, AStrokeGoesInAlongTheFaceOutAndBackAndOneOffTheFaceIsRefused) {
+  MotionSettings s;
+  s.kind = "stroke";
+  s.amplitude_m = 0.005;
+  s.stroke_length_m = 0.06;
+  s.at_m = {0.09, 0.125};
+  DeviceMotion stroke(s);  // 1 Hz: a stroke per 1000 periods
+  std::vector<std::array<double, 3>> tips;
+  for (int n = 0; n <= 1000; ++n) tips.push_back(stroke.Next().value());
+  EXPECT_DOUBLE_EQ(tips[0][2], -0.002);
+  EXPECT_NEAR(tips[200][2], 0.005, 1e-12);  // in
+  EXPECT_NEAR(tips[200][0], 0.09, 1e-12);
+  EXPECT_NEAR(tips[700][0], 0.15, 1e-12);  // along, at depth
+  EXPECT_NEAR(tips[450][2], 0.005, 1e-12);
+  EXPECT_NEAR(tips[800][2], -0.002, 1e-12);  // out
+  EXPECT_NEAR(tips[1000][0], 0.09, 1e-12);   // back above the start
+  double fastest = 0;
+  for (std::size_t n = 1; n < tips.size(); ++n) {
+    fastest =
+        std::max(fastest, std::hypot(tips[n][0] - tips[n - 1][0], tips[n][2] - tips[n - 1][2]));
+  }
+  // The fastest leg is the way back above the surface, 60 mm in 0.2 s; a smoothstep tops 1.5 × its
+  // mean speed: nothing jumps.
+  EXPECT_LT(fastest, 0.06 / 200 * 1.5 + 1e-9);
+  for (double y : {tips[300][1], tips[900][1]}) EXPECT_DOUBLE_EQ(y, 0.125);
+  s.stroke_length_m = 0.2;
+  try {
+    DeviceMotion off(s);
+    FAIL() << "a stroke off the face was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--length"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DeviceMotion, OnABlockTheWalkStaysOnItsFaceAndAPressOffItIsRefused) {
   MotionSettings s;
   s.kind = "walk";

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
 #include "core/error.hpp"
@@ -32,8 +33,24 @@ struct DeviceOptions {
   int cpu_load = 0;
   std::vector<double> bad_input_at_s;
   bool json = false;
+  std::string trace_file;  // --trace: every answer as CSV
   DeviceLimits limits;
 };
+
+// Every answer with the tip of the input it answers, as CSV (a plot of force against position).
+void WriteTrace(const std::string& path, const std::vector<device::TracePoint>& trace) {
+  std::ofstream out(path);
+  HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": cannot write it");
+  out << "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,in_contact,flags\n";
+  char row[256];
+  for (const device::TracePoint& p : trace) {
+    std::snprintf(row, sizeof row, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%d\n", p.t_s,
+                  p.position_m[0], p.position_m[1], p.position_m[2], p.force_n[0], p.force_n[1],
+                  p.force_n[2], (p.flags & 1) ? 1 : 0, p.flags);
+    out << row;
+  }
+  HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": writing it failed (disk full?)");
+}
 
 // The object's box as the daemon's scene makes it (ContactBox): its extent along x, y, z, m.
 std::array<double, 3> SceneExtent(const std::string& path) {
@@ -74,6 +91,7 @@ int Run(DeviceOptions o) {
   device::SessionSettings settings;
   settings.duration_s = o.duration_s;
   settings.bad_input_bursts_s = o.bad_input_at_s;
+  settings.keep_trace = !o.trace_file.empty();
   if (o.motion.kind == "press") {
     settings.press_period_inputs = std::lround(settings.rate_hz / o.motion.frequency_hz);
   }
@@ -93,6 +111,7 @@ int Run(DeviceOptions o) {
       });
   if (terminal) std::fprintf(stderr, "\n");
   const double load_cpu_s = load.Stop();
+  if (!o.trace_file.empty()) WriteTrace(o.trace_file, report.trace);
   const std::vector<std::string> exceeded = ExceededLimits(report, o.limits);
   if (o.json) {
     nlohmann::json out = ReportJson(report);
@@ -150,15 +169,24 @@ Command AddDeviceCommand(CLI::App& parent) {
   app->add_option("--status-channel", options->status_channel)->capture_default_str();
   app->add_option("--input", options->motion.kind,
                   "press (the paper's), sine, walk (seeded random walk with touch-downs at "
-                  "different points) or replay (an LCM log)")
+                  "different points), stroke (in at --at, along +x by --length, out and back: "
+                  "for a sliding tool, contact.model = \"proxy\") or replay (an LCM log)")
       ->capture_default_str();
   app->add_option("--amplitude", options->motion.amplitude_m,
-                  "Press depth, sine amplitude, deepest walk press, m")
+                  "Press depth, sine amplitude, deepest walk press, stroke depth, m")
       ->capture_default_str();
-  app->add_option("--frequency", options->motion.frequency_hz, "Press and sine frequency, Hz")
+  app->add_option("--length", options->motion.stroke_length_m,
+                  "How far a stroke slides along +x, m")
+      ->capture_default_str();
+  app->add_option("--trace", options->trace_file,
+                  "Write every answer as CSV: the input's time and tip (m), the force (N), "
+                  "in contact, flags")
+      ->capture_default_str();
+  app->add_option("--frequency", options->motion.frequency_hz,
+                  "Press, sine and stroke frequency, Hz")
       ->capture_default_str();
   app->add_option("--at", options->at,
-                  "Press and sine point on the front face: X,Y in m "
+                  "Press, sine and stroke start point on the front face: X,Y in m "
                   "(default: its middle)")
       ->delimiter(',')
       ->expected(2);

@@ -84,6 +84,8 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
                         {"flags_seen", FlagNames(r.flags_seen)},
                         {"answers_after_last_bad_input", r.answers_after_last_burst}};
   if (!r.press_peaks_n.empty()) out["press_peaks_n"] = r.press_peaks_n;
+  out["max_lateral_force_n"] = r.largest_lateral_n;
+  out["max_lateral_to_normal"] = r.largest_lateral_ratio;
   if (r.monitor) out["lcm_monitor"] = StreamJson(*r.monitor);
   if (r.status) {
     nlohmann::json regions = nlohmann::json::array();
@@ -172,8 +174,10 @@ std::string ReportText(const device::SessionReport& r) {
       "%.4f N between periods in contact",
       static_cast<long long>(r.nonfinite_forces), static_cast<long long>(r.force_out_of_contact),
       r.largest_force_step_n);
-  add("  in contact                 %lld answers; largest force %.3f N",
-      static_cast<long long>(r.contact_answers), r.largest_force_n);
+  add("  in contact                 %lld answers; largest force %.3f N; largest lateral %.3f N, "
+      "%.3f × the normal",
+      static_cast<long long>(r.contact_answers), r.largest_force_n, r.largest_lateral_n,
+      r.largest_lateral_ratio);
   if (!r.press_peaks_n.empty()) {
     std::string peaks;
     for (double p : r.press_peaks_n) {
