@@ -235,10 +235,15 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
       break;
     case RegionRestart::kCarryingMotion:
       // The new regions hold the contact where the last period before the pause left it (a
-      // sliding tool's proxy goes on where it was: Install bound it to them).
-      if (!sliding_)
+      // sliding tool's proxy goes on where it was, Install bound it to them, and its push blends
+      // back from the one held).
+      if (sliding_) {
+        sliding_->CatchUp(release_ns, static_cast<std::int64_t>(static_cast<double>(held_periods_) *
+                                                                primary_period_ns_));
+      } else {
         contact_.CatchUpFrom(regions_->primary_contact_m(),
                              release_ns - static_cast<std::int64_t>(primary_period_ns_));
+      }
       break;
     case RegionRestart::kNone:
       return;

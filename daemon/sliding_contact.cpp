@@ -122,12 +122,27 @@ double SlidingContact::RampScale(std::int64_t now_ns) const noexcept {
   return tau * tau * (3 - 2 * tau);
 }
 
+std::array<double, 3> SlidingContact::Rendered(const std::array<double, 3>& spring_n,
+                                               std::int64_t now_ns) const noexcept {
+  const double scale = RampScale(now_ns);
+  std::array<double, 3> push{};
+  for (int c = 0; c < 3; ++c) push[c] = scale * spring_n[c];
+  if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ < catch_up_duration_ns_) {
+    // A blend of two pushes within the friction cone stays within it (the cone is convex): the
+    // user never feels more than μ_s times the normal force, as a fading offset would give.
+    const double tau = static_cast<double>(now_ns - catch_up_ns_) / catch_up_duration_ns_;
+    const double w = tau * tau * (3 - 2 * tau);
+    for (int c = 0; c < 3; ++c) push[c] = held_push_[c] + w * (push[c] - held_push_[c]);
+  }
+  return push;
+}
+
 std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
                                                  std::int64_t now_ns) noexcept {
   const int substeps = regions.schedule(kPrimaryRegion).substeps;
-  std::array<double, 3> push{};
-  const double scale = RampScale(now_ns);
-  if (scale >= 1.0) ramp_start_ns_ = -1;
+  std::array<double, 3> first_push{};
+  if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
+  if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ >= catch_up_duration_ns_) catch_up_ns_ = -1;
   for (int q = 1; q <= substeps; ++q) {
     std::fill(loads_.begin(), loads_.end(), 0.0);
     if (state_ == State::kEngaged && proxy_) {
@@ -139,24 +154,35 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
       if (touch.left_surface) {
         // Off the face's rim: released; a new touch only after the tip has left the object.
         state_ = State::kAwaitLiftOff;
-        std::fill(loads_.begin(), loads_.end(), 0.0);
       } else if (touch.left_region) {
         out_of_region_ = true;  // nothing pushed until the regions are under it again
       } else if (out_of_region_ && touch.in_contact) {
         out_of_region_ = false;  // back in a primary: its push ramps in again
         ramp_start_ns_ = now_ns;
       }
+      std::array<double, 3> push{};
       if (state_ == State::kEngaged && !touch.left_region) {
-        for (double& load : loads_) load *= scale;
-        if (q == 1) {
-          for (int c = 0; c < 3; ++c) push[c] = scale * touch.force_on_object_n[c];
-        }
+        push = Rendered(touch.force_on_object_n, now_ns);
+        proxy_->SpreadLoads(push, loads_);
+      } else {
+        std::fill(loads_.begin(), loads_.end(), 0.0);
       }
+      if (q == 1) first_push = push;
     }
     regions.StepPrimaryLoaded(loads_);
   }
+  last_push_ = first_push;
   AfterPeriod();
-  return push;
+  return first_push;
+}
+
+void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns) noexcept {
+  if (state_ != State::kEngaged) return;
+  catch_up_ns_ = now_ns;
+  held_push_ = last_push_;
+  // Twice as long as the pause (what the tool did meanwhile comes back at half its pace), at most
+  // kCatchUp_ns; none after no pause at all.
+  catch_up_duration_ns_ = std::min(kCatchUp_ns, 2 * paused_ns);
 }
 
 void SlidingContact::AfterPeriod() noexcept {
@@ -173,7 +199,7 @@ void SlidingContact::AfterPeriod() noexcept {
 void SlidingContact::RestartFromRest() noexcept {
   if (state_ != State::kFree) state_ = State::kAwaitLiftOff;
   following_ = out_of_region_ = false;
-  ramp_start_ns_ = -1;
+  ramp_start_ns_ = catch_up_ns_ = -1;
 }
 
 void SlidingContact::RestartKeepingContact() noexcept {
@@ -183,6 +209,7 @@ void SlidingContact::RestartKeepingContact() noexcept {
     state_ = State::kWaiting;
     if (wanted_) node_ = *wanted_;
     following_ = out_of_region_ = false;
+    catch_up_ns_ = -1;
   }
 }
 

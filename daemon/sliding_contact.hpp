@@ -75,6 +75,17 @@ class SlidingContact {
 
   /** The regions restart from rest: any contact is released and must lift off first. */
   void RestartFromRest() noexcept;
+  /**
+   * New regions took over with the old ones' motion (the regions followed the proxy, or switched
+   * configuration in contact) at `now_ns`, after a pause of `paused_ns` in which the user felt the
+   * last push held while the tool went on: the push blends from that held one to the spring's own
+   * over twice the pause (a smoothstep; at most kCatchUp_ns), so the force does not step where
+   * the tool moved meanwhile.
+   */
+  void CatchUp(std::int64_t now_ns, std::int64_t paused_ns) noexcept;
+  /** The longest a push blends back after a pause (CatchUp), ns: the node contact's catch-up. */
+  static constexpr std::int64_t kCatchUp_ns = ContactTracker::kCatchUp_ns;
+
   /** The regions restart from rest around a new centre: an engaged or waiting contact engages
    *  again under the tip, its force ramped in from zero. */
   void RestartKeepingContact() noexcept;
@@ -88,6 +99,10 @@ class SlidingContact {
   // Engages a waiting touch when the regions are centred on its node and bound on its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
+  // The push the object gets and the user feels back, from the spring's own `spring_n`: ramped in,
+  // or blended from the push held over a pause (CatchUp).
+  std::array<double, 3> Rendered(const std::array<double, 3>& spring_n,
+                                 std::int64_t now_ns) const noexcept;
   // After a period's steps: where the regions should go (following the proxy).
   void AfterPeriod() noexcept;
 
@@ -105,6 +120,10 @@ class SlidingContact {
   bool following_ = false;           // the regions should follow the proxy (onto wanted_)
   bool out_of_region_ = false;       // the proxy slid out of the primary: nothing pushed
   std::int64_t ramp_start_ns_ = -1;  // the force ramps in from here (−1: no ramp)
+  std::int64_t catch_up_ns_ = -1;    // the push blends back from held_push_ from here (−1: none)
+  std::array<double, 3> last_push_{};  // the last period's push (the one a pause holds)
+  std::array<double, 3> held_push_{};  // the push a pause held, blended from (CatchUp)
+  std::int64_t catch_up_duration_ns_ = 0;
 };
 
 }  // namespace hapticsim

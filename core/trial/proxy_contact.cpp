@@ -74,6 +74,7 @@ void ProxyContact::Rebind(ProxySurface surface) {
       surface_.num_nodes() == 0 || surface.lattice_nodes == surface_.lattice_nodes,
       "internal: a proxy moved onto another lattice");
   surface_ = std::move(surface);
+  pushed_.count = 0;
   // Every node of the face's plane the surface lets the proxy push may be loaded.
   loaded_dofs_.clear();
   slot_of_node_.assign(static_cast<std::size_t>(surface_.num_nodes()), -1);
@@ -232,6 +233,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           const Eigen::VectorXd& u,
                                           std::span<double> loads) noexcept {
   std::fill(loads.begin(), loads.end(), 0.0);
+  pushed_.count = 0;
   Result result;
   Patch corners;
   const auto offset_to_tool = [&] {
@@ -281,15 +283,25 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   result.in_contact = true;
   result.sliding = sliding_;
   for (int c = 0; c < 3; ++c) result.force_on_object_n[c] = k * d[c];
-  for (int j = 0; j < corners.count; ++j) {
-    const int slot = slot_of_node_[static_cast<std::size_t>(corners.nodes[static_cast<std::size_t>(j)])];
+  pushed_.count = corners.count;  // (only the entries in use: a patch holds up to 289)
+  std::copy_n(corners.nodes.begin(), corners.count, pushed_.nodes.begin());
+  std::copy_n(corners.weights.begin(), corners.count, pushed_.weights.begin());
+  SpreadLoads(result.force_on_object_n, loads);
+  return result;
+}
+
+void ProxyContact::SpreadLoads(const std::array<double, 3>& force_on_object_n,
+                               std::span<double> loads) const noexcept {
+  std::fill(loads.begin(), loads.end(), 0.0);
+  for (int j = 0; j < pushed_.count; ++j) {
+    const int slot =
+        slot_of_node_[static_cast<std::size_t>(pushed_.nodes[static_cast<std::size_t>(j)])];
     if (slot < 0) continue;  // a held node: the support takes that share
     for (int c = 0; c < 3; ++c) {
       loads[static_cast<std::size_t>(3 * slot + c)] =
-          corners.weights[static_cast<std::size_t>(j)] * result.force_on_object_n[c];
+          pushed_.weights[static_cast<std::size_t>(j)] * force_on_object_n[c];
     }
   }
-  return result;
 }
 
 }  // namespace hapticsim

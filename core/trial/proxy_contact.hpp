@@ -99,6 +99,11 @@ class ProxyContact {
    *  and the loads on loaded_dofs() written to `loads`. Never allocates or throws. */
   Result Update(const std::array<double, 3>& tool_m, const Eigen::VectorXd& u,
                 std::span<double> loads) noexcept;
+  /** Writes to `loads` the push `force_on_object_n` spread as the last Update in contact spread
+   *  its own (the same nodes and weights): a push blended or ramped by the caller. Zero loads if
+   *  the last Update pushed nothing. Never allocates. */
+  void SpreadLoads(const std::array<double, 3>& force_on_object_n,
+                   std::span<double> loads) const noexcept;
   /** The proxy put under the tool at `tool_m` (a touch-down), sticking. Never allocates. */
   void PlaceUnder(const std::array<double, 3>& tool_m) noexcept;
   /** The face's inward normal (±e_axis). */
@@ -148,6 +153,7 @@ class ProxyContact {
   std::array<double, 2> proxy_{};  // along t1, t2 in node spacings
   double reach_ = 1;               // the tip's radius in node spacings, at least one
   bool sliding_ = false;
+  Patch pushed_;  // the nodes and weights the last Update pushed (count 0: none)
   std::vector<int> loaded_dofs_;
   std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded
   double lightest_mass_kg_ = 0;
