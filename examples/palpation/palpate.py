@@ -70,13 +70,20 @@ def svg(points, path, band_mm, title=None):
         f.write("\n".join(parts) + "\n")
 
 
-def parse_args(doc, out):
-    """The examples' command line: which hapticsim, which scene, where to write (made)."""
+def parse_args(doc, out, daemon=False):
+    """The examples' command line: which hapticsim (and hapticsimd, for `daemon`), which scene,
+    where to write (made)."""
     parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     parser.add_argument("--hapticsim", default=os.path.join(ROOT, "build", "tools", "hapticsim"))
+    if daemon:
+        parser.add_argument("--hapticsimd", help="default: next to --hapticsim's build folder, "
+                            "daemon/hapticsimd")
     parser.add_argument("--scene", default=os.path.join(HERE, "palpation.toml"))
     parser.add_argument("--out", default=out)
     args = parser.parse_args()
+    if daemon and not args.hapticsimd:
+        build = os.path.dirname(os.path.dirname(os.path.abspath(args.hapticsim)))
+        args.hapticsimd = os.path.join(build, "daemon", "hapticsimd")
     os.makedirs(args.out, exist_ok=True)
     return args
 

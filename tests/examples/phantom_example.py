@@ -13,9 +13,9 @@ EXAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "
                        "palpation")
 
 
-def run_on_phantom(hapticsim, folder, scene_text, script):
-    """Makes the phantom and the scene in `folder`, runs examples/palpation/`script` on them and
-    returns its printed summary and its CSV's lines."""
+def run_on_phantom(hapticsim, folder, scene_text, script, extra_args=()):
+    """Makes the phantom and the scene in `folder`, runs examples/palpation/`script` on them (with
+    `extra_args`) and returns its printed summary and its CSV's lines."""
     os.makedirs(folder)
     subprocess.run([sys.executable, os.path.join(EXAMPLE, "make_phantom.py"),
                     os.path.join(folder, "phantom.nii")], check=True, capture_output=True)
@@ -23,7 +23,8 @@ def run_on_phantom(hapticsim, folder, scene_text, script):
     with open(scene, "w") as f:
         f.write(scene_text)
     result = subprocess.run([sys.executable, os.path.join(EXAMPLE, script), "--hapticsim",
-                             hapticsim, "--scene", scene, "--out", os.path.join(folder, "out")],
+                             hapticsim, "--scene", scene, "--out", os.path.join(folder, "out"),
+                             *extra_args],
                             capture_output=True, text=True)
     if result.returncode != 0:
         raise SystemExit("%s failed:\n%s" % (script, result.stderr))
@@ -33,17 +34,18 @@ def run_on_phantom(hapticsim, folder, scene_text, script):
     return summary, rows
 
 
-def check_bump(hapticsim, script, check_rows, least_bump, control_within):
+def check_bump(hapticsim, script, check_rows, least_bump, control_within, extra_args=()):
     """The test: `check_rows(summary, rows)` returns what is wrong with the run's output; the
     inclusion must raise the force by more than `least_bump` (a fraction), the control's ratio
-    stay within `control_within` of one. Returns the exit status, printing what failed."""
+    stay within `control_within` of one. `extra_args` go to the script. Returns the exit status,
+    printing what failed."""
     with open(os.path.join(EXAMPLE, "palpation.toml")) as f:
         scene_text = f.read()
     failures = []
     work = tempfile.mkdtemp(prefix="palpation-")
     try:
         summary, rows = run_on_phantom(hapticsim, os.path.join(work, "inclusion"), scene_text,
-                                       script)
+                                       script, extra_args)
         print("with the inclusion:", json.dumps(summary))
         failures += check_rows(summary, rows)
         if not summary["force_over_inclusion_N"] > (1 + least_bump) * summary[
@@ -54,7 +56,8 @@ def check_bump(hapticsim, script, check_rows, least_bump, control_within):
         control_text = scene_text.replace("youngs_modulus = 80000.0", "youngs_modulus = 10000.0")
         if control_text == scene_text:
             failures.append("the example's scene no longer sets the inclusion to 80000 Pa")
-        control, _ = run_on_phantom(hapticsim, os.path.join(work, "control"), control_text, script)
+        control, _ = run_on_phantom(hapticsim, os.path.join(work, "control"), control_text, script,
+                                    extra_args)
         print("inclusion as soft as the tissue:", json.dumps(control))
         if not abs(control["ratio"] - 1) < control_within:
             failures.append("the control phantom shows a bump of %.3f" % control["ratio"])

@@ -1,0 +1,162 @@
+#!/usr/bin/env python3
+"""Strokes the phantom through the daemon: hapticsimd serves the phantom with a tool that slides
+(contact.model = "proxy", a 5 mm tip), and the simulated device (hapticsim device --input stroke)
+strokes its front face three times, 60 mm along x across the inclusion, 4 s a stroke, over shared
+memory in real time. The force each answer carried is drawn against the tool's position, so the
+stiffer inclusion shows as a bump, as an engineer feels it through a device.
+
+Usage: stroke_daemon.py [--hapticsim PATH] [--hapticsimd PATH] [--scene FILE.toml] [--out DIR]
+
+Writes DIR/stroke-daemon.csv (the tool's x in mm, the normal and the lateral force on the user in N,
+one row per answer in contact while sliding, from the second stroke on: the first starts with the
+regions moving onto the touch) and DIR/stroke-daemon.svg, with the daemon's log, its config and
+scene, and the device's trace and report; prints the normal force over the inclusion's centre
+against plain tissue (x = 15 and 65 mm; each the mean within 2.5 mm), how far the lateral force
+went (μ_s = 0.5 by default), the largest force step between answers, and how often the regions
+followed the proxy.
+Make the phantom first: python3 make_phantom.py phantom.nii (next to the scene)."""
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+
+from palpate import parse_args, svg
+
+# The phantom's face is 80 × 40 mm (2.5 mm voxels): from x = 10 mm in the middle row, 60 mm along
+# +x. A primary of 5 nodes leaves the 5 mm tip (2 voxels each way) 2 nodes to slide before the
+# regions must have followed it: at 2.5 mm a move takes the supervisor a few milliseconds.
+START_M = (0.010, 0.020)
+LENGTH_M = 0.06
+FREQUENCY_HZ = 0.25
+STROKES = 3
+TOOL = ["contact.model=proxy", "contact.radius=0.005", "adaptivity.primary_size=5",
+        "adaptivity.secondary_rate=1000"]
+
+
+def run(command, what):
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        sys.exit("stroke_daemon: %s failed:\n%s%s" % (what, result.stdout, result.stderr.strip()))
+    return result.stdout
+
+
+def daemon_scene(hapticsim, scene, out):
+    """The scene with the sliding tool, its geometry file made absolute (the copy is in `out`)."""
+    with open(scene, "rb") as f:
+        geometry = tomllib.load(f).get("geometry", {}).get("file", "")
+    command = [hapticsim, "scene", "--scene", scene]
+    for setting in TOOL:
+        command += ["--set", setting]
+    if geometry:
+        path = os.path.join(os.path.dirname(os.path.abspath(scene)), geometry)
+        command += ["--set", "geometry.file=" + path]
+    path = os.path.join(out, "stroke-daemon-scene.toml")
+    with open(path, "w") as f:
+        f.write(run(command, "hapticsim scene"))
+    with open(path, "rb") as f:
+        return path, tomllib.load(f)["input"]["amplitude"]
+
+
+def start_daemon(hapticsimd, scene, out, socket):
+    """hapticsimd on `scene`, device input over shared memory only (nothing on the network)."""
+    config = os.path.join(out, "stroke-daemon.toml")
+    with open(config, "w") as f:
+        f.write('[scene]\nfile = "%s"\n[device]\ninput = "shm"\n[shm]\nenabled = true\n'
+                'socket = "%s"\n[lcm]\nenabled = false\n[control]\nenabled = false\n'
+                % (scene, socket))
+    log = open(os.path.join(out, "stroke-daemon.log"), "w")
+    daemon = subprocess.Popen([hapticsimd, "--config", config], stdout=log, stderr=log)
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        with open(log.name) as f:
+            if "serving" in f.read():
+                return daemon, log.name
+        if daemon.poll() is not None:
+            with open(log.name) as f:
+                sys.exit("stroke_daemon: hapticsimd stopped:\n" + f.read())
+        time.sleep(0.1)
+    daemon.kill()
+    sys.exit("stroke_daemon: hapticsimd did not start serving within 60 s")
+
+
+def slides(trace):
+    """(x mm, normal N, lateral N) of every answer in contact in the middle of a slide (a phase of
+    0.25 to 0.65 of its stroke: the press is done, the lift not begun), from the second stroke on;
+    and the largest force step between answers in contact from there."""
+    points, largest_step, last = [], 0.0, None
+    with open(trace) as f:
+        for row in csv.DictReader(f):
+            t = float(row["t_s"])
+            force = [float(row[k]) for k in ("fx_n", "fy_n", "fz_n")]
+            contact = row["in_contact"] == "1"
+            if t < 1 / FREQUENCY_HZ:
+                continue
+            if contact and last is not None:
+                largest_step = max(largest_step, math.dist(force, last))
+            last = force if contact else None
+            phase = (t * FREQUENCY_HZ) % 1
+            if contact and 0.25 < phase < 0.65:
+                points.append((float(row["x_m"]) * 1e3, -force[2], math.hypot(force[0], force[1])))
+    return points, largest_step
+
+
+def main():
+    args = parse_args(__doc__, "stroke-daemon-out", daemon=True)
+    scene, amplitude = daemon_scene(args.hapticsim, args.scene, args.out)
+    socket = os.path.join(tempfile.mkdtemp(prefix="hsim-"), "hapticsimd.sock")
+    daemon, log = start_daemon(args.hapticsimd, scene, args.out, socket)
+    trace = os.path.join(args.out, "stroke-daemon-trace.csv")
+    try:
+        command = [args.hapticsim, "device", "--transport", "shm", "--shm-socket", socket,
+                   "--scene", scene, "--input", "stroke", "--amplitude", str(amplitude),
+                   "--length", str(LENGTH_M), "--at", "%g,%g" % START_M, "--frequency",
+                   str(FREQUENCY_HZ), "--duration", str(STROKES / FREQUENCY_HZ), "--trace", trace,
+                   "--json"]
+        print("stroke_daemon: " + " ".join(command), file=sys.stderr)
+        device = json.loads(run(command, "hapticsim device"))
+    finally:
+        daemon.terminate()
+        daemon.wait(timeout=10)
+        if os.path.isdir(os.path.dirname(socket)):
+            os.rmdir(os.path.dirname(socket))
+    with open(os.path.join(args.out, "stroke-daemon-device.json"), "w") as f:
+        json.dump(device, f, indent=2)
+
+    points, largest_step = slides(trace)
+    csv_path = os.path.join(args.out, "stroke-daemon.csv")
+    with open(csv_path, "w") as f:
+        f.write("x_mm,normal_force_N,lateral_force_N\n")
+        for x, normal, lateral in points:
+            f.write("%.6g,%.9g,%.9g\n" % (x, normal, lateral))
+    plot = os.path.join(args.out, "stroke-daemon.svg")
+    bins = {}  # the strokes' answers averaged per 0.5 mm of the tool's way: one curve
+    for x, normal, _ in points:
+        bins.setdefault(round(x * 2) / 2, []).append(normal)
+    curve = [(x, sum(v) / len(v)) for x, v in sorted(bins.items())]
+    svg(curve, plot, (32.5, 47.5),
+        "Through hapticsimd: normal force against the tool's position (mean of %d strokes)"
+        % (STROKES - 1))
+
+    def at(x_mm):
+        near = [normal for x, normal, _ in points if abs(x - x_mm) <= 2.5]
+        return sum(near) / len(near)
+
+    with open(log) as f:
+        moves = f.read().count("regions centred on contact node")
+    plain = (at(15.0) + at(65.0)) / 2
+    print(json.dumps({"answers_in_slides": len(points), "regions_moved": moves,
+                      "force_over_inclusion_N": at(40.0), "force_over_plain_tissue_N": plain,
+                      "ratio": at(40.0) / plain,
+                      "largest_lateral_to_normal": device["max_lateral_to_normal"],
+                      "largest_step_N": largest_step, "lost_answers": device["lost_answers"],
+                      "late_answers": device["late_answers"], "csv": csv_path, "plot": plot},
+                     indent=2))
+
+
+if __name__ == "__main__":
+    main()
