@@ -59,8 +59,16 @@ Daemon::Daemon(const DaemonArguments& args, StartupConfig startup)
                                        LoopOptionsOf(config_, args_.no_port_guard));
   loop_->SetErrorState(first.error_percent, DecisionFlags(first));
   const LatticeIndex contact = loop_->centre_node();
-  spdlog::info("contact: the regions are centred on node ({}, {}, {}) and follow the tool",
-               contact[0], contact[1], contact[2]);
+  spdlog::info(
+      "contact: the regions are centred on node ({}, {}, {}) and follow the tool{}", contact[0],
+      contact[1], contact[2],
+      loop_->sliding_contact()
+          ? fmt::format("; the tool slides (contact.model = \"proxy\": μ_s {}, μ_k {}, "
+                        "{} N/m, tip radius {} m)",
+                        config_.scene.contact.static_friction,
+                        config_.scene.contact.kinetic_friction,
+                        config_.scene.contact.stiffness_n_per_m, config_.scene.contact.radius_m)
+          : std::string("; the touched node follows the tip (contact.model = \"node\")"));
   StartTransports();
   if (const std::string refused = loop_->Start(); !refused.empty()) {
     spdlog::warn("real-time settings: {}running on", refused);
