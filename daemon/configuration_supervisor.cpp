@@ -224,14 +224,21 @@ bool ConfigurationSupervisor::MoveRegions(std::int64_t now) {
   // Where a pending configuration goes: a hovered node once the object has settled, else here.
   const LatticeIndex pending_node =
       settled ? wanted.value_or(loop_.centre_node()) : loop_.centre_node();
-  if (!mover_.busy() || ((waiting || following) && mover_.may_interrupt())) {
+  // A follow gives up the check behind the last move (left behind, the proxy slides to the edge of
+  // the primary, next to its interface: on the phantom the force chattered there), not a pending
+  // configuration's: the proxy has the primary's reach to slide meanwhile.
+  const bool interrupt = waiting || (following && !mover_.busy_with_pending());
+  if (!mover_.busy() || (interrupt && mover_.may_interrupt())) {
     std::optional<RegionsMover::Request> request;
     if (pending_ && !waiting && !following) {
       request = {pending_->configuration, pending_node, true, false};
     } else if (wanted && *wanted != loop_.centre_node() &&
                (waiting || following ||
                 (settled && (now - hover_since_ns_) * 1e-9 >= kHoverBeforeRecentre_s))) {
-      request = {decision_.configuration, *wanted, false, waiting || following, following};
+      // A follow keeps the configuration running (equal rates where the runaway watch moved it).
+      const RegionConfiguration& configuration =
+          following ? mover_.placement().centred.configuration : decision_.configuration;
+      request = {configuration, *wanted, false, waiting || following, following};
     }
     if (request && mover_.may_ask(*request)) mover_.Ask(*request, now);
   }

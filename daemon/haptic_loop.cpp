@@ -35,7 +35,10 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     CheckPrimaryReachesTip(scene, box_.spacing_m());
     sliding_.emplace(box_, scene.contact, options.engage_ramp_s);
   }
-  Install(scene, std::make_unique<AsyncRegions>(scene));
+  auto regions = std::make_unique<AsyncRegions>(scene);
+  std::optional<SlidingContact::Binding> binding;
+  if (sliding_) binding = sliding_->Prepare(*regions);
+  Install(scene, std::move(regions), std::move(binding));
   guard_ =
       PortGuard(options.port, primary_period_ns_ * 1e-9,
                 options.port_guard_off ? PortGuard::Mode::kOffForTests : PortGuard::Mode::kGuarded);
@@ -118,7 +121,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   if (usable) held_centre_ = centre_;
   const std::optional<LatticeIndex> centre =
       usable || holding ? std::optional<LatticeIndex>(held_centre_) : std::nullopt;
-  const ContactTracker::Contact contact = TrackContact(have && !stale, release_ns, centre);
+  const ContactTracker::Contact contact = TrackContact(have && !stale, release_ns, centre, usable);
   const bool in_contact = contact.engaged && (usable || holding);
   if (usable) engaged_ = in_contact;
   if (!contact.engaged) holding_ = false;  // lifted off while held: a new touch is not held
@@ -137,11 +140,14 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
   PublishPeriod(now_ns, sent.force_n, simulated_n, flags);
 }
 
-ContactTracker::Contact HapticLoop::TrackContact(
-    bool fresh, std::int64_t release_ns, const std::optional<LatticeIndex>& centre) noexcept {
+ContactTracker::Contact HapticLoop::TrackContact(bool fresh, std::int64_t release_ns,
+                                                 const std::optional<LatticeIndex>& centre,
+                                                 bool usable) noexcept {
   if (sliding_) {
-    return fresh ? sliding_->Update(tip_.TipAt(release_ns), release_ns, centre)
-                 : sliding_->Hold(release_ns, centre);
+    // Not while the regions are held for a reconfiguration: the supervisor rebinds the proxy then.
+    const std::optional<LatticeIndex> ours = usable ? centre : std::nullopt;
+    return fresh ? sliding_->Update(tip_.TipAt(release_ns), release_ns, ours)
+                 : sliding_->Hold(release_ns, ours);
   }
   return fresh ? contact_.Update(tip_.TipAt(release_ns), release_ns, centre)
                : contact_.Hold(release_ns, centre);
@@ -238,8 +244,12 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
       // sliding tool's proxy goes on where it was, Install bound it to them, and its push blends
       // back from the one held).
       if (sliding_) {
-        sliding_->CatchUp(release_ns, static_cast<std::int64_t>(static_cast<double>(held_periods_) *
-                                                                primary_period_ns_));
+        // The pause held the push for at most kMaxHold_s (PrimaryPeriod), then released it.
+        const double paused_ns = static_cast<double>(held_periods_) * primary_period_ns_;
+        const bool expired =
+            held_periods_ > 0 &&
+            static_cast<double>(held_periods_ - 1) * primary_period_ns_ >= kMaxHold_s * 1e9;
+        sliding_->CatchUp(release_ns, static_cast<std::int64_t>(paused_ns), expired);
       } else {
         contact_.CatchUpFrom(regions_->primary_contact_m(),
                              release_ns - static_cast<std::int64_t>(primary_period_ns_));

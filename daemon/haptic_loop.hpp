@@ -318,7 +318,9 @@ class HapticLoop {
   void StartSecondaries(std::int64_t origin_ns);
   void StopSecondaries();
   std::string ApplyRealtimeSettings(std::thread& thread) const;
-  void Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions);
+  // `binding`: the sliding tool's proxy over `regions` (SlidingContact::Prepare), when it has one.
+  void Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions,
+               std::optional<SlidingContact::Binding> binding);
   // The first release on the primary grid at or after `not_before_ns`.
   std::int64_t NextPrimaryRelease(std::int64_t not_before_ns) const;
   // Primary thread: sleeping at rest (see the class comment).
@@ -339,7 +341,8 @@ class HapticLoop {
   // Primary thread: the period's contact, from the tip (fresh) or held — the node's or the
   // sliding tool's.
   ContactTracker::Contact TrackContact(bool fresh, std::int64_t release_ns,
-                                       const std::optional<LatticeIndex>& centre) noexcept;
+                                       const std::optional<LatticeIndex>& centre,
+                                       bool usable) noexcept;
   // Primary thread: the node the contact wants the regions on, for the supervisor.
   void PublishContactRequest(const ContactTracker::Contact& contact) noexcept;
   // Primary thread: the period's reaction at its start — stepped on regions that are its own,

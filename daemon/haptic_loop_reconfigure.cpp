@@ -12,7 +12,8 @@
 
 namespace hapticsim {
 
-void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions) {
+void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regions,
+                         std::optional<SlidingContact::Binding> binding) {
   {
     const std::lock_guard<std::mutex> lock(surface_mutex_);
     scene_ = scene;
@@ -20,7 +21,8 @@ void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regio
     ++installs_;
   }
   centre_ = regions_->partition().contact_node();
-  if (sliding_) sliding_->Bind(*regions_);  // the primary leaves the regions alone meanwhile
+  // The primary leaves the regions alone meanwhile, and the sliding tool's proxy with them.
+  if (sliding_ && binding) sliding_->Bind(std::move(*binding));
   const int count = regions_->num_regions();
   tick_ns_ = 1e9 / static_cast<double>(regions_->ticks_per_second());
   auto nominal_ns = [&](int a) {
@@ -53,6 +55,9 @@ std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
 void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   if (sliding_) CheckPrimaryReachesTip(scene, box_.spacing_m());  // the proxy's tip in the primary
   auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
+  // What can throw or allocate of a sliding tool's proxy over them, made before any pause.
+  std::optional<SlidingContact::Binding> binding;
+  if (sliding_) binding = sliding_->Prepare(*regions);
   const auto& lattice = regions->partition().mesh().options();
   if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || lattice.lattice_nodes != box_.nodes() ||
       lattice.spacing_m != box_.spacing_m()) {
@@ -79,7 +84,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     if (carrying) regions->RestoreState(regions_->CaptureState());
     handover_.SetRestartWhileStopped(restart);
     ForgetSleep();
-    Install(scene, std::move(regions));
+    Install(scene, std::move(regions), std::move(binding));
     return;
   }
   handover_.RequestPause(carrying);
@@ -99,7 +104,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   // Nothing steps the old regions now: their motion is the new ones' start.
   if (carrying) regions->RestoreState(regions_->CaptureState());
   ForgetSleep();
-  Install(scene, std::move(regions));
+  Install(scene, std::move(regions), std::move(binding));
   // The new regions start (from rest, or from the carried motion) on the primary's own release
   // grid, late enough for the secondaries to be released ahead of it.
   const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());

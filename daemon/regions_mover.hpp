@@ -100,6 +100,8 @@ class RegionsMover {
   /** True while what it is busy with may be given up for a touch: a verification (behind a
    *  move, or before a configuration change), not an outcome still to be applied. */
   bool may_interrupt() const { return busy() && !ready_; }
+  /** True while what it is busy with is the supervisor's pending configuration change. */
+  bool busy_with_pending() const { return asked_ && asked_->applies_pending; }
   /** When its verification running now started (CLOCK_MONOTONIC ns), 0 when none runs. */
   std::int64_t running_since_ns() const { return verifier_.running_since_ns(); }
   /** False for a configuration and node that ran away (or were refused) before: not asked again. */

@@ -25,27 +25,30 @@ std::optional<LatticeIndex> SlidingContact::NodeInsideFace(
   return node;
 }
 
-void SlidingContact::Bind(const AsyncRegions& regions) {
+SlidingContact::Binding SlidingContact::Prepare(const AsyncRegions& regions) const {
   const RegionPartition& partition = regions.partition();
   HAPTICSIM_THROW_UNLESS(partition.proxy_contact(),
                          "internal: a sliding contact on regions built for a driven node");
+  Binding binding;
+  binding.centre = partition.contact_node();
+  binding.loads.assign(regions.proxy_loaded_dofs().size(), 0.0);
   const std::array<double, 3> normal = partition.contact_normal();
-  bound_centre_ = partition.contact_node();
   int axes = 0;
   for (double c : normal) axes += c != 0 ? 1 : 0;
-  if (axes != 1) {  // regions on an edge (hovered over): a touch waits for them on its face
-    proxy_.reset();
-    loads_.assign(regions.proxy_loaded_dofs().size(), 0.0);
-    return;
-  }
-  if (proxy_ && proxy_->inward_normal() == normal) {
-    proxy_->Rebind(partition.PrimaryProxySurface());
-  } else {
-    proxy_.emplace(partition.PrimaryProxySurface(), bound_centre_, normal, settings_);
-  }
-  HAPTICSIM_THROW_UNLESS(proxy_->loaded_dofs() == regions.proxy_loaded_dofs(),
+  if (axes != 1) return binding;  // regions on an edge: a touch waits for them on its face
+  binding.proxy.emplace(partition.PrimaryProxySurface(), binding.centre, normal, settings_);
+  HAPTICSIM_THROW_UNLESS(binding.proxy->loaded_dofs() == regions.proxy_loaded_dofs(),
                          "internal: the proxy and the primary region load different nodes");
-  loads_.assign(proxy_->loaded_dofs().size(), 0.0);
+  return binding;
+}
+
+void SlidingContact::Bind(Binding binding) noexcept {
+  // On the face the proxy was on it goes on where it is; elsewhere it starts at the new centre
+  // (and an engaged contact on another face waits: StepPeriod).
+  if (binding.proxy && proxy_) binding.proxy->ContinueFrom(*proxy_);
+  proxy_ = std::move(binding.proxy);
+  loads_ = std::move(binding.loads);
+  bound_centre_ = binding.centre;
 }
 
 SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_m,
@@ -56,6 +59,7 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
   if (!box_.Inside(tip_m)) {
     state_ = State::kFree;
     following_ = out_of_region_ = false;
+    ramp_start_ns_ = catch_up_ns_ = -1;
     std::array<double, 3> nearest = tip_m;  // the point of the box under the hovering tip
     for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, box_.extent_m()[c]);
     wanted_ = NodeInsideFace(box_.EntryOf(nearest));
@@ -93,15 +97,17 @@ SlidingContact::Contact SlidingContact::Hold(std::int64_t now_ns,
 
 void SlidingContact::TryEngage(const std::optional<LatticeIndex>& centre,
                                std::int64_t now_ns) noexcept {
-  if (!proxy_ || !centre || *centre != node_ || bound_centre_ != node_ ||
-      proxy_->inward_normal() != inward_) {
+  // Only on regions that are this period's (`centre`): while they are replaced, Bind writes proxy_.
+  // Wherever the bound primary can push under the tip — on its node, or off it within the
+  // primary's reach (then the regions follow it from there) — not only on the node it wants.
+  if (!centre || !proxy_ || proxy_->inward_normal() != inward_ || !proxy_->CanTouchAt(tool_)) {
     return;
   }
   proxy_->PlaceUnder(tool_);
   last_tool_ = tool_;
   state_ = State::kEngaged;
   out_of_region_ = following_ = false;
-  wanted_ = node_;
+  catch_up_ns_ = -1;
   ramp_start_ns_ = now_ns;  // from waiting; a touch engaged at once from outside clears it
 }
 
@@ -141,6 +147,15 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
                                                  std::int64_t now_ns) noexcept {
   const int substeps = regions.schedule(kPrimaryRegion).substeps;
   std::array<double, 3> first_push{};
+  if (state_ == State::kEngaged && (!proxy_ || proxy_->inward_normal() != inward_)) {
+    // The regions went to another face under an engaged tool (followed to a node whose normal is
+    // not the touched face's): nothing pushes it there; it waits for regions on its own face.
+    state_ = State::kWaiting;
+    out_of_region_ = false;
+    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) node_ = *node;
+    wanted_ = node_;
+  }
+  if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
   if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ >= catch_up_duration_ns_) catch_up_ns_ = -1;
   for (int q = 1; q <= substeps; ++q) {
@@ -161,11 +176,14 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
         ramp_start_ns_ = now_ns;
       }
       std::array<double, 3> push{};
-      if (state_ == State::kEngaged && !touch.left_region) {
+      if (state_ == State::kEngaged && touch.in_contact) {
         push = Rendered(touch.force_on_object_n, now_ns);
         proxy_->SpreadLoads(push, loads_);
       } else {
+        // Nothing pushed, nothing felt: a blend from a held push would be a force the object never
+        // gets back.
         std::fill(loads_.begin(), loads_.end(), 0.0);
+        catch_up_ns_ = -1;
       }
       if (q == 1) first_push = push;
     }
@@ -176,8 +194,14 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
   return first_push;
 }
 
-void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns) noexcept {
+void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns,
+                             bool hold_expired) noexcept {
   if (state_ != State::kEngaged) return;
+  if (hold_expired) {  // the push was released meanwhile: it ramps in again from zero
+    ramp_start_ns_ = now_ns;
+    catch_up_ns_ = -1;
+    return;
+  }
   catch_up_ns_ = now_ns;
   held_push_ = last_push_;
   // Twice as long as the pause (what the tool did meanwhile comes back at half its pace), at most
@@ -189,8 +213,12 @@ void SlidingContact::AfterPeriod() noexcept {
   following_ = false;
   if (state_ != State::kEngaged || !proxy_) return;
   std::optional<LatticeIndex> next = ProxyWantsPrimaryAt(*proxy_, bound_centre_, box_.spacing_m());
-  if (!next && out_of_region_) next = proxy_->NearestNode();
-  if (next && box_.Drivable(*next)) {
+  // Slid out of the primary before it followed: the node inside the face nearest the proxy (never a
+  // rim node, whose normal is not the face's).
+  if (!next && out_of_region_) {
+    next = NodeInsideFace(ContactBox::Entry{proxy_->proxy_rest_m(), inward_, 0});
+  }
+  if (next && *next != bound_centre_) {
     wanted_ = *next;
     following_ = true;
   }
@@ -204,10 +232,12 @@ void SlidingContact::RestartFromRest() noexcept {
 
 void SlidingContact::RestartKeepingContact() noexcept {
   if (state_ == State::kEngaged || state_ == State::kWaiting) {
-    // The motion the proxy pressed into is gone: it touches again where the tool is, once the
-    // regions are centred on the node it wants, its force ramped in.
+    // The motion the proxy pressed into is gone: it touches again where the tool is, once regions
+    // on its face can push there (TryEngage), its force ramped in. It wants the node under the
+    // tip, not one it asked to follow to: that may have been refused.
     state_ = State::kWaiting;
-    if (wanted_) node_ = *wanted_;
+    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) node_ = *node;
+    wanted_ = node_;
     following_ = out_of_region_ = false;
     catch_up_ns_ = -1;
   }

@@ -32,8 +32,9 @@ namespace hapticsim {
  * (zero force, "waiting") and asks for the regions at once; one that slides off the face's rim
  * releases the contact, and the tip must leave the object before it touches again.
  *
- * Threads: Bind is the supervisor's, while the primary leaves the regions alone (HapticLoop::
- * Install); everything else is the primary thread's and never allocates.
+ * Threads: Prepare is any thread's; Bind is the supervisor's, while the primary leaves the
+ * regions alone (HapticLoop::Install); everything else is the primary thread's, never allocates,
+ * and reads what Bind writes only on regions that are its own (a `centre` given).
  */
 class SlidingContact {
  public:
@@ -41,17 +42,29 @@ class SlidingContact {
 
   SlidingContact(const ContactBox& box, const ContactSettings& settings, double engage_ramp_s);
 
+  /** A proxy over new regions' primary, made before they are installed. */
+  struct Binding {
+    std::optional<ProxyContact> proxy;  ///< none: regions centred on an edge node
+    LatticeIndex centre{};
+    std::vector<double> loads;  ///< one per proxy-loaded DOF of their primary
+  };
   /**
-   * The proxy over `regions`' primary (RegionPartition::PrimaryProxySurface). On the face it was
-   * on it stays where it is, sliding or not (the regions followed it); on another face it starts
-   * at their centre. Allocates.
-   * @throws Error when the regions are not a proxy's (RegionPartition::proxy_contact) or their
-   *         centre is not on a flat face.
+   * Any thread, before the regions are installed (it allocates): the proxy over `regions`'
+   * primary (RegionPartition::PrimaryProxySurface), at their centre.
+   * @throws Error when the regions are not a proxy's (RegionPartition::proxy_contact).
    */
-  void Bind(const AsyncRegions& regions);
+  Binding Prepare(const AsyncRegions& regions) const;
+  /**
+   * The supervisor, while the primary leaves the regions alone (HapticLoop::Install): the proxy
+   * bound to the new regions. On the face it was on it goes on where it is, sliding or not (the
+   * regions followed it); on another face it starts at their centre, and an engaged contact waits
+   * for regions on its own face. Never throws.
+   */
+  void Bind(Binding binding) noexcept;
 
   /** One period with the tip at `tip_m` (object frame, m). `centre`: the node the regions are
-   *  centred on, or none while they are being replaced. */
+   *  centred on, or none while they are being replaced (or held: a waiting touch does not engage
+   *  then, and nothing Bind writes is read). */
   Contact Update(const std::array<double, 3>& tip_m, std::int64_t now_ns,
                  const std::optional<LatticeIndex>& centre) noexcept;
   /** One period without fresh input: the tool held where it was. */
@@ -70,8 +83,6 @@ class SlidingContact {
   std::optional<LatticeIndex> wanted_node() const { return wanted_; }
   /** True while the tip is outside the object (or before the first input). */
   bool outside() const { return state_ == State::kFree; }
-  /** Whether the proxy slid in the last period. */
-  bool sliding() const { return proxy_ && proxy_->sliding(); }
 
   /** The regions restart from rest: any contact is released and must lift off first. */
   void RestartFromRest() noexcept;
@@ -80,9 +91,10 @@ class SlidingContact {
    * configuration in contact) at `now_ns`, after a pause of `paused_ns` in which the user felt the
    * last push held while the tool went on: the push blends from that held one to the spring's own
    * over twice the pause (a smoothstep; at most kCatchUp_ns), so the force does not step where
-   * the tool moved meanwhile.
+   * the tool moved meanwhile. `hold_expired`: the pause outlasted the hold and the push was
+   * released: it ramps in again from zero instead.
    */
-  void CatchUp(std::int64_t now_ns, std::int64_t paused_ns) noexcept;
+  void CatchUp(std::int64_t now_ns, std::int64_t paused_ns, bool hold_expired) noexcept;
   /** The longest a push blends back after a pause (CatchUp), ns: the node contact's catch-up. */
   static constexpr std::int64_t kCatchUp_ns = ContactTracker::kCatchUp_ns;
 

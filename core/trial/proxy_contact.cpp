@@ -205,6 +205,19 @@ std::array<double, 3> ProxyContact::SurfacePoint(const Patch& corners,
   return point;
 }
 
+bool ProxyContact::CanTouchAt(const std::array<double, 3>& tool_m) const noexcept {
+  Patch patch;
+  const double h = surface_.spacing_m;
+  return PatchAt({tool_m[t1_] / h, tool_m[t2_] / h}, &patch) && Readable(patch) && Reachable(patch);
+}
+
+bool ProxyContact::ContinueFrom(const ProxyContact& other) noexcept {
+  if (other.axis_ != axis_ || other.sign_ != sign_ || other.plane_ != plane_) return false;
+  proxy_ = other.proxy_;
+  sliding_ = other.sliding_;
+  return true;
+}
+
 void ProxyContact::PlaceUnder(const std::array<double, 3>& tool_m) noexcept {
   proxy_ = {tool_m[t1_] / surface_.spacing_m, tool_m[t2_] / surface_.spacing_m};
   sliding_ = false;

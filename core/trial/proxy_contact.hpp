@@ -104,6 +104,13 @@ class ProxyContact {
    *  the last Update pushed nothing. Never allocates. */
   void SpreadLoads(const std::array<double, 3>& force_on_object_n,
                    std::span<double> loads) const noexcept;
+  /** Whether a tool at `tool_m` could push here: over a face cell whose tip patch this surface
+   *  reads and may push (or leave to a support). Never allocates. */
+  bool CanTouchAt(const std::array<double, 3>& tool_m) const noexcept;
+  /** Goes on where `other` is on the same face, sliding or not (the regions moved under the
+   *  proxy: `other` is the proxy on the old ones). False, and nothing changed, for another face.
+   *  Never allocates. */
+  bool ContinueFrom(const ProxyContact& other) noexcept;
   /** The proxy put under the tool at `tool_m` (a touch-down), sticking. Never allocates. */
   void PlaceUnder(const std::array<double, 3>& tool_m) noexcept;
   /** The face's inward normal (±e_axis). */
@@ -112,8 +119,6 @@ class ProxyContact {
     normal[static_cast<std::size_t>(axis_)] = sign_;
     return normal;
   }
-  /** Whether the proxy slides (it slid in the last update in contact). */
-  bool sliding() const noexcept { return sliding_; }
   /** The proxy's rest position on the face, m (grid frame). */
   std::array<double, 3> proxy_rest_m() const;
   /** The lattice node of the face's plane nearest the proxy. */

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""Strokes the phantom through the daemon: hapticsimd serves the phantom with a tool that slides
-(contact.model = "proxy", a 5 mm tip), and the simulated device (hapticsim device --input stroke)
-strokes its front face three times, 60 mm along x across the inclusion, 4 s a stroke, over shared
-memory in real time. The force each answer carried is drawn against the tool's position, so the
+"""Strokes the phantom through the daemon: hapticsimd serves the phantom, at 5 mm voxels, with a
+tool that slides (contact.model = "proxy", a 10 mm tip), and the simulated device (hapticsim device
+--input stroke) strokes its front face three times, 60 mm along x across the inclusion, 4 s a
+stroke, over shared memory in real time. The force each answer carried is drawn against the tool's position, so the
 stiffer inclusion shows as a bump, as an engineer feels it through a device.
 
 Usage: stroke_daemon.py [--hapticsim PATH] [--hapticsimd PATH] [--scene FILE.toml] [--out DIR]
@@ -27,15 +27,18 @@ import tomllib
 
 from palpate import parse_args, svg
 
-# The phantom's face is 80 × 40 mm (2.5 mm voxels): from x = 10 mm in the middle row, 60 mm along
-# +x. A primary of 5 nodes leaves the 5 mm tip (2 voxels each way) 2 nodes to slide before the
-# regions must have followed it: at 2.5 mm a move takes the supervisor a few milliseconds.
+# The phantom's face is 80 × 40 mm: from x = 10 mm in the middle row, 60 mm along +x. Served at
+# 5 mm voxels (geometry.spacing_m): at its own 2.5 mm the secondary region needs more than this
+# 2-core machine gives it at 1 kHz and the stroke chattered once it fell behind
+# (docs/operations.md). A tip of two voxels (on one voxel the proxy's push dimples the surface it
+# reads: docs/model.md) and a primary of 4, which leaves the tip a voxel and more to slide before
+# the regions must have followed it.
 START_M = (0.010, 0.020)
 LENGTH_M = 0.06
 FREQUENCY_HZ = 0.25
 STROKES = 3
-TOOL = ["contact.model=proxy", "contact.radius=0.005", "adaptivity.primary_size=5",
-        "adaptivity.secondary_rate=1000"]
+TOOL = ["contact.model=proxy", "contact.radius=0.01", "geometry.spacing_m=0.005",
+        "adaptivity.primary_size=4"]
 
 
 def run(command, what):
