@@ -58,12 +58,11 @@ class ContactBox {
   std::optional<LatticeIndex> NearestDrivable(
       const std::array<double, 3>& surface_point_m) const noexcept;
 
-  /** NearestDrivable of the point of the box nearest to `tip_m` (a tip outside: the node it
-   *  hovers over). */
-  std::optional<LatticeIndex> NearestDrivableTo(const std::array<double, 3>& tip_m) const noexcept {
+  /** The point of the box nearest to `tip_m` (a tip outside: the point it hovers over). */
+  std::array<double, 3> NearestPoint(const std::array<double, 3>& tip_m) const noexcept {
     std::array<double, 3> nearest = tip_m;
     for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, extent_m_[c]);
-    return NearestDrivable(nearest);
+    return nearest;
   }
 
   /** A node as one integer, (ix · ny + iy) · nz + iz (the order of the regions' surface ids),

@@ -30,7 +30,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   if (!box_.Inside(tip_m)) {
     state_ = State::kFree;
     fresh_tips_ = 0;
-    wanted_ = box_.NearestDrivableTo(tip_m);
+    wanted_ = NearestContactNode(box_.NearestPoint(tip_m));
     return {};
   }
   if (state_ == State::kAwaitLiftOff) return {};

@@ -10,7 +10,6 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "core/regions/proxy_following.hpp"
 #include "rt/monotonic_clock.hpp"
 
 namespace hapticsim {
@@ -31,10 +30,7 @@ HapticLoop::HapticLoop(const Scene& scene, const Options& options)
       box_(ContactBox::Of(scene)),
       contact_(box_, options.engage_ramp_s),
       guard_(options.port, 1e-3) {
-  if (UsesProxyContact(scene)) {
-    CheckPrimaryReachesTip(scene, box_.spacing_m());
-    sliding_.emplace(box_, scene.contact, options.engage_ramp_s);
-  }
+  if (UsesProxyContact(scene)) sliding_.emplace(box_, scene.contact, options.engage_ramp_s);
   auto regions = std::make_unique<AsyncRegions>(scene);
   std::optional<SlidingContact::Binding> binding;
   if (sliding_) binding = sliding_->Prepare(*regions);
@@ -229,14 +225,20 @@ bool HapticLoop::RegionsAreOurs(std::int64_t release_ns) noexcept {
 void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
   switch (handover_.TakeRestart()) {
     case RegionRestart::kFromRest:
-      contact_.RestartFromRest();
-      if (sliding_) sliding_->RestartFromRest();
+      if (sliding_) {
+        sliding_->RestartFromRest();
+      } else {
+        contact_.RestartFromRest();
+      }
       restarted_since_fault_ = guard_.latched();
       guard_.Reengage();
       break;
     case RegionRestart::kKeepingContact:
-      contact_.RestartKeepingContact();
-      if (sliding_) sliding_->RestartKeepingContact();
+      if (sliding_) {
+        sliding_->RestartKeepingContact();
+      } else {
+        contact_.RestartKeepingContact();
+      }
       guard_.Reengage();
       break;
     case RegionRestart::kCarryingMotion:

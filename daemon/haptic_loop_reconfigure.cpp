@@ -6,7 +6,6 @@
 #include <memory>
 
 #include "core/error.hpp"
-#include "core/regions/proxy_following.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "rt/monotonic_clock.hpp"
 
@@ -53,7 +52,6 @@ std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
 }
 
 void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
-  if (sliding_) CheckPrimaryReachesTip(scene, box_.spacing_m());  // the proxy's tip in the primary
   auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
   // What can throw or allocate of a sliding tool's proxy over them, made before any pause.
   std::optional<SlidingContact::Binding> binding;

@@ -60,22 +60,18 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
     state_ = State::kFree;
     following_ = out_of_region_ = false;
     ramp_start_ns_ = catch_up_ns_ = -1;
-    std::array<double, 3> nearest = tip_m;  // the point of the box under the hovering tip
-    for (int c = 0; c < 3; ++c) nearest[c] = std::clamp(nearest[c], 0.0, box_.extent_m()[c]);
-    wanted_ = NodeInsideFace(box_.EntryOf(nearest));
+    wanted_ = NodeInsideFace(box_.EntryOf(box_.NearestPoint(tip_m)));
     return {};
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
     const ContactBox::Entry entry = box_.EntryOf(tip_m);
     inward_ = entry.inward_normal;
-    const std::optional<LatticeIndex> node = NodeInsideFace(entry);
-    wanted_ = node;
-    if (!node) {  // a held face: the support is not rendered (ContactTracker)
+    wanted_ = NodeInsideFace(entry);
+    if (!wanted_) {  // a held face: the support is not rendered (ContactTracker)
       state_ = State::kAwaitLiftOff;
       return {};
     }
-    node_ = *node;
     state_ = State::kWaiting;
     TryEngage(centre, now_ns);
     // Engaged at once from outside, the spring starts at the surface: no ramp unless it is deep.
@@ -152,8 +148,7 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     // not the touched face's): nothing pushes it there; it waits for regions on its own face.
     state_ = State::kWaiting;
     out_of_region_ = false;
-    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) node_ = *node;
-    wanted_ = node_;
+    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) wanted_ = node;
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
@@ -180,9 +175,8 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
         push = Rendered(touch.force_on_object_n, now_ns);
         proxy_->SpreadLoads(push, loads_);
       } else {
-        // Nothing pushed, nothing felt: a blend from a held push would be a force the object never
-        // gets back.
-        std::fill(loads_.begin(), loads_.end(), 0.0);
+        // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push
+        // would be a force the object never gets back.
         catch_up_ns_ = -1;
       }
       if (q == 1) first_push = push;
@@ -236,8 +230,7 @@ void SlidingContact::RestartKeepingContact() noexcept {
     // on its face can push there (TryEngage), its force ramped in. It wants the node under the
     // tip, not one it asked to follow to: that may have been refused.
     state_ = State::kWaiting;
-    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) node_ = *node;
-    wanted_ = node_;
+    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) wanted_ = node;
     following_ = out_of_region_ = false;
     catch_up_ns_ = -1;
   }

@@ -21,8 +21,9 @@ namespace hapticsim {
  *
  * Touch-down is ContactTracker's — the face the tip is least deep behind — and the node it wants
  * is the one nearest the entry point inside that face (a rim node's normal is not the face's). The
- * proxy engages when the regions are centred on that node and bound on that face; otherwise it
- * waits (zero force, "waiting") until the supervisor has moved them there. Its force ramps in over
+ * proxy engages wherever the regions it is bound to, on that face, can push under the tip (then
+ * they follow it from there); otherwise it waits (zero force, "waiting") until the supervisor has
+ * moved them onto the node it wants. Its force ramps in over
  * `engage_ramp_s` (the spring's pull scaled by a smoothstep) wherever it would step: a touch deeper
  * than ContactTracker::kDeepTouchDown_m, after waiting, after regions that restarted from rest, and
  * when the proxy comes back into a primary it slid out of. The spring itself starts from zero at
@@ -108,7 +109,8 @@ class SlidingContact {
   // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
   // normal the face's, as a proxy needs; never a rim node), none on a held face.
   std::optional<LatticeIndex> NodeInsideFace(const ContactBox::Entry& entry) const noexcept;
-  // Engages a waiting touch when the regions are centred on its node and bound on its face.
+  // Engages a waiting touch when the regions, this period's (`centre`), can push under the tip on
+  // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
   // The push the object gets and the user feels back, from the spring's own `spring_n`: ramped in,
@@ -127,7 +129,6 @@ class SlidingContact {
   std::vector<double> loads_;                   // on the bound primary's proxy_loaded_dofs()
   std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
   std::array<double, 3> inward_{};              // the touched face's
-  LatticeIndex node_{};                         // the touched node
   std::optional<LatticeIndex> wanted_;
   bool following_ = false;           // the regions should follow the proxy (onto wanted_)
   bool out_of_region_ = false;       // the proxy slid out of the primary: nothing pushed

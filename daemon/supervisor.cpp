@@ -8,7 +8,6 @@
 #include "core/error.hpp"
 #include "core/errormap/error_lookup.hpp"
 #include "core/regions/async_regions.hpp"
-#include "core/regions/proxy_following.hpp"
 
 namespace hapticsim {
 namespace {
@@ -23,10 +22,6 @@ constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
 std::string BuildProblem(const Scene& scene) {
   try {
     const AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
-    // A sliding tool's primary follows its proxy: it must reach every node the tip touches.
-    if (UsesProxyContact(scene)) {
-      CheckPrimaryReachesTip(scene, regions.partition().mesh().options().spacing_m);
-    }
     return "";
   } catch (const Error& e) {
     return e.what();

@@ -66,7 +66,6 @@ class StrokeRun {
             " points into the contact's face: a stroke moves along the face, "
             "choose one of the other two axes");
     CheckAgree(proxy_, *regions_);
-    CheckPrimaryReachesTip(scene, regions_->partition().mesh().options().spacing_m);
     out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
     out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
     loads_.assign(proxy_.loaded_dofs().size(), 0.0);

@@ -87,16 +87,18 @@ struct InputSettings {
   int stroke_sign = 1;
 };
 
-/**
- * The sliding contact of a stroke (contact.*): the tool touches the surface through a proxy that
- * stays on it, joined to the tool by a spring; the proxy sticks until the spring's tangential
- * pull exceeds static_friction × its normal push, then slides keeping it at kinetic_friction ×.
- */
 /** How hapticsimd's contact meets the device's tool (contact.model). */
 enum class ContactModel {
   kNode,   ///< the paper's: the touched surface node follows the tool tip, stuck until lift-off
   kProxy,  ///< a tool that slides: a proxy on the surface, a spring and friction (as a stroke)
 };
+
+/**
+ * The sliding contact of a stroke, and of hapticsimd's tool with contact.model = "proxy"
+ * (contact.*): the tool touches the surface through a proxy that stays on it, joined to the tool
+ * by a spring; the proxy sticks until the spring's tangential pull exceeds static_friction × its
+ * normal push, then slides keeping it at kinetic_friction ×.
+ */
 
 struct ContactSettings {
   ContactModel model = ContactModel::kNode;  ///< hapticsimd's contact (contact.model)
