@@ -12,12 +12,12 @@ std::array<double, 3> Minus(const std::array<double, 3>& a, const std::array<dou
 
 }  // namespace
 
-ContactTracker::ContactTracker(const ContactBox& box, double engage_ramp_s)
-    : box_(box), ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
+ContactTracker::ContactTracker(const ContactObject& object, double engage_ramp_s)
+    : object_(object), ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
 
 std::optional<LatticeIndex> ContactTracker::NearestContactNode(
     const std::array<double, 3>& surface_point_m) const noexcept {
-  return box_.NearestDrivable(surface_point_m);
+  return object_.NearestDrivable(surface_point_m);
 }
 
 ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_m,
@@ -27,24 +27,24 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   if (held_) fresh_tips_ = 0;  // a gap: its jump is the stale ramp's
   const bool after_gap = held_;
   held_ = false;
-  if (!box_.Inside(tip_m)) {
+  if (!object_.Inside(tip_m)) {
     state_ = State::kFree;
     fresh_tips_ = 0;
-    wanted_ = NearestContactNode(box_.NearestPoint(tip_m));
+    wanted_ = NearestContactNode(object_.NearestPoint(tip_m));
     return {};
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
     // Touch-down through the face the tip is least deep behind (front face first on a tie, as
     // InwardNormal orders them).
-    const ContactBox::Entry entry = box_.EntryOf(tip_m);
+    const ContactObject::Entry entry = object_.EntryOf(tip_m);
     entry_ = entry.point_m;
     inward_ = entry.inward_normal;
     const double depth = entry.depth_m;
     const std::optional<LatticeIndex> node = NearestContactNode(entry_);
     wanted_ = node;
     if (!node) {
-      // On a held face: the tool touches the support, which is not rendered (ContactBox::
+      // On a held face: the tool touches the support, which is not rendered (ContactObject::
       // NearestDrivable); nothing until it has left the object.
       state_ = State::kAwaitLiftOff;
       return {};

@@ -5,7 +5,7 @@
 #include <optional>
 
 #include "core/scene/scene.hpp"
-#include "daemon/contact_box.hpp"
+#include "daemon/contact_object.hpp"
 
 namespace hapticsim {
 
@@ -13,11 +13,12 @@ namespace hapticsim {
  * Where the tool tip touches the object and how far it has pressed: the primary thread's contact
  * state, as plain logic (no threads, no allocation) so it can be tested on its own.
  *
- * The object is a box, [0, Lx] × [0, Ly] × [0, Lz] in the object frame (ContactBox: the
- * paper's cube, or a geometry that fills its lattice). The tip is in contact while it is strictly
- * inside. At touch-down the entry face is the one the tip is least deep behind; the entry point
+ * The object is its voxels in the object frame (ContactObject: the paper's cube, or a geometry's
+ * voxels, which may leave some of its lattice empty). The tip is in contact while it is strictly
+ * inside one. At touch-down the entry face is the face of the object's surface the tip is least
+ * deep behind along an axis (ContactObject::EntryOf); the entry point
  * is the tip projected on that face, and the contact node is the surface node nearest to the
- * entry point (never one a support holds: a free neighbour instead, ContactBox::NearestDrivable;
+ * entry point (never one a support holds: a free neighbour instead, ContactObject::NearestDrivable;
  * on a held face none, and the touch renders nothing until the tip has left the object).
  * While in contact the node follows the tip: displacement = tip − entry point, in all three
  * directions. The node stays the same until lift-off (as in the paper, the contact does not slide).
@@ -41,7 +42,7 @@ namespace hapticsim {
  */
 class ContactTracker {
  public:
-  ContactTracker(const ContactBox& box, double engage_ramp_s);
+  ContactTracker(const ContactObject& object, double engage_ramp_s);
 
   /** The result of one update. */
   struct Contact {
@@ -102,7 +103,7 @@ class ContactTracker {
   static constexpr std::int64_t kCatchUp_ns = 20'000'000;
 
   /** The surface node a touch at a point on (or projected onto) the surface drives; never a held
-   *  one, and none on a held face (ContactBox::NearestDrivable). */
+   *  one, and none on a held face (ContactObject::NearestDrivable). */
   std::optional<LatticeIndex> NearestContactNode(
       const std::array<double, 3>& surface_point_m) const noexcept;
 
@@ -119,7 +120,7 @@ class ContactTracker {
   void StartRamp(const std::array<double, 3>& from_m, const std::array<double, 3>& velocity_m_per_s,
                  std::int64_t duration_ns, std::int64_t now_ns) noexcept;
 
-  ContactBox box_;
+  ContactObject object_;
   std::int64_t ramp_ns_ = 0;
   State state_ = State::kAwaitLiftOff;
   std::array<double, 3> tip_{};

@@ -17,7 +17,7 @@
 #include "core/error.hpp"
 #include "core/regions/proxy_following.hpp"
 #include "core/scene/scene_toml.hpp"
-#include "daemon/contact_box.hpp"
+#include "daemon/contact_object.hpp"
 #include "daemon/supervisor.hpp"
 
 namespace hapticsim {
@@ -260,13 +260,11 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   require(c.scene.adaptivity.enabled(),
           "the scene's adaptivity.primary_size must be >= 1 (the daemon runs regions)");
   ValidateScene(c.scene);
-  // The contact tracker, the input guard and the deformation output take the object to be the
-  // box of its lattice (ContactBox): a scene whose object leaves voxels empty is refused here.
-  const std::string not_a_box = BoxObjectProblem(DescribeSceneObject(c.scene));
-  require(not_a_box.empty(), not_a_box);
+  // The object as the loop will meet it: its geometry read, its supports checked to hold it, a
+  // surface node left for the tool (each throws saying what to fix).
+  const ContactObject object = ContactObject::Of(c.scene);
   // A sliding tool's primary follows its proxy and must reach every node its tip touches.
-  if (UsesProxyContact(c.scene))
-    CheckPrimaryReachesTip(c.scene, ContactBox::Of(c.scene).spacing_m());
+  if (UsesProxyContact(c.scene)) CheckPrimaryReachesTip(c.scene, object.spacing_m());
 }
 
 std::string LcmUrlProblem(const std::string& url, bool allow_network) {

@@ -27,10 +27,10 @@ std::int64_t HapticLoop::NowNs() noexcept { return MonotonicNowNs(); }
 HapticLoop::HapticLoop(const Scene& scene, const Options& options)
     : scene_(scene),
       options_(options),
-      box_(ContactBox::Of(scene)),
-      contact_(box_, options.engage_ramp_s),
+      object_(ContactObject::Of(scene)),
+      contact_(object_, options.engage_ramp_s),
       guard_(options.port, 1e-3) {
-  if (UsesProxyContact(scene)) sliding_.emplace(box_, scene.contact, options.engage_ramp_s);
+  if (UsesProxyContact(scene)) sliding_.emplace(object_, scene.contact, options.engage_ramp_s);
   auto regions = std::make_unique<AsyncRegions>(scene);
   std::optional<SlidingContact::Binding> binding;
   if (sliding_) binding = sliding_->Prepare(*regions);
@@ -66,7 +66,7 @@ std::array<double, 3> HapticLoop::StepPrimaryPeriod(
 std::optional<LatticeIndex> HapticLoop::wanted_contact_node() const {
   const std::int64_t code = counters_.wanted_node_code.value();
   if (code < 0) return std::nullopt;
-  return box_.Decode(code);
+  return object_.Decode(code);
 }
 
 void HapticLoop::SetErrorState(double error_percent, std::int32_t flags) noexcept {
@@ -154,7 +154,7 @@ void HapticLoop::PublishContactRequest(const ContactTracker::Contact& contact) n
   counters_.contact_following.Set(contact.following);
   const std::optional<LatticeIndex> wanted =
       sliding_ ? sliding_->wanted_node() : contact_.wanted_node();
-  counters_.wanted_node_code.Set(wanted ? box_.Code(*wanted) : -1);
+  counters_.wanted_node_code.Set(wanted ? object_.Code(*wanted) : -1);
 }
 
 std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,

@@ -154,10 +154,11 @@ class HapticLoop {
     AdaptivitySettings configuration;    ///< the regions' (primary_size, secondary_lod, rates)
     LatticeIndex centre{};               ///< the node the regions are centred on
     bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
-    /// The surface nodes on the wire's lattice (ContactBox::ToWireIds of AsyncRegions::surface_ids,
-    /// the same for every configuration): id = (ix · n + iy) · n + iz, n = nodes_per_axis.
+    /// The surface nodes on the wire's lattice (ContactObject::ToWireIds of
+    /// AsyncRegions::surface_ids, the same for every configuration): id = (ix · n + iy) · n + iz, n
+    /// = nodes_per_axis.
     std::vector<std::int32_t> ids;
-    std::int32_t nodes_per_axis = 0;     ///< ContactBox::wire_nodes_per_axis
+    std::int32_t nodes_per_axis = 0;     ///< ContactObject::wire_nodes_per_axis
     double spacing_m = 0;                ///< the lattice's, m
     std::vector<double> displacement_m;  ///< 3 per id, m
     std::int64_t asked_ns = 0;           ///< CLOCK_MONOTONIC when the regions were asked
@@ -181,8 +182,8 @@ class HapticLoop {
   bool contact_following() const { return counters_.contact_following.value(); }
   /** Whether the tool touches through a sliding proxy (contact.model = "proxy", SlidingContact). */
   bool sliding_contact() const { return sliding_.has_value(); }
-  /** The object as the tool meets it (its box and drivable nodes): fixed for the loop's life. */
-  const ContactBox& contact_box() const { return box_; }
+  /** The object as the tool meets it (its voxels and drivable nodes): fixed for the loop's life. */
+  const ContactObject& contact_object() const { return object_; }
   /** The node the regions are centred on. Supervisor thread only. */
   const LatticeIndex& centre_node() const { return centre_; }
   /** Regions replaced since the loop was made (Reconfigure calls that took effect). */
@@ -369,7 +370,7 @@ class HapticLoop {
 
   Scene scene_;
   Options options_;
-  const ContactBox box_;  // the object as the tool meets it: the same for every configuration
+  const ContactObject object_;  // the object as the tool meets it: the same for every configuration
   std::unique_ptr<AsyncRegions> regions_;
   // [0] the primary's (kept across reconfigurations: its period never changes), then one per
   // secondary region of the installed regions.

@@ -57,8 +57,8 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   std::optional<SlidingContact::Binding> binding;
   if (sliding_) binding = sliding_->Prepare(*regions);
   const auto& lattice = regions->partition().mesh().options();
-  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || lattice.lattice_nodes != box_.nodes() ||
-      lattice.spacing_m != box_.spacing_m()) {
+  if (PrimaryRateHz(scene) != PrimaryRateHz(scene_) || lattice.lattice_nodes != object_.nodes() ||
+      lattice.spacing_m != object_.spacing_m()) {
     throw Error("a reconfiguration cannot change the object's mesh or the primary rate");
   }
   const bool carry = handover == Handover::kCarryMotion;

@@ -32,9 +32,9 @@ bool HapticLoop::TakeSurface(std::int64_t max_wait_ns, SurfaceFrame* frame) {
         if (!regions_->ReadSurface(&frame->displacement_m)) return false;
         frame->complete = served;
         if (frame->configuration_id != installs_) {
-          box_.ToWireIds(regions_->surface_ids(), &frame->ids);
-          frame->nodes_per_axis = box_.wire_nodes_per_axis();
-          frame->spacing_m = box_.spacing_m();
+          object_.ToWireIds(regions_->surface_ids(), &frame->ids);
+          frame->nodes_per_axis = object_.wire_nodes_per_axis();
+          frame->spacing_m = object_.spacing_m();
         }
         frame->configuration_id = installs_;
         frame->configuration = scene_.adaptivity;

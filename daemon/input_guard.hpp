@@ -33,7 +33,8 @@ class InputGuard {
    *  every integer; at 1 kHz, 285,000 years of device periods. */
   static constexpr std::int64_t kMaxSeq = std::int64_t{1} << 53;
 
-  /** `object_extent_m`: the object's box, from 0 to it along each axis (ContactBox::extent_m). */
+  /** `object_extent_m`: the object's box, from 0 to it along each axis (ContactObject::extent_m).
+   */
   InputGuard(const std::array<double, 3>& object_extent_m, double workspace_margin_m,
              double max_speed_m_per_s)
       : extent_m_(object_extent_m), margin_m_(workspace_margin_m), max_speed_(max_speed_m_per_s) {}

@@ -18,7 +18,7 @@ class InputIntake {
  public:
   InputIntake(double workspace_margin_m, double max_speed_m_per_s, HapticLoop& loop,
               InputCounters& counters, bool owns_input)
-      : guard_(loop.contact_box().extent_m(), workspace_margin_m, max_speed_m_per_s),
+      : guard_(loop.contact_object().extent_m(), workspace_margin_m, max_speed_m_per_s),
         loop_(loop),
         counters_(counters),
         owns_input_(owns_input) {}

@@ -8,21 +8,42 @@
 
 namespace hapticsim {
 
-SlidingContact::SlidingContact(const ContactBox& box, const ContactSettings& settings,
+SlidingContact::SlidingContact(const ContactObject& object, const ContactSettings& settings,
                                double engage_ramp_s)
-    : box_(box), settings_(settings), ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
+    : object_(object),
+      settings_(settings),
+      ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
 
 std::optional<LatticeIndex> SlidingContact::NodeInsideFace(
-    const ContactBox::Entry& entry) const noexcept {
-  LatticeIndex node{};
-  const std::array<int, 3>& n = box_.nodes();
+    const ContactObject::Entry& entry) const noexcept {
+  // The node of the entry's plane nearest to the point, or the nearest of its eight neighbours in
+  // the plane, that lies inside a flat face with the entry's normal (off the face's rim, and off
+  // any step of the surface: a proxy slides on one flat face).
+  int axis = 0;
+  while (axis < 2 && entry.inward_normal[axis] == 0) ++axis;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  std::array<double, 3> at{};  // the point in lattice units
+  LatticeIndex rounded{};
   for (int c = 0; c < 3; ++c) {
-    const int nearest = static_cast<int>(std::lround(entry.point_m[c] / box_.spacing_m()));
-    node[c] = entry.inward_normal[c] != 0 ? (entry.inward_normal[c] > 0 ? 0 : n[c] - 1)
-                                          : std::clamp(nearest, 1, std::max(1, n[c] - 2));
+    at[c] = entry.point_m[c] / object_.spacing_m();
+    rounded[c] = static_cast<int>(std::lround(at[c]));
   }
-  if (!box_.Drivable(node)) return std::nullopt;
-  return node;
+  std::optional<LatticeIndex> best;
+  double best_d2 = 0;
+  for (int du = -1; du <= 1; ++du) {
+    for (int dv = -1; dv <= 1; ++dv) {
+      LatticeIndex node = rounded;
+      node[u] += du;
+      node[v] += dv;
+      if (object_.FlatFaceNormal(node) != entry.inward_normal) continue;
+      const double d2 =
+          (node[u] - at[u]) * (node[u] - at[u]) + (node[v] - at[v]) * (node[v] - at[v]);
+      if (!best || d2 < best_d2) best = node, best_d2 = d2;
+    }
+  }
+  // On a held face: none (the support is not rendered).
+  if (!best || !object_.Drivable(*best)) return std::nullopt;
+  return best;
 }
 
 SlidingContact::Binding SlidingContact::Prepare(const AsyncRegions& regions) const {
@@ -56,16 +77,16 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
                                                const std::optional<LatticeIndex>& centre) noexcept {
   last_tool_ = state_ == State::kEngaged ? tool_ : tip_m;
   tool_ = tip_m;
-  if (!box_.Inside(tip_m)) {
+  if (!object_.Inside(tip_m)) {
     state_ = State::kFree;
     following_ = out_of_region_ = false;
     ramp_start_ns_ = catch_up_ns_ = -1;
-    wanted_ = NodeInsideFace(box_.EntryOf(box_.NearestPoint(tip_m)));
+    wanted_ = NodeInsideFace(object_.HoverEntry(tip_m));
     return {};
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
-    const ContactBox::Entry entry = box_.EntryOf(tip_m);
+    const ContactObject::Entry entry = object_.EntryOf(tip_m);
     inward_ = entry.inward_normal;
     wanted_ = NodeInsideFace(entry);
     if (!wanted_) {  // a held face: the support is not rendered (ContactTracker)
@@ -148,7 +169,7 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     // not the touched face's): nothing pushes it there; it waits for regions on its own face.
     state_ = State::kWaiting;
     out_of_region_ = false;
-    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) wanted_ = node;
+    if (const auto node = NodeInsideFace(ContactObject::Entry{tool_, inward_, 0})) wanted_ = node;
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
@@ -206,11 +227,12 @@ void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns,
 void SlidingContact::AfterPeriod() noexcept {
   following_ = false;
   if (state_ != State::kEngaged || !proxy_) return;
-  std::optional<LatticeIndex> next = ProxyWantsPrimaryAt(*proxy_, bound_centre_, box_.spacing_m());
+  std::optional<LatticeIndex> next =
+      ProxyWantsPrimaryAt(*proxy_, bound_centre_, object_.spacing_m());
   // Slid out of the primary before it followed: the node inside the face nearest the proxy (never a
   // rim node, whose normal is not the face's).
   if (!next && out_of_region_) {
-    next = NodeInsideFace(ContactBox::Entry{proxy_->proxy_rest_m(), inward_, 0});
+    next = NodeInsideFace(ContactObject::Entry{proxy_->proxy_rest_m(), inward_, 0});
   }
   if (next && *next != bound_centre_) {
     wanted_ = *next;
@@ -230,7 +252,7 @@ void SlidingContact::RestartKeepingContact() noexcept {
     // on its face can push there (TryEngage), its force ramped in. It wants the node under the
     // tip, not one it asked to follow to: that may have been refused.
     state_ = State::kWaiting;
-    if (const auto node = NodeInsideFace(ContactBox::Entry{tool_, inward_, 0})) wanted_ = node;
+    if (const auto node = NodeInsideFace(ContactObject::Entry{tool_, inward_, 0})) wanted_ = node;
     following_ = out_of_region_ = false;
     catch_up_ns_ = -1;
   }

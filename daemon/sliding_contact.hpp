@@ -7,7 +7,7 @@
 
 #include "core/regions/async_regions.hpp"
 #include "core/trial/proxy_contact.hpp"
-#include "daemon/contact_box.hpp"
+#include "daemon/contact_object.hpp"
 #include "daemon/contact_tracker.hpp"
 
 namespace hapticsim {
@@ -41,7 +41,8 @@ class SlidingContact {
  public:
   using Contact = ContactTracker::Contact;
 
-  SlidingContact(const ContactBox& box, const ContactSettings& settings, double engage_ramp_s);
+  SlidingContact(const ContactObject& object, const ContactSettings& settings,
+                 double engage_ramp_s);
 
   /** A proxy over new regions' primary, made before they are installed. */
   struct Binding {
@@ -108,7 +109,7 @@ class SlidingContact {
   Contact Answer() const noexcept;
   // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
   // normal the face's, as a proxy needs; never a rim node), none on a held face.
-  std::optional<LatticeIndex> NodeInsideFace(const ContactBox::Entry& entry) const noexcept;
+  std::optional<LatticeIndex> NodeInsideFace(const ContactObject::Entry& entry) const noexcept;
   // Engages a waiting touch when the regions, this period's (`centre`), can push under the tip on
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
@@ -120,7 +121,7 @@ class SlidingContact {
   // After a period's steps: where the regions should go (following the proxy).
   void AfterPeriod() noexcept;
 
-  ContactBox box_;
+  ContactObject object_;
   ContactSettings settings_;
   std::int64_t ramp_ns_ = 0;
   State state_ = State::kAwaitLiftOff;

@@ -18,8 +18,8 @@ constexpr std::int64_t kMs = 1'000'000;
 
 MeshSettings Mesh() { return MeshSettings{}; }
 // The default cube as the daemon's tracker sees it: a box of 13³ nodes, its back corners held.
-const ContactBox& CubeBox() {
-  static const ContactBox box = ContactBox::Of(Scene{});
+const ContactObject& CubeBox() {
+  static const ContactObject box = ContactObject::Of(Scene{});
   return box;
 }
 

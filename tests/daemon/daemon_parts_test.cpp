@@ -200,12 +200,11 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
 // adaptivity.outer_rate — stays the scene's, in the regions the daemon builds (SceneWith, as
 // main.cpp builds its HapticLoop). Without [adaptivity] the daemon starts from the default size
 // at equal rates.
-// hapticsimd's config check takes any object that fills its lattice's box (ContactBox): here a
-// box drawn as an STL, 4 × 4 × 4 voxels of 1 cm, with a [[material]] table and its back face held
-// by a [[support]] plane. (An object that leaves voxels empty is refused by the same check,
-// BoxObjectProblem: ContactBox.AnObjectThatLeavesVoxelsEmptyIsRefusedSayingHowMany; a daemon
-// serving such a block: HapticsimdDeformation.ABlockFromAFileIsServedOnItsOwnLattice.)
-TEST(DaemonConfig, AGeometryThatFillsItsBoxPassesTheCheck) {
+// hapticsimd's config check takes an object from a geometry file: here a box drawn as an STL,
+// 4 × 4 × 4 voxels of 1 cm, with a [[material]] table and its back face held by a [[support]]
+// plane. (Objects that leave voxels of their lattice empty are served too: voxel_object_test.cpp;
+// a daemon serving a block: HapticsimdDeformation.ABlockFromAFileIsServedOnItsOwnLattice.)
+TEST(DaemonConfig, AGeometryFromAFilePassesTheCheckAndOneWithoutSupportsIsRefused) {
   const std::string stl = ConfigTestPath() + ".box.stl";
   testing::WriteBoxStl(stl, 0.04);
   const std::string scene = ConfigTestPath() + ".scene.toml";
@@ -221,8 +220,6 @@ TEST(DaemonConfig, AGeometryThatFillsItsBoxPassesTheCheck) {
   EXPECT_NE(error.find("needs [[support]] tables"), std::string::npos) << error;
 }
 
-// A stroke's sliding proxy runs offline only (RunRegionStroke): a daemon scene asking for one is
-// refused, not served as a press.
 // A sliding tool is served (contact.model = "proxy", or a stroke's scene); its primary must reach
 // the tip's nodes, and a scene whose primary cannot is refused saying what to set.
 TEST(DaemonConfig, ASlidingToolIsServedAndAPrimaryTooSmallForItIsRefused) {

@@ -52,7 +52,7 @@ void WriteTrace(const std::string& path, const std::vector<device::TracePoint>& 
   HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": writing it failed (disk full?)");
 }
 
-// The object's box as the daemon's scene makes it (ContactBox): its extent along x, y, z, m.
+// The object's box as the daemon's scene makes it (ContactObject): its extent along x, y, z, m.
 std::array<double, 3> SceneExtent(const std::string& path) {
   const SceneObject object = DescribeSceneObject(LoadSceneFile(path));
   const HexGrid& grid = object.grid;
