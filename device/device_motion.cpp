@@ -57,6 +57,20 @@ std::string Metres(double value) {
 
 }  // namespace
 
+std::optional<double> ObjectFront::At(double x_m, double y_m) const {
+  if (z_m.empty()) return 0.0;
+  const std::array<double, 2> at{x_m, y_m};
+  std::array<int, 2> column{};
+  for (int c = 0; c < 2; ++c) {
+    const double edge = columns[c] * spacing_m;
+    if (!(at[c] >= 0 && at[c] <= edge)) return std::nullopt;
+    column[c] = std::min(static_cast<int>(std::floor(at[c] / spacing_m)), columns[c] - 1);
+  }
+  const double z = z_m[static_cast<std::size_t>(column[0] + columns[0] * column[1])];
+  if (std::isnan(z)) return std::nullopt;
+  return z;
+}
+
 DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.seed) {
   for (double e : s.extent_m) {
     if (!(e > 0 && std::isfinite(e))) throw Error("--edge must be positive, m");
@@ -79,6 +93,18 @@ DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.se
                 " leaves the front face (0 ≤ x ≤ " + Metres(s.extent_m[0]) +
                 " m): a stroke slides along +x on it; shorten it or start further left");
   }
+  if (s.kind == "press" || s.kind == "sine" || s.kind == "stroke") {
+    const auto over = [&](double x) {
+      if (s.front.At(x, s.at_m[1])) return;
+      throw Error("--at " + Metres(s.at_m[0]) + "," + Metres(s.at_m[1]) +
+                  (x != s.at_m[0] ? " and --length " + Metres(s.stroke_length_m) : "") +
+                  ": the object has no voxel under (" + Metres(x) + ", " + Metres(s.at_m[1]) +
+                  ") m; choose a point over it");
+    };
+    over(s.at_m[0]);
+    if (s.kind == "stroke") over(s.at_m[0] + s.stroke_length_m);
+    front_z_ = *s.front.At(s.at_m[0], s.at_m[1]);
+  }
   if (s.kind == "replay") {
     replay_ = ReadReplay(s.replay_path, s.replay_channel, s.rate_hz);
   } else if (s.kind == "walk") {
@@ -97,9 +123,19 @@ std::array<double, 3> DeviceMotion::NewWaypoint(bool inside) {
   std::uniform_real_distribution<double> depth(0.2 * settings_.amplitude_m, settings_.amplitude_m);
   std::uniform_real_distribution<double> height(0.001, 0.01);
   const std::array<double, 3>& e = settings_.extent_m;
-  const double x = std::clamp(to_[0] + step(random_), 0.1 * e[0], 0.9 * e[0]);
-  const double y = std::clamp(to_[1] + step(random_), 0.1 * e[1], 0.9 * e[1]);
-  return {x, y, inside ? depth(random_) : -height(random_)};
+  // Over the object only: a step that lands off it (an object that leaves voxels empty) is drawn
+  // again; after 100 misses the walk stays over its last point.
+  double x = to_[0], y = to_[1];
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const double tx = std::clamp(to_[0] + step(random_), 0.1 * e[0], 0.9 * e[0]);
+    const double ty = std::clamp(to_[1] + step(random_), 0.1 * e[1], 0.9 * e[1]);
+    if (settings_.front.At(tx, ty)) {
+      x = tx, y = ty;
+      break;
+    }
+  }
+  const double front = settings_.front.At(x, y).value_or(0.0);
+  return {x, y, front + (inside ? depth(random_) : -height(random_))};
 }
 
 std::array<double, 3> DeviceMotion::NextWalk() {
@@ -124,9 +160,10 @@ std::array<double, 3> DeviceMotion::StrokeAt(double t_s) const {
   // The legs' ends as shares of the period: in, along, out, back.
   static constexpr std::array<double, 5> kEnds = {0.0, 0.2, 0.7, 0.8, 1.0};
   const double phase = t_s * settings_.frequency_hz - std::floor(t_s * settings_.frequency_hz);
-  const std::array<double, 3> start{settings_.at_m[0], settings_.at_m[1], -settings_.hover_m};
+  const std::array<double, 3> start{settings_.at_m[0], settings_.at_m[1],
+                                    front_z_ - settings_.hover_m};
   std::array<std::array<double, 3>, 5> corners{start, start, start, start, start};
-  corners[1][2] = corners[2][2] = settings_.amplitude_m;
+  corners[1][2] = corners[2][2] = front_z_ + settings_.amplitude_m;
   corners[2][0] = corners[3][0] = settings_.at_m[0] + settings_.stroke_length_m;
   int leg = 0;
   while (leg < 3 && phase >= kEnds[static_cast<std::size_t>(leg) + 1]) ++leg;
@@ -148,10 +185,10 @@ std::optional<std::array<double, 3>> DeviceMotion::Next() {
   const double phase = 2 * std::numbers::pi * settings_.frequency_hz * t;
   std::array<double, 3> tip{settings_.at_m[0], settings_.at_m[1], 0.0};
   if (settings_.kind == "press") {
-    tip[2] = -settings_.hover_m +
+    tip[2] = front_z_ - settings_.hover_m +
              (settings_.amplitude_m + settings_.hover_m) * 0.5 * (1 - std::cos(phase));
   } else if (settings_.kind == "sine") {
-    tip[2] = settings_.amplitude_m * std::sin(phase);
+    tip[2] = front_z_ + settings_.amplitude_m * std::sin(phase);
   } else if (settings_.kind == "stroke") {
     tip = StrokeAt(t);
   } else {  // walk: the constructor refused any other kind

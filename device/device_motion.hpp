@@ -9,12 +9,28 @@
 
 namespace hapticsim::device {
 
+/**
+ * Where the object's front is over each point of the x–y plane: the least z of the voxels in the
+ * column of voxels there (an object that leaves voxels empty has its front at several depths).
+ * Empty (no columns): the box's front face, z = 0, everywhere.
+ */
+struct ObjectFront {
+  double spacing_m = 0;          ///< the columns' width (the voxels' edge), m
+  std::array<int, 2> columns{};  ///< along x and y
+  std::vector<double> z_m;       ///< per column, x fastest; NaN where the column is empty
+  /** The front's z over (x, y), m; none off the object (and, with columns, off the lattice). */
+  std::optional<double> At(double x_m, double y_m) const;
+};
+
 /** What the simulated device does with its tool tip (object frame, m; see device_input_t). */
 struct MotionSettings {
   std::string kind = "press";  ///< press | sine | walk | stroke | replay
   /// The daemon's object as the device meets it: its box's extent along x, y, z, m (the cube's
   /// edge three times; --edge, or --scene). The front face is z = 0, x and y from 0 to theirs.
   std::array<double, 3> extent_m{0.25, 0.25, 0.25};
+  /// Where the object's front is (--scene); the presses, sines and strokes start from it at
+  /// `at_m` and the walk's waypoints from it where they are.
+  ObjectFront front;
   double amplitude_m = 0.01;                 ///< press depth / sine amplitude / deepest walk press
   double frequency_hz = 1.0;                 ///< press and sine
   std::array<double, 2> at_m{0.125, 0.125};  ///< press and sine: the point on the front face
@@ -29,6 +45,7 @@ struct MotionSettings {
 
 /**
  * The tool tip, period by period, reproducibly:
+ * Depths and heights are from the object's front (`front`) at the point over which they are.
  * - press: from `hover_m` above the front face at `at_m` to `amplitude_m` deep and back,
  *   (1 − cos 2πft)/2 — the paper's press;
  * - sine: amplitude·sin 2πft around the surface at `at_m`, touching down and lifting off every
@@ -69,6 +86,7 @@ class DeviceMotion {
   std::array<double, 3> from_{}, to_{};
   std::int64_t leg_start_ = 0, leg_periods_ = 1;
   bool inside_next_ = true;
+  double front_z_ = 0;  // the object's front at at_m (press, sine, stroke), m
   std::vector<std::optional<std::array<double, 3>>> replay_;
 };
 

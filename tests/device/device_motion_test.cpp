@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <optional>
 #include <set>
 #include <vector>
@@ -91,6 +92,66 @@ TEST(DeviceMotion, OnABlockTheWalkStaysOnItsFaceAndAPressOffItIsRefused) {
   s.at_m = {0.04, 0.02};
   s.amplitude_m = 0.03;  // as deep as the block
   EXPECT_THROW(DeviceMotion deep(s), Error);
+}
+
+// An object whose front is at two depths: 10 × 6 columns of 1 cm, the four left columns' front
+// at z = 2 cm (a step cut out), the rest at z = 0, and one column empty through (a hole at x 8–9
+// cm, y 2–3 cm). Each motion starts from the front over its own point; a point over the hole is
+// refused naming --at; the walk's waypoints stay over the object at their own depths (its legs may
+// cross the hole).
+TEST(DeviceMotion, OverAnObjectWithEmptyVoxelsEachMotionStartsFromTheFrontUnderIt) {
+  MotionSettings s;
+  s.extent_m = {0.10, 0.06, 0.04};
+  s.front.spacing_m = 0.01;
+  s.front.columns = {10, 6};
+  for (int y = 0; y < 6; ++y) {
+    for (int x = 0; x < 10; ++x) s.front.z_m.push_back(x < 4 ? 0.02 : 0.0);
+  }
+  s.front.z_m[8 + 10 * 2] = std::numeric_limits<double>::quiet_NaN();
+  s.amplitude_m = 0.003;
+  s.hover_m = 0.002;
+  s.kind = "press";
+  s.at_m = {0.025, 0.03};  // over the step
+  DeviceMotion step(s);
+  std::array<double, 3> tip = step.Next().value();
+  EXPECT_NEAR(tip[2], 0.018, 1e-12);  // 2 mm above the step's floor
+  for (int n = 1; n <= 500; ++n) tip = step.Next().value();
+  EXPECT_NEAR(tip[2], 0.023, 1e-9);  // 3 mm into it, half a period on
+  s.at_m = {0.065, 0.03};            // over the front face right of the step
+  EXPECT_NEAR(DeviceMotion(s).Next().value()[2], -0.002, 1e-12);
+  s.kind = "stroke";
+  s.at_m = {0.005, 0.025};
+  s.stroke_length_m = 0.03;
+  tip = DeviceMotion(s).Next().value();
+  EXPECT_NEAR(tip[2], 0.018, 1e-12);
+  s.kind = "press";
+  s.at_m = {0.085, 0.025};  // over the hole
+  try {
+    DeviceMotion refused(s);
+    FAIL() << "a press over no voxel was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--at 0.085,0.025"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no voxel under"), std::string::npos) << e.what();
+  }
+  s.kind = "walk";
+  s.at_m = {0.05, 0.03};
+  DeviceMotion walk(s);
+  int on_step = 0, deep_on_step = 0, over_hole = 0;
+  for (int n = 0; n < 60000; ++n) {
+    tip = walk.Next().value();
+    const std::optional<double> front = s.front.At(tip[0], tip[1]);
+    if (!front) {  // a leg between two waypoints over the object may cross the hole
+      ++over_hole;
+      continue;
+    }
+    if (*front > 0.01) {
+      ++on_step;
+      deep_on_step += tip[2] > 0.02 ? 1 : 0;
+    }
+  }
+  EXPECT_LT(over_hole, 60000 / 50) << "waypoints over the hole";
+  EXPECT_GT(on_step, 1000);
+  EXPECT_GT(deep_on_step, 100) << "the walk never pressed into the step's floor";
 }
 
 TEST(DeviceMotion, TheWalkIsReproducibleAndTouchesDownSomewhereNewEachTime) {

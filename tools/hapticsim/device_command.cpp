@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 
 #include "core/error.hpp"
 #include "core/scene/scene_model.hpp"
@@ -28,7 +29,7 @@ struct DeviceOptions {
   device::MotionSettings motion;
   std::vector<double> at;
   double edge_m = 0;       // --edge: the cube's edge
-  std::string scene_file;  // --scene: the daemon's scene, for its object's box
+  std::string scene_file;  // --scene: the daemon's scene, for its object
   double duration_s = 10;
   int cpu_load = 0;
   std::vector<double> bad_input_at_s;
@@ -52,19 +53,34 @@ void WriteTrace(const std::string& path, const std::vector<device::TracePoint>& 
   HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": writing it failed (disk full?)");
 }
 
-// The object's box as the daemon's scene makes it (ContactObject): its extent along x, y, z, m.
-std::array<double, 3> SceneExtent(const std::string& path) {
+// The object as the daemon's scene makes it (ContactObject): its lattice's extent along x, y, z
+// (m) and where its front is over each column of voxels.
+void MeetSceneObject(const std::string& path, device::MotionSettings* motion) {
   const SceneObject object = DescribeSceneObject(LoadSceneFile(path));
   const HexGrid& grid = object.grid;
-  return {(grid.nx() - 1) * grid.spacing(), (grid.ny() - 1) * grid.spacing(),
-          (grid.nz() - 1) * grid.spacing()};
+  const double h = grid.spacing();
+  motion->extent_m = {(grid.nx() - 1) * h, (grid.ny() - 1) * h, (grid.nz() - 1) * h};
+  device::ObjectFront& front = motion->front;
+  front.spacing_m = h;
+  front.columns = {grid.nx() - 1, grid.ny() - 1};
+  front.z_m.assign(static_cast<std::size_t>(front.columns[0]) * front.columns[1],
+                   std::numeric_limits<double>::quiet_NaN());
+  for (int y = 0; y < front.columns[1]; ++y) {
+    for (int x = 0; x < front.columns[0]; ++x) {
+      for (int z = 0; z < grid.nz() - 1; ++z) {
+        if (!object.field.occupied(object.field.Element(x, y, z))) continue;
+        front.z_m[static_cast<std::size_t>(x + front.columns[0] * y)] = z * h;
+        break;
+      }
+    }
+  }
 }
 
 int Run(DeviceOptions o) {
   HAPTICSIM_THROW_UNLESS(o.edge_m == 0 || o.scene_file.empty(),
                          "--edge and --scene both give the object: use one");
   if (o.edge_m != 0) o.motion.extent_m = {o.edge_m, o.edge_m, o.edge_m};
-  if (!o.scene_file.empty()) o.motion.extent_m = SceneExtent(o.scene_file);
+  if (!o.scene_file.empty()) MeetSceneObject(o.scene_file, &o.motion);
   if (!o.at.empty()) {
     HAPTICSIM_THROW_UNLESS(o.at.size() == 2, "--at takes two numbers: X,Y on the front face, m");
     o.motion.at_m = {o.at[0], o.at[1]};
@@ -186,14 +202,15 @@ Command AddDeviceCommand(CLI::App& parent) {
                   "Press, sine and stroke frequency, Hz")
       ->capture_default_str();
   app->add_option("--at", options->at,
-                  "Press, sine and stroke start point on the front face: X,Y in m "
-                  "(default: its middle)")
+                  "Press, sine and stroke start point over the object's front: X,Y in m "
+                  "(default: the middle of its box)")
       ->delimiter(',')
       ->expected(2);
   app->add_option("--edge", options->edge_m, "The daemon's cube edge, m (default 0.25)");
   app->add_option("--scene", options->scene_file,
                   "The daemon's scene file ([scene] file in its config): the device presses, "
-                  "sines and walks on its object's front face, z = 0 (instead of --edge)");
+                  "sines, strokes and walks on its object's front (its least z over each point; "
+                  "z = 0 on a block), instead of --edge's cube");
   app->add_option("--seed", options->motion.seed, "Random walk seed")->capture_default_str();
   app->add_option("--walk-speed", options->motion.walk_speed_m_per_s, "Random walk top speed, m/s")
       ->capture_default_str();
