@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -15,8 +16,11 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/scene/scene_model.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "device/device_link.hpp"
 #include "tools/hapticsim/command.hpp"
+#include "tools/view/object_surface.hpp"
 #include "tools/view/view_feed.hpp"
 #include "tools/view/view_server.hpp"
 
@@ -30,6 +34,7 @@ struct ViewOptions {
   view::FeedChannels channels;
   view::ServerSettings server;
   std::string open = "auto";
+  std::string scene_file;  // --scene: the daemon's scene, for its object's surface
 };
 
 #if HAPTICSIM_WITH_VIEW
@@ -65,14 +70,22 @@ int Run(const ViewOptions& o) {
   }
   const view::FeedChannels& channels = o.channels;
   view::ServerSettings settings = o.server;
-  settings.hello_json = nlohmann::json{{"type", "hello"},
-                                       {"lcm_url", o.lcm_url},
-                                       {"channels",
-                                        {{"device", channels.device},
-                                         {"force", channels.force},
-                                         {"status", channels.status},
-                                         {"deformation", channels.deformation}}}}
-                            .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  nlohmann::json hello{{"type", "hello"},
+                       {"lcm_url", o.lcm_url},
+                       {"channels",
+                        {{"device", channels.device},
+                         {"force", channels.force},
+                         {"status", channels.status},
+                         {"deformation", channels.deformation}}}};
+  if (!o.scene_file.empty()) {
+    // The object's faces, for an object whose surface ids alone do not say which squares are its
+    // faces (one that leaves voxels empty): drawn instead of the box's.
+    const SceneObject object = DescribeSceneObject(LoadSceneFile(o.scene_file));
+    hello["surface_quads"] = view::ObjectSurfaceQuads(object);
+    hello["nodes_per_axis"] = std::max({object.grid.nx(), object.grid.ny(), object.grid.nz()});
+    hello["scene"] = o.scene_file;
+  }
+  settings.hello_json = hello.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   struct sigaction action {};
   action.sa_handler = OnStopSignal;
   sigaction(SIGINT, &action, nullptr);
@@ -129,6 +142,10 @@ Command AddViewCommand(CLI::App& parent) {
                   "Start the desktop's browser on the page: auto (when $DISPLAY or "
                   "$WAYLAND_DISPLAY is set), yes or no")
       ->capture_default_str();
+  app->add_option("--scene", options->scene_file,
+                  "The daemon's scene file ([scene] file in its config): draws its object's own "
+                  "faces, which an object that leaves voxels of its lattice empty needs (without "
+                  "it the page draws the faces of the lattice's box)");
   app->add_option("--frame-rate", options->server.frame_rate_hz,
                   "Most updates per second sent to a page, Hz")
       ->capture_default_str();

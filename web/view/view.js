@@ -93,6 +93,17 @@ function surfaceQuads(n, last, indexOf) {
   return quads;
 }
 
+// The object's own faces (hapticsim view --scene: four node ids each, wound outwards) as node
+// indices; a face with a node the frame does not carry is left out.
+function objectQuads(faceIds, indexOf) {
+  const quads = [];
+  for (let q = 0; q < faceIds.length; q += 4) {
+    const corners = faceIds.slice(q, q + 4).map((id) => indexOf.get(id));
+    if (corners.every((v) => v !== undefined)) quads.push(...corners);
+  }
+  return quads;
+}
+
 const QUAD_TRIANGLES = [0, 1, 2, 0, 2, 3];
 
 function quadLines(quads) {
@@ -120,7 +131,12 @@ function buildObject(m) {
     rest[3 * k + c] = l * h;
     last[c] = Math.max(last[c], l);
   }));
-  const quads = surfaceQuads(n, last, indexOf);
+  const quads = hello.surfaceQuads && hello.nodesPerAxis === n
+    ? objectQuads(hello.surfaceQuads, indexOf) : surfaceQuads(n, last, indexOf);
+  // Surface nodes no square drawn has: an object that leaves voxels of its box empty, drawn as a
+  // box (its own faces come with --scene).
+  const drawn = new Set(quads);
+  object.undrawnNodes = ids.length - drawn.size;
   const nodes = new THREE.BufferAttribute(rest.slice(), 3);
   const lines = new THREE.BufferGeometry();
   lines.setAttribute('position', nodes);
@@ -224,6 +240,8 @@ function frameCamera() {
 controls.addEventListener('start', () => { controls.userMoved = true; });
 
 // ---- messages --------------------------------------------------------------------------------
+// From the view's hello: the object's own faces when it was given the scene (--scene).
+const hello = { surfaceQuads: null, nodesPerAxis: 0 };
 const state = { frames: 0, lastTool: 0, toolPosition: null, force: null, status: null,
                 deformation: null };
 
@@ -242,7 +260,9 @@ function onDeformation(m) {
   document.body.dataset.inContact = String(m.in_contact);
   $('surface').textContent = `frame ${m.frame}, ${m.node_ids.length} nodes, ` +
       `${shown(m.latency_ms, 1)}\u00a0ms to send` +
-      (m.complete ? '' : state.status?.asleep ? ', at rest' : ', a region did not step in time');
+      (m.complete ? '' : state.status?.asleep ? ', at rest' : ', a region did not step in time') +
+      (object.undrawnNodes > 0 ? `; ${object.undrawnNodes} nodes on no face drawn: an object ` +
+        'that leaves voxels empty? start hapticsim view with --scene (the daemon\'s scene)' : '');
 }
 
 const shown = (v, digits) => (Number.isFinite(v) ? v.toFixed(digits) : '–');
@@ -300,6 +320,9 @@ function connect() {
   socket.onmessage = (event) => {
     const m = JSON.parse(event.data);
     if (m.type === 'hello') {
+      hello.surfaceQuads = m.surface_quads ?? null;
+      hello.nodesPerAxis = m.nodes_per_axis ?? 0;
+      object.configuration = -1;  // (re)built with the faces this view has
       connection.className = 'waiting';
       connection.textContent = `waiting for hapticsimd on ${m.lcm_url}…`;
       return;
@@ -371,6 +394,12 @@ window.hapticsimView = {
       });
     }
     return out;
+  },
+  // The squares drawn (each four node ids) and the surface nodes on none of them.
+  surfaceDrawn() {
+    const quads = [];
+    for (const v of object.quads ?? []) quads.push(object.ids[v]);
+    return { quads, undrawnNodes: object.undrawnNodes ?? 0, nodeIds: object.ids ?? [] };
   },
   // The touched node where the page draws it now (object frame, m), or null.
   touchedNodeDrawn() {
