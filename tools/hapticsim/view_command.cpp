@@ -16,11 +16,11 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/scene/object_surface.hpp"
 #include "core/scene/scene_model.hpp"
 #include "core/scene/scene_toml.hpp"
 #include "device/device_link.hpp"
 #include "tools/hapticsim/command.hpp"
-#include "tools/view/object_surface.hpp"
 #include "tools/view/view_feed.hpp"
 #include "tools/view/view_server.hpp"
 
@@ -81,7 +81,7 @@ int Run(const ViewOptions& o) {
     // The object's faces, for an object whose surface ids alone do not say which squares are its
     // faces (one that leaves voxels empty): drawn instead of the box's.
     const SceneObject object = DescribeSceneObject(LoadSceneFile(o.scene_file));
-    hello["surface_quads"] = view::ObjectSurfaceQuads(object);
+    hello["surface_quads"] = ObjectSurfaceQuads(object);
     hello["nodes_per_axis"] = std::max({object.grid.nx(), object.grid.ny(), object.grid.nz()});
     hello["scene"] = o.scene_file;
   }

@@ -1,9 +1,9 @@
-#include "tools/view/object_surface.hpp"
+#include "core/scene/object_surface.hpp"
 
 #include <algorithm>
 #include <array>
 
-namespace hapticsim::view {
+namespace hapticsim {
 
 std::vector<std::int32_t> ObjectSurfaceQuads(const SceneObject& object) {
   const HexGrid& grid = object.grid;
@@ -48,4 +48,4 @@ std::vector<std::int32_t> ObjectSurfaceQuads(const SceneObject& object) {
   return quads;
 }
 
-}  // namespace hapticsim::view
+}  // namespace hapticsim
