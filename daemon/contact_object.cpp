@@ -27,15 +27,15 @@ ContactObject::ContactObject(const SceneObject& object)
   for (int z = 0; z < vz; ++z) {
     for (int y = 0; y < vy; ++y) {
       for (int x = 0; x < vx; ++x) {
-        occupied_[static_cast<std::size_t>(x + vx * (y + vy * z))] =
-            object.field.occupied(object.field.Element(x, y, z));
+        const bool occupied = object.field.occupied(object.field.Element(x, y, z));
+        occupied_[static_cast<std::size_t>(x + vx * (y + vy * z))] = occupied;
+        occupied_voxels_ += occupied ? 1 : 0;
       }
     }
   }
   const std::size_t count = static_cast<std::size_t>(nodes_[0]) * nodes_[1] * nodes_[2];
   drivable_.assign(count, false);
   flat_face_.assign(count, 0);
-  bool any_free = false;
   for (int ix = 0; ix < nodes_[0]; ++ix) {
     for (int iy = 0; iy < nodes_[1]; ++iy) {
       for (int iz = 0; iz < nodes_[2]; ++iz) {
@@ -45,12 +45,13 @@ ContactObject::ContactObject(const SceneObject& object)
         const bool held =
             std::binary_search(object.fixed_nodes.begin(), object.fixed_nodes.end(), node);
         drivable_[Index(at)] = !held;
-        any_free = any_free || !held;
+        drivable_nodes_ += held ? 0 : 1;
         flat_face_[Index(at)] = FlatFaceCode(at);
       }
     }
   }
-  HAPTICSIM_THROW_UNLESS(any_free, "the supports hold every surface node: nothing to touch");
+  HAPTICSIM_THROW_UNLESS(drivable_nodes_ > 0,
+                         "the supports hold every surface node: nothing to touch");
   FloodNearestVoxels();
 }
 

@@ -35,6 +35,10 @@ class ContactObject {
   /** The lattice's box along each axis, m: (n − 1)·h (the object lies inside it). */
   const std::array<double, 3>& extent_m() const { return extent_m_; }
 
+  /** How many voxels it occupies, and how many surface nodes a tool may drive. */
+  int occupied_voxels() const { return occupied_voxels_; }
+  int drivable_nodes() const { return drivable_nodes_; }
+
   /** True for a tool tip strictly inside the lattice's box and in an occupied voxel, m. */
   bool Inside(const std::array<double, 3>& tip_m) const noexcept;
   /** Where a tip inside the object came in: of the six ways out along the axes, the one it is
@@ -113,6 +117,7 @@ class ContactObject {
   std::vector<std::int8_t> flat_face_;  // by Code: 0, or ±(axis + 1) of the inward normal
   std::vector<bool> occupied_;          // by voxel, x fastest
   std::vector<std::int32_t> nearest_;   // by voxel: the nearest occupied voxel (itself if so)
+  int occupied_voxels_ = 0, drivable_nodes_ = 0;
 };
 
 }  // namespace hapticsim

@@ -58,6 +58,13 @@ Daemon::Daemon(const DaemonArguments& args, StartupConfig startup)
   loop_ = std::make_unique<HapticLoop>(SceneWith(config_.scene, first.configuration),
                                        LoopOptionsOf(config_, args_.no_port_guard));
   loop_->SetErrorState(first.error_percent, DecisionFlags(first));
+  const ContactObject& object = loop_->contact_object();
+  const std::array<int, 3>& nodes = object.nodes();
+  spdlog::info(
+      "object: {} of the {} × {} × {} voxels of {:.4g} m occupied; {} surface nodes the tool may "
+      "touch",
+      object.occupied_voxels(), nodes[0] - 1, nodes[1] - 1, nodes[2] - 1, object.spacing_m(),
+      object.drivable_nodes());
   const LatticeIndex contact = loop_->centre_node();
   spdlog::info(
       "contact: the regions are centred on node ({}, {}, {}) and follow the tool{}", contact[0],
