@@ -88,8 +88,9 @@ typedef struct hapticsim_deformation {
   int64_t configuration_id; /* changes whenever the regions are replaced (ids may then differ) */
   int32_t in_contact;       /* 1: the tool engaged within the last 5 primary periods */
   int32_t complete;         /* 1: every region published its part after being asked */
-  int32_t nodes_per_axis;   /* n: node id = (ix * n + iy) * n + iz (the object's largest node
-                               count: the object is a box of nodes 0 … its largest index) */
+  int32_t nodes_per_axis;   /* n: node id = (ix * n + iy) * n + iz (the largest node count of
+                               the object's lattice, nodes 0 … its largest index; its faces:
+                               ObjectSurfaceQuads in core/scene/object_surface.hpp) */
   int32_t contact_node[3];  /* lattice indices the regions are centred on */
   double spacing_m;         /* lattice spacing, m: a node rests at (ix, iy, iz) * spacing_m */
   int32_t num_nodes;        /* surface nodes written into the caller's arrays */

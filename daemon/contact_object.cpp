@@ -126,8 +126,8 @@ bool ContactObject::Inside(const std::array<double, 3>& tip_m) const noexcept {
 ContactObject::Entry ContactObject::EntryFrom(const std::array<double, 3>& point_m,
                                               const std::array<int, 3>& voxel) const noexcept {
   // Along each axis the row of occupied voxels through `voxel` ends, on either side, at a face
-  // of the surface: the nearest of those six faces is the way in.
-  const auto row_end = [&](int c, int step) {
+  // of the surface: the nearest of those six faces is the way in (the front, −z, first on a tie).
+  const auto face_beyond_row = [&](int c, int step) {
     std::array<int, 3> at = voxel;
     do {
       at[c] += step;
@@ -135,9 +135,9 @@ ContactObject::Entry ContactObject::EntryFrom(const std::array<double, 3>& point
     return (step < 0 ? at[c] + 1 : at[c]) * spacing_m_;
   };
   int axis = 2;
-  double face = row_end(2, -1), depth = point_m[2] - face, inward = 1;
+  double face = 0, depth = std::numeric_limits<double>::infinity(), inward = 1;
   for (int c : {2, 0, 1}) {
-    const double low = row_end(c, -1), high = row_end(c, +1);
+    const double low = face_beyond_row(c, -1), high = face_beyond_row(c, +1);
     if (point_m[c] - low < depth) depth = point_m[c] - low, axis = c, face = low, inward = 1;
     if (high - point_m[c] < depth) depth = high - point_m[c], axis = c, face = high, inward = -1;
   }
@@ -158,38 +158,46 @@ std::array<int, 3> ContactObject::NearestVoxel(
   const std::array<int, 3> v = VoxelOf(point_m);
   const int nx = nodes_[0] - 1, ny = nodes_[1] - 1;
   const std::int32_t flooded = nearest_[static_cast<std::size_t>(v[0] + nx * (v[1] + ny * v[2]))];
-  const std::array<int, 3> source{flooded % nx, flooded / nx % ny, flooded / (nx * ny)};
-  // The flood's voxel is near the nearest; the nearest to this point is it or beside it.
-  std::array<int, 3> best = source;
+  // The flood's voxel is near the nearest, not always it (it measures in steps, not metres): the
+  // nearest among the voxels around it and around the point's own voxel.
+  std::array<int, 3> best{flooded % nx, flooded / nx % ny, flooded / (nx * ny)};
   double best_d2 = std::numeric_limits<double>::infinity();
-  for (int d = 0; d < 27; ++d) {
-    const std::array<int, 3> at{source[0] + d % 3 - 1, source[1] + d / 3 % 3 - 1,
-                                source[2] + d / 9 - 1};
-    if (!Occupied(at[0], at[1], at[2])) continue;
-    double d2 = 0;
-    for (int c = 0; c < 3; ++c) {
-      const double gap =
-          point_m[c] - Clamp(point_m[c], at[c] * spacing_m_, (at[c] + 1) * spacing_m_);
-      d2 += gap * gap;
+  for (const std::array<int, 3> around : {best, v}) {
+    for (int d = 0; d < 27; ++d) {
+      const std::array<int, 3> at{around[0] + d % 3 - 1, around[1] + d / 3 % 3 - 1,
+                                  around[2] + d / 9 - 1};
+      if (!Occupied(at[0], at[1], at[2])) continue;
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double gap =
+            point_m[c] - Clamp(point_m[c], at[c] * spacing_m_, (at[c] + 1) * spacing_m_);
+        d2 += gap * gap;
+      }
+      if (d2 < best_d2) best_d2 = d2, best = at;
     }
-    if (d2 < best_d2) best_d2 = d2, best = at;
   }
   return best;
+}
+
+std::array<double, 3> ContactObject::PointOf(const std::array<int, 3>& voxel,
+                                             const std::array<double, 3>& tip_m) const noexcept {
+  std::array<double, 3> point{};
+  for (int c = 0; c < 3; ++c) {
+    point[c] = Clamp(tip_m[c], voxel[c] * spacing_m_, (voxel[c] + 1) * spacing_m_);
+  }
+  return point;
 }
 
 std::array<double, 3> ContactObject::NearestPoint(
     const std::array<double, 3>& tip_m) const noexcept {
   if (Inside(tip_m)) return tip_m;
-  const std::array<int, 3> v = NearestVoxel(tip_m);
-  std::array<double, 3> nearest{};
-  for (int c = 0; c < 3; ++c)
-    nearest[c] = Clamp(tip_m[c], v[c] * spacing_m_, (v[c] + 1) * spacing_m_);
-  return nearest;
+  return PointOf(NearestVoxel(tip_m), tip_m);
 }
 
 ContactObject::Entry ContactObject::HoverEntry(const std::array<double, 3>& tip_m) const noexcept {
   if (Inside(tip_m)) return EntryOf(tip_m);
-  return EntryFrom(NearestPoint(tip_m), NearestVoxel(tip_m));
+  const std::array<int, 3> voxel = NearestVoxel(tip_m);
+  return EntryFrom(PointOf(voxel, tip_m), voxel);
 }
 
 std::array<double, 3> ContactObject::FlatFaceNormal(const LatticeIndex& node) const noexcept {

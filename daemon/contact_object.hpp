@@ -50,9 +50,9 @@ class ContactObject {
     double depth_m = 0;
   };
   Entry EntryOf(const std::array<double, 3>& tip_m) const noexcept;
-  /** Where a tip outside the object would come down: the point of its nearest voxel nearest to
+  /** Where a tip outside the object would come down: the point of a voxel near it nearest to
    *  the tip (NearestPoint), with that voxel's way out as EntryOf gives it (depth 0 on a face
-   *  of the surface). */
+   *  of the surface where the voxel is the nearest). */
   Entry HoverEntry(const std::array<double, 3>& tip_m) const noexcept;
 
   /** True for a node on the object's surface (beside an occupied voxel and an empty one, or the
@@ -70,8 +70,9 @@ class ContactObject {
   std::optional<LatticeIndex> NearestDrivable(
       const std::array<double, 3>& surface_point_m) const noexcept;
 
-  /** The point of the object nearest to `tip_m` (a tip inside: itself; outside: a point of the
-   *  occupied voxel nearest to it, which lies on the surface). */
+  /** The point of the object near `tip_m` (a tip inside: itself; outside: the point nearest to
+   *  it of the nearest occupied voxel around the flood's and the tip's own voxel — the nearest
+   *  point of the object but where a gap hides a nearer voxel further away). */
   std::array<double, 3> NearestPoint(const std::array<double, 3>& tip_m) const noexcept;
 
   /** The inward normal of the flat face `node` lies inside of — its four voxels on one side of
@@ -88,7 +89,7 @@ class ContactObject {
    * The lattice as deformation_t and the shared-memory segment give it: one node count n for all
    * three axes, node id = (ix · n + iy) · n + iz. n is the box's largest count, so every node of
    * the box has an id and a reader that decodes with n gets its indices (the cube's ids are the
-   * regions' own). A reader finds the box's far faces at the largest index along each axis.
+   * regions' own). The object's faces: ObjectSurfaceQuads (core/scene/object_surface.hpp).
    */
   int wire_nodes_per_axis() const { return std::max({nodes_[0], nodes_[1], nodes_[2]}); }
   /** The regions' surface ids (Code's order) as wire ids, into `wire` (resized). */
@@ -107,7 +108,11 @@ class ContactObject {
   // 0, or ±(axis + 1) of the inward normal of the flat face `node` lies inside of.
   std::int8_t FlatFaceCode(const LatticeIndex& node) const noexcept;
   void FloodNearestVoxels();
-  // The occupied voxel nearest to `point_m` (clamped into the lattice's box).
+  // The point of `voxel` nearest to `tip_m`.
+  std::array<double, 3> PointOf(const std::array<int, 3>& voxel,
+                                const std::array<double, 3>& tip_m) const noexcept;
+  // The occupied voxel nearest to `point_m`, among those around the flood's voxel for it and
+  // around its own.
   std::array<int, 3> NearestVoxel(const std::array<double, 3>& point_m) const noexcept;
 
   std::array<int, 3> nodes_{};

@@ -264,7 +264,9 @@ void ValidateDaemonConfig(const DaemonConfig& c) {
   // surface node left for the tool (each throws saying what to fix).
   const ContactObject object = ContactObject::Of(c.scene);
   // A sliding tool's primary follows its proxy and must reach every node its tip touches.
-  if (UsesProxyContact(c.scene)) CheckPrimaryReachesTip(c.scene, object.spacing_m());
+  if (UsesProxyContact(c.scene)) {
+    CheckPrimaryReachesTip(c.scene, object.spacing_m(), kThreadsFollowSlack);
+  }
 }
 
 std::string LcmUrlProblem(const std::string& url, bool allow_network) {

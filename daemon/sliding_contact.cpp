@@ -14,11 +14,21 @@ SlidingContact::SlidingContact(const ContactObject& object, const ContactSetting
       settings_(settings),
       ramp_ns_(static_cast<std::int64_t>(engage_ramp_s * 1e9)) {}
 
+ContactObject::Entry SlidingContact::OnTouchedFace(
+    const std::array<double, 3>& point_m) const noexcept {
+  ContactObject::Entry entry{point_m, inward_, 0};
+  for (int c = 0; c < 3; ++c) {
+    if (inward_[c] != 0) entry.point_m[c] = face_m_;
+  }
+  return entry;
+}
+
 std::optional<LatticeIndex> SlidingContact::NodeInsideFace(
     const ContactObject::Entry& entry) const noexcept {
-  // The node of the entry's plane nearest to the point, or the nearest of its eight neighbours in
-  // the plane, that lies inside a flat face with the entry's normal (off the face's rim, and off
-  // any step of the surface: a proxy slides on one flat face).
+  // The node of the entry's face plane nearest to the point, or the nearest of its eight
+  // neighbours in the plane, that lies inside a flat face with the entry's normal (off the face's
+  // rim, and off any step of the surface: a proxy slides on one flat face). The point is on the
+  // plane (callers with a tip under the face project it: OnTouchedFace).
   int axis = 0;
   while (axis < 2 && entry.inward_normal[axis] == 0) ++axis;
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
@@ -88,6 +98,9 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
   if (state_ == State::kFree) {
     const ContactObject::Entry entry = object_.EntryOf(tip_m);
     inward_ = entry.inward_normal;
+    for (int c = 0; c < 3; ++c) {
+      if (inward_[c] != 0) face_m_ = entry.point_m[c];
+    }
     wanted_ = NodeInsideFace(entry);
     if (!wanted_) {  // a held face: the support is not rendered (ContactTracker)
       state_ = State::kAwaitLiftOff;
@@ -169,7 +182,7 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     // not the touched face's): nothing pushes it there; it waits for regions on its own face.
     state_ = State::kWaiting;
     out_of_region_ = false;
-    if (const auto node = NodeInsideFace(ContactObject::Entry{tool_, inward_, 0})) wanted_ = node;
+    if (const auto node = NodeInsideFace(OnTouchedFace(tool_))) wanted_ = node;
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
@@ -232,7 +245,7 @@ void SlidingContact::AfterPeriod() noexcept {
   // Slid out of the primary before it followed: the node inside the face nearest the proxy (never a
   // rim node, whose normal is not the face's).
   if (!next && out_of_region_) {
-    next = NodeInsideFace(ContactObject::Entry{proxy_->proxy_rest_m(), inward_, 0});
+    next = NodeInsideFace(OnTouchedFace(proxy_->proxy_rest_m()));
   }
   if (next && *next != bound_centre_) {
     wanted_ = *next;
@@ -252,7 +265,7 @@ void SlidingContact::RestartKeepingContact() noexcept {
     // on its face can push there (TryEngage), its force ramped in. It wants the node under the
     // tip, not one it asked to follow to: that may have been refused.
     state_ = State::kWaiting;
-    if (const auto node = NodeInsideFace(ContactObject::Entry{tool_, inward_, 0})) wanted_ = node;
+    if (const auto node = NodeInsideFace(OnTouchedFace(tool_))) wanted_ = node;
     following_ = out_of_region_ = false;
     catch_up_ns_ = -1;
   }

@@ -110,6 +110,8 @@ class SlidingContact {
   // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
   // normal the face's, as a proxy needs; never a rim node), none on a held face.
   std::optional<LatticeIndex> NodeInsideFace(const ContactObject::Entry& entry) const noexcept;
+  // `point_m` (the tip, under the face; the proxy) projected onto the touched face's plane.
+  ContactObject::Entry OnTouchedFace(const std::array<double, 3>& point_m) const noexcept;
   // Engages a waiting touch when the regions, this period's (`centre`), can push under the tip on
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
@@ -130,6 +132,7 @@ class SlidingContact {
   std::vector<double> loads_;                   // on the bound primary's proxy_loaded_dofs()
   std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
   std::array<double, 3> inward_{};              // the touched face's
+  double face_m_ = 0;                           // where its plane is along its normal's axis, m
   std::optional<LatticeIndex> wanted_;
   bool following_ = false;           // the regions should follow the proxy (onto wanted_)
   bool out_of_region_ = false;       // the proxy slid out of the primary: nothing pushed

@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/errormap/error_lookup.hpp"
 #include "core/regions/async_regions.hpp"
+#include "core/regions/proxy_following.hpp"
 
 namespace hapticsim {
 namespace {
@@ -22,6 +23,11 @@ constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
 std::string BuildProblem(const Scene& scene) {
   try {
     const AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
+    // A sliding tool's primary follows it on threads: a follow takes time (kThreadsFollowSlack).
+    const RegionPartition& partition = regions.partition();
+    if (partition.proxy_contact()) {
+      CheckPrimaryReachesTip(scene, partition.mesh().options().spacing_m, kThreadsFollowSlack);
+    }
     return "";
   } catch (const Error& e) {
     return e.what();

@@ -104,6 +104,12 @@ DeviceMotion::DeviceMotion(const MotionSettings& s) : settings_(s), random_(s.se
     over(s.at_m[0]);
     if (s.kind == "stroke") over(s.at_m[0] + s.stroke_length_m);
     front_z_ = *s.front.At(s.at_m[0], s.at_m[1]);
+    if (!(front_z_ + s.amplitude_m < s.extent_m[2])) {
+      throw Error("--amplitude " + Metres(s.amplitude_m) +
+                  " from the object's front at --at (z = " + Metres(front_z_) +
+                  ") reaches past its lattice's back (z = " + Metres(s.extent_m[2]) +
+                  " m): press less deep or elsewhere");
+    }
   }
   if (s.kind == "replay") {
     replay_ = ReadReplay(s.replay_path, s.replay_channel, s.rate_hz);

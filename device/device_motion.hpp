@@ -54,7 +54,9 @@ struct MotionSettings {
  *   apart, alternately above the surface and pressed into it (up to `amplitude_m`), joined at up to
  *   `walk_speed_m_per_s` with smooth starts and stops, so it touches down and lifts off at a
  *   different surface point each time;
- * - stroke: a palpation stroke every 1/f: from `hover_m` above `at_m` in to `amplitude_m` deep
+ * - stroke: a palpation stroke every 1/f (its depth the front's at `at_m` all along: over a
+ *   curved object, the depth changes as the front does): from `hover_m` above `at_m` in to
+ *   `amplitude_m` deep
  *   (the first 20 % of the period), along +x by `stroke_length_m` at that depth (50 %), out to
  *   `hover_m` above (10 %) and back above the surface to `at_m` (20 %), each leg a smoothstep —
  *   for a sliding tool (contact.model = "proxy");

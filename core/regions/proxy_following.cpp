@@ -21,14 +21,18 @@ std::optional<LatticeIndex> ProxyWantsPrimaryAt(const ProxyContact& proxy,
   return nearest;
 }
 
-void CheckPrimaryReachesTip(const Scene& scene, double spacing_m) {
+void CheckPrimaryReachesTip(const Scene& scene, double spacing_m, double slack_nodes) {
   const double reach = std::max(1.0, scene.contact.radius_m / spacing_m);
-  const int needed = static_cast<int>(std::ceil(reach)) + 1;
+  const int needed = static_cast<int>(std::ceil(reach) + std::ceil(slack_nodes)) + 1;
   HAPTICSIM_THROW_UNLESS(scene.adaptivity.primary_size >= needed,
                          "contact.radius = " + GetSceneValue(scene, "contact.radius") +
                              " m reaches " + std::to_string(reach) + " lattice spacings of " +
                              std::to_string(spacing_m) +
-                             " m from the proxy, and the primary region follows the proxy: set "
+                             " m from the proxy, and the primary region follows the proxy" +
+                             (slack_nodes > 0 ? std::string(" (on real threads, a follow takes "
+                                                            "time while the tool slides on)")
+                                              : std::string()) +
+                             ": set "
                              "adaptivity.primary_size >= " +
                              std::to_string(needed));
 }

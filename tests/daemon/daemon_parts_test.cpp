@@ -221,7 +221,8 @@ TEST(DaemonConfig, AGeometryFromAFilePassesTheCheckAndOneWithoutSupportsIsRefuse
 }
 
 // A sliding tool is served (contact.model = "proxy", or a stroke's scene); its primary must reach
-// the tip's nodes, and a scene whose primary cannot is refused saying what to set.
+// the tip's nodes with a node to spare for the time a follow takes, and a scene whose primary
+// cannot is refused saying what to set.
 TEST(DaemonConfig, ASlidingToolIsServedAndAPrimaryTooSmallForItIsRefused) {
   const std::string scene = ConfigTestPath() + ".proxy.toml";
   std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\n[adaptivity]\nprimary_size = 3\n";
@@ -233,6 +234,12 @@ TEST(DaemonConfig, ASlidingToolIsServedAndAPrimaryTooSmallForItIsRefused) {
   std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\n[adaptivity]\nprimary_size = 1\n";
   const std::string error = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
   EXPECT_NE(error.find("adaptivity.primary_size >= 2"), std::string::npos) << error;
+  // On threads a follow takes time while the tool slides on: a node more than offline, where a
+  // primary of 2 strokes (RegionStroke.ThePrimaryMustReachTwoNodesFromTheProxy).
+  std::ofstream(scene) << "[contact]\nmodel = \"proxy\"\n[adaptivity]\nprimary_size = 2\n";
+  const std::string threads = ConfigError("[scene]\nfile = \"" + scene + "\"\n");
+  EXPECT_NE(threads.find("adaptivity.primary_size >= 3"), std::string::npos) << threads;
+  EXPECT_NE(threads.find("on real threads"), std::string::npos) << threads;
 }
 
 TEST(DaemonConfig, TheSupervisorChoosesThreeSettingsAndTheSceneKeepsTheRest) {

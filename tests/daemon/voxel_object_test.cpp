@@ -260,5 +260,43 @@ TEST(HapticLoopWithEmptyVoxels, AToolSlidesAlongTheStepsFloorAsOnABlockAsThick) 
   EXPECT_NEAR(floor.kinetic_share, block.kinetic_share, 0.1);
   EXPECT_NEAR(floor.normal_n, block.normal_n, 0.25 * block.normal_n);
 }
+
+// A sliding tool 7 mm into the step's floor (deeper than half a voxel), its proxy slid 6 mm along
+// x (short of a follow), whose regions are moved onto the step's wall under it (a follow to a
+// node of another face, SlidingTool.RegionsMovedToAnotherFace…): the touch waits and asks for the
+// floor's node under the tip — found on the face it touched, not in the object 7 mm below it —
+// and once the regions are there its push comes back.
+TEST(HapticLoopWithEmptyVoxels, ASlidingToolDeepInTheFloorAsksForTheFloorsNodeUnderIt) {
+  Scene scene = SteppedBlock();
+  scene.contact.model = ContactModel::kProxy;
+  scene.adaptivity.primary_size = 3;
+  scene.input.contact_node = LatticeIndex{2, 3, 2};
+  HapticLoop loop(scene, HapticLoop::Options{});
+  std::int64_t release = 1'000'000'000;
+  ForceRecord record, last;
+  int seq = 0;
+  const auto play = [&](const Point& tip) {
+    testing::PlayPeriodInVirtualTime(loop, release, DeviceSample{seq++, release, tip, false});
+    release += 1'000'000;
+    while (loop.forces().Pop(&record)) last = record;
+  };
+  for (int n = 0; n < 40; ++n) play({0.02, 0.03, 0.018});
+  for (int n = 1; n <= 300; ++n) play({0.02, 0.03, 0.018 + 0.009 * std::min(1.0, n / 200.0)});
+  for (int n = 1; n <= 100; ++n) play({0.02 + 0.006 * n / 100.0, 0.03, 0.027});
+  ASSERT_TRUE(last.flags & force_flags::kInContact);
+  ASSERT_EQ(loop.centre_node(), (LatticeIndex{2, 3, 2})) << "the proxy was followed already";
+  ASSERT_EQ(loop.wanted_contact_node(), (LatticeIndex{2, 3, 2}));
+  const RegionConfiguration configuration{3, 1, 1000};
+  loop.Reconfigure(SceneWith(scene, configuration, LatticeIndex{4, 3, 1}),
+                   HapticLoop::Handover::kCarryMotion);
+  for (int n = 0; n < 5; ++n) play({0.026, 0.03, 0.027});
+  EXPECT_TRUE(loop.contact_waiting());
+  EXPECT_EQ(loop.wanted_contact_node(), (LatticeIndex{3, 3, 2}));
+  loop.Reconfigure(SceneWith(scene, configuration, LatticeIndex{3, 3, 2}),
+                   HapticLoop::Handover::kRampIn);
+  for (int n = 0; n < 300; ++n) play({0.026, 0.03, 0.027});
+  EXPECT_TRUE(last.flags & force_flags::kInContact);
+  EXPECT_LT(last.force_n[2], -0.05) << "the push did not come back";
+}
 }  // namespace
 }  // namespace hapticsim

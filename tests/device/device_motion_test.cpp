@@ -125,6 +125,15 @@ TEST(DeviceMotion, OverAnObjectWithEmptyVoxelsEachMotionStartsFromTheFrontUnderI
   tip = DeviceMotion(s).Next().value();
   EXPECT_NEAR(tip[2], 0.018, 1e-12);
   s.kind = "press";
+  s.at_m = {0.025, 0.03};
+  s.amplitude_m = 0.025;  // from the step's floor at 2 cm, past the back at 4 cm
+  try {
+    DeviceMotion refused(s);
+    FAIL() << "a press past the back was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("past its lattice's back"), std::string::npos) << e.what();
+  }
+  s.amplitude_m = 0.003;
   s.at_m = {0.085, 0.025};  // over the hole
   try {
     DeviceMotion refused(s);

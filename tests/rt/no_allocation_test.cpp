@@ -209,45 +209,51 @@ TEST(DaemonPrimaryPeriod, NeverAllocatesWithASlidingTool) {
 // An object that leaves voxels empty (ContactObject on voxels): the block of 10 × 6 × 4 voxels of
 // 1 cm with a step cut out of its front (x < 4 cm, z < 2 cm empty), its back held. The tool hovers
 // in the step and in front of the object (the hovered face, the nearest voxel), presses into the
-// step's floor (the way in through the voxels), drags towards the wall, lifts off and presses the
-// front face beside the step.
+// step's floor (the way in through the voxels), drags 2 cm along it to the wall, lifts off and
+// presses the front face beside the step: with the node contact, then with a sliding tool (the
+// flat faces, the node inside the face, the proxy on the floor).
 TEST(DaemonPrimaryPeriod, NeverAllocatesOnAnObjectWithEmptyVoxels) {
   Scene scene =
       testing::VoxelScene(10, 6, 4, 0.01, [](int x, int, int z) { return x < 4 && z < 2 ? 0 : 1; });
   testing::HoldPlaneZ(&scene, 0.04);
   scene.materials = {{1, Material{}}};
-  scene.adaptivity.primary_size = 2;
+  scene.adaptivity.primary_size = 3;
   scene.adaptivity.secondary_lod = 1;
   scene.adaptivity.secondary_rate_hz = 1000;
   scene.input.contact_node = LatticeIndex{2, 3, 2};
-  HapticLoop loop(scene, HapticLoop::Options{});
-  std::int64_t now = HapticLoop::NowNs();
-  ForceRecord record;
-  bool pushed_back = false;
-  testing::ScopedAllocationCount count;
-  for (int n = 0; n < 1000; ++n, now += 1'000'000) {
-    std::array<double, 3> tip{0.02, 0.03, 0.015};  // hovering in the step
-    if (n < 50)
-      tip = {0.02, 0.03, -0.01};  // in front of it
-    else if (n < 400)
-      tip[2] = 0.018 + 0.005 * std::min(1.0, (n - 100) / 200.0);  // the floor
-    else if (n < 500)
-      tip = {0.02 + 0.01 * (n - 400) / 100.0, 0.03, 0.023};  // towards the wall
-    else if (n < 700)
-      tip = {0.06, 0.03, -0.002};  // lifted, over the front face
-    else
-      tip = {0.06, 0.03, 0.003 * (n - 700) / 300.0};  // pressing it
-    loop.OfferInput(DeviceSample{n, now, tip, false});
-    loop.PrimaryPeriod(now, now);
-    for (int r = 1; r < loop.regions().num_regions(); ++r) {
-      if (loop.SecondaryMayStep(r)) const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+  for (const ContactModel model : {ContactModel::kNode, ContactModel::kProxy}) {
+    scene.contact.model = model;
+    HapticLoop loop(scene, HapticLoop::Options{});
+    std::int64_t now = HapticLoop::NowNs();
+    ForceRecord record;
+    bool pushed_back = false;
+    testing::ScopedAllocationCount count;
+    for (int n = 0; n < 1000; ++n, now += 1'000'000) {
+      std::array<double, 3> tip{0.02, 0.03, 0.015};  // hovering in the step
+      if (n < 50) {
+        tip = {0.02, 0.03, -0.01};  // in front of it
+      } else if (n < 400) {
+        tip[2] = 0.018 + 0.007 * std::min(1.0, (n - 100) / 200.0);  // into the floor
+      } else if (n < 500) {
+        tip = {0.02 + 0.02 * (n - 400) / 100.0, 0.03, 0.025};  // along it to the wall
+      } else if (n < 700) {
+        tip = {0.06, 0.03, -0.002};  // lifted, over the front face
+      } else {
+        tip = {0.06, 0.03, 0.003 * (n - 700) / 300.0};  // pressing it
+      }
+      loop.OfferInput(DeviceSample{n, now, tip, false});
+      loop.PrimaryPeriod(now, now);
+      for (int r = 1; r < loop.regions().num_regions(); ++r) {
+        if (loop.SecondaryMayStep(r)) const_cast<AsyncRegions&>(loop.regions()).StepRegion(r);
+      }
+      while (loop.forces().Pop(&record)) pushed_back |= record.force_n[2] < -0.05;
     }
-    while (loop.forces().Pop(&record)) pushed_back |= record.force_n[2] < -0.05;
+    const char* name = model == ContactModel::kNode ? "node contact" : "sliding tool";
+    EXPECT_EQ(count.count(), 0u) << name;
+    EXPECT_TRUE(pushed_back) << name << ": the floor pushed back";
+    EXPECT_EQ(loop.wanted_contact_node(), (LatticeIndex{6, 3, 0}))
+        << name << ": the front face beside the step";
   }
-  EXPECT_EQ(count.count(), 0u);
-  EXPECT_TRUE(pushed_back) << "the floor pushed back";
-  EXPECT_EQ(loop.wanted_contact_node(), (LatticeIndex{6, 3, 0}))
-      << "the front face beside the step";
 }
 
 // The port guard acting in the primary period: the envelope saturating, the engagement ramp and a
