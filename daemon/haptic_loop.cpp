@@ -410,7 +410,8 @@ void HapticLoop::SecondaryThread(RegionIndex region, std::int64_t origin_ns) {
     const std::int64_t release = std::max(
         woken_ns, origin_ns + static_cast<std::int64_t>(regions_->state_ticks(region) * tick_ns_) -
                       lead_ns_[region]);
-    SleepUntilMonotonicNs(release);
+    // Asked to stop (new regions replace these), it does not sleep on to a release far ahead.
+    if (!SleepUntilMonotonicNsOrStop(release, stop_secondaries_)) break;
     const std::int64_t woke = NowNs();
     // Stalled (preempted, a debugger, a page-fault storm): hold the state over the missed periods
     // and carry on from the present, rather than stepping them late against the inner region's

@@ -1,6 +1,7 @@
 // The haptic loop's protocols between its threads, each on real threads of its own: the device
 // input's hand-off (InputHandoff), the reconfiguration's handshake (RegionHandover), sleeping at
-// rest (SecondaryParking) and the counters (LoopCounters, on a running HapticLoop). Under
+// rest (SecondaryParking), a secondary's sleep asked to stop (SecondarySleep) and the counters
+// (LoopCounters, on a running HapticLoop). Under
 // ThreadSanitizer a missing release/acquire pair shows as a data race on the plain data each test
 // hands across; in any build, each test checks what the protocol promises.
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <thread>
 #include <vector>
 
@@ -282,6 +284,34 @@ TEST(SecondaryParking, SecondariesParkOnlyOnceAllWereFoundAtRestAndEveryWakeRele
     EXPECT_GT(steps[a], 0) << "region " << a << " should step again after the last wake";
     EXPECT_EQ(woke_at[a], 1000 + kSleeps - 1) << "region " << a << " should restart at its origin";
   }
+}
+
+// ---- A secondary's sleep, asked to stop
+// ----------------------------------------------------------
+
+// A secondary thread sleeping until a release far ahead comes out within a slice of being asked to
+// stop (a reconfiguration joins it: with a plain sleep, it would wait the whole sleep), and one
+// not asked wakes at its release, not before.
+TEST(SecondarySleep, AThreadAskedToStopLeavesASleepFarAheadWithinASlice) {
+  std::atomic<bool> stop{false};
+  std::atomic<bool> woke_normally{true};
+  const std::int64_t start = MonotonicNowNs();
+  std::thread sleeper([&] {
+    woke_normally = SleepUntilMonotonicNsOrStop(start + 5'000'000'000, stop, 10'000'000);
+  });
+  std::this_thread::sleep_for(milliseconds(50));
+  const std::int64_t asked = MonotonicNowNs();
+  stop = true;
+  sleeper.join();
+  const double after_s = SecondsSince(asked);
+  EXPECT_FALSE(woke_normally);
+  EXPECT_LT(after_s, 1.0) << "held by the sleep after the stop";
+  std::printf("asked to stop 50 ms into a 5 s sleep: out %.1f ms later\n", 1e3 * after_s);
+
+  stop = false;
+  const std::int64_t wake = MonotonicNowNs() + 35'000'000;  // three slices and a half
+  EXPECT_TRUE(SleepUntilMonotonicNsOrStop(wake, stop, 10'000'000));
+  EXPECT_GE(MonotonicNowNs(), wake);
 }
 
 // ---- LoopCounters, on a running loop ------------------------------------------------------------
