@@ -24,38 +24,13 @@ import sys
 import time
 
 from PIL import Image
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
+
+from view_browser import Work, changed_fraction, headless_chromium, panel_on_screenshot
 
 daemon_bin, cli, examples, work = sys.argv[1:5]
 scene = os.path.join(examples, "organ", "organ.toml")
-os.makedirs(work, exist_ok=True)
-processes = []
-
-
-def start(args, log_name, **kwargs):
-    log = open(os.path.join(work, log_name), "w")
-    p = subprocess.Popen(args, stdout=kwargs.pop("stdout", log), stderr=log, text=True, **kwargs)
-    processes.append(p)
-    return p
-
-
-def fail(message):
-    print("FAIL:", message)
-    for name in sorted(os.listdir(work)):
-        if name.endswith(".log"):
-            print(f"--- {name}:\n" + open(os.path.join(work, name)).read()[-3000:])
-    sys.exit(1)
-
-
-def wait_for(what, condition, timeout_s):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    fail(f"timed out after {timeout_s} s waiting for {what}")
+folder = Work(work)
+start, fail, wait_for = folder.start, folder.fail, folder.wait_for
 
 
 def start_view(extra, log_name):
@@ -83,16 +58,7 @@ try:
     plain_view, plain_url = start_view([], "view-plain.log")
     scene_view, scene_url = start_view(["--scene", scene], "view-scene.log")
 
-    options = webdriver.ChromeOptions()
-    options.binary_location = "/usr/bin/chromium"
-    for a in ["--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-              "--enable-unsafe-swiftshader", "--window-size=1000,700", "--disable-gpu-sandbox",
-              f"--user-data-dir={work}/chromium-profile"]:
-        options.add_argument(a)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver",
-                                               log_path=os.path.join(work, "chromedriver.log")),
-                               options=options)
+    browser = headless_chromium(work)
     try:
         plain = open_page(browser, plain_url)
         text = browser.find_element("id", "surface").text
@@ -119,17 +85,8 @@ try:
         time.sleep(0.5)
         shot = os.path.join(work, "organ.png")
         browser.save_screenshot(shot)
-        panel = browser.execute_script(
-            "const r = document.getElementById('panel').getBoundingClientRect();"
-            "return [r.left, r.top, r.right, r.bottom];")
-        scale = browser.execute_script("return window.devicePixelRatio")
-        panel = [v * scale for v in panel]
-        image = Image.open(shot).convert("RGB")
-        px = image.load()
-        pixels = [(x, y) for y in range(0, image.size[1], 2) for x in range(0, image.size[0], 2)
-                  if not (panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3])]
-        shown = sum(sum(abs(a - b) for a, b in zip(px[x, y], (0x1d, 0x21, 0x27))) > 30
-                    for x, y in pixels) / len(pixels)
+        panel, _ = panel_on_screenshot(browser)
+        shown = changed_fraction(Image.open(shot), panel)
         print(f"{100 * shown:.1f} % of the picture outside the panel is the organ")
         if shown < 0.05:
             fail("the screenshot does not show the organ")
@@ -165,11 +122,4 @@ try:
             fail(f"hapticsim view did not stop cleanly: exit {view.returncode}, {out!r}")
     print("PASS")
 finally:
-    for p in processes:
-        if p.poll() is None:
-            p.terminate()
-    for p in processes:
-        try:
-            p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
+    folder.stop_all()

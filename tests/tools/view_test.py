@@ -30,38 +30,13 @@ import sys
 import time
 
 from PIL import Image, ImageChops
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
+
+from view_browser import Work, changed_fraction, headless_chromium, outside_panel, panel_on_screenshot
 
 daemon_bin, cli, work = sys.argv[1:4]
 daemon_args = sys.argv[4:]
-os.makedirs(work, exist_ok=True)
-processes = []
-
-
-def start(args, log_name, **kwargs):
-    log = open(os.path.join(work, log_name), "w")
-    p = subprocess.Popen(args, stdout=kwargs.pop("stdout", log), stderr=log, text=True, **kwargs)
-    processes.append(p)
-    return p
-
-
-def fail(message):
-    print("FAIL:", message)
-    for name in sorted(os.listdir(work)):
-        if name.endswith(".log"):
-            print(f"--- {name}:\n" + open(os.path.join(work, name)).read()[-3000:])
-    sys.exit(1)
-
-
-def wait_for(what, condition, timeout_s):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    fail(f"timed out after {timeout_s} s waiting for {what}")
+folder = Work(work)
+start, fail, wait_for = folder.start, folder.fail, folder.wait_for
 
 
 def request(port, path, headers):
@@ -71,24 +46,6 @@ def request(port, path, headers):
     r.read()
     c.close()
     return r.status
-
-
-def outside_panel(size, panel, step=1):
-    """The pixels (x, y) of a screenshot of `size` that the panel does not cover (its text
-    changes with every message), every step-th along each axis."""
-    w, h = size
-    for y in range(0, h, step):
-        for x in range(0, w, step):
-            if not (panel[0] <= x <= panel[2] and panel[1] <= y <= panel[3]):
-                yield x, y
-
-
-def changed_fraction(image, background, panel):
-    """The share of pixels outside the panel that are not the page's background colour."""
-    px = image.convert("RGB").load()
-    pixels = list(outside_panel(image.size, panel, step=2))
-    changed = sum(sum(abs(a - b) for a, b in zip(px[x, y], background)) > 30 for x, y in pixels)
-    return changed / len(pixels)
 
 
 try:
@@ -116,16 +73,7 @@ try:
     if request(port, "/feed", ws) != 403:
         fail("a WebSocket from another web site's Origin was not refused")
 
-    options = webdriver.ChromeOptions()
-    options.binary_location = "/usr/bin/chromium"
-    for a in ["--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-              "--enable-unsafe-swiftshader", "--window-size=1000,700", "--disable-gpu-sandbox",
-              f"--user-data-dir={work}/chromium-profile"]:
-        options.add_argument(a)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver",
-                                               log_path=os.path.join(work, "chromedriver.log")),
-                               options=options)
+    browser = headless_chromium(work)
     try:
         browser.get(url)
         wait_for("5 surface frames on the page",
@@ -134,13 +82,9 @@ try:
         time.sleep(0.5)
         before_path = os.path.join(work, "before.png")
         browser.save_screenshot(before_path)
-        panel = browser.execute_script(
-            "const r = document.getElementById('panel').getBoundingClientRect();"
-            "return [r.left, r.top, r.right, r.bottom];")
-        scale = browser.execute_script("return window.devicePixelRatio")
-        panel = [v * scale for v in panel]
+        panel, scale = panel_on_screenshot(browser)
         before = Image.open(before_path)
-        shown = changed_fraction(before, (0x1d, 0x21, 0x27), panel)
+        shown = changed_fraction(before, panel)
         print(f"before the press: {100 * shown:.1f} % of the picture outside the panel is the object")
         if shown < 0.05:
             fail(f"the screenshot does not show the object ({100 * shown:.1f} % not background)")
@@ -279,11 +223,4 @@ try:
     print(out.strip())
     print("PASS")
 finally:
-    for p in processes:
-        if p.poll() is None:
-            p.terminate()
-    for p in processes:
-        try:
-            p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
+    folder.stop_all()
