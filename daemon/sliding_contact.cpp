@@ -62,7 +62,6 @@ SlidingContact::Binding SlidingContact::Prepare(const AsyncRegions& regions) con
                          "internal: a sliding contact on regions built for a driven node");
   Binding binding;
   binding.centre = partition.contact_node();
-  binding.loads.assign(regions.proxy_loaded_dofs().size(), 0.0);
   const std::array<double, 3> normal = partition.contact_normal();
   int axes = 0;
   for (double c : normal) axes += c != 0 ? 1 : 0;
@@ -78,7 +77,6 @@ void SlidingContact::Bind(Binding binding) noexcept {
   // (and an engaged contact on another face waits: StepPeriod).
   if (binding.proxy && proxy_) binding.proxy->ContinueFrom(*proxy_);
   proxy_ = std::move(binding.proxy);
-  loads_ = std::move(binding.loads);
   bound_centre_ = binding.centre;
 }
 
@@ -158,19 +156,45 @@ double SlidingContact::RampScale(std::int64_t now_ns) const noexcept {
   return tau * tau * (3 - 2 * tau);
 }
 
-std::array<double, 3> SlidingContact::Rendered(const std::array<double, 3>& spring_n,
-                                               std::int64_t now_ns) const noexcept {
-  const double scale = RampScale(now_ns);
-  std::array<double, 3> push{};
-  for (int c = 0; c < 3; ++c) push[c] = scale * spring_n[c];
-  if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ < catch_up_duration_ns_) {
-    // A blend of two pushes within the friction cone stays within it (the cone is convex): the
-    // user never feels more than μ_s times the normal force, as a fading offset would give.
+std::array<double, 3> SlidingContact::Rendered(const ProxyContact::Result& touch,
+                                               std::int64_t now_ns) noexcept {
+  // The push p is the spring's, ramped in (k scaled), taken at the step's end where p has moved
+  // the surface by C·p: p = k·(offset − C·p).
+  const double k = RampScale(now_ns) * settings_.stiffness_n_per_m;
+  const double over = 1.0 + k * touch.compliance_m_per_n;
+  std::array<double, 3> offset = touch.offset_m;
+  if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ < catch_up_duration_ns_ && k > 0) {
+    // Catching up after a pause, the spring pulls from where it gave the held push, and that
+    // point goes back to the tool: offset − (1 − w)·δ, δ set so that the first push is the held
+    // one. The spring stays stiff throughout: a held force blended out without it drove a light
+    // node through the surface under the tool. What the fading δ adds is kept inside the friction
+    // cone (InsideFrictionCone): the user never feels more than μ_s times the normal force.
+    if (!catch_up_anchored_) {
+      for (int c = 0; c < 3; ++c) catch_up_offset_m_[c] = offset[c] - held_push_[c] * over / k;
+      catch_up_anchored_ = true;
+    }
     const double tau = static_cast<double>(now_ns - catch_up_ns_) / catch_up_duration_ns_;
     const double w = tau * tau * (3 - 2 * tau);
-    for (int c = 0; c < 3; ++c) push[c] = held_push_[c] + w * (push[c] - held_push_[c]);
+    for (int c = 0; c < 3; ++c) offset[c] -= (1 - w) * catch_up_offset_m_[c];
   }
-  return push;
+  std::array<double, 3> push{};
+  for (int c = 0; c < 3; ++c) push[c] = k * offset[c] / over;
+  return InsideFrictionCone(push);
+}
+
+std::array<double, 3> SlidingContact::InsideFrictionCone(
+    const std::array<double, 3>& push) const noexcept {
+  double normal = 0;
+  for (int c = 0; c < 3; ++c) normal += push[c] * inward_[c];
+  if (!(normal > 0)) return {};  // a push never pulls the tool in
+  std::array<double, 3> tangential{};
+  for (int c = 0; c < 3; ++c) tangential[c] = push[c] - normal * inward_[c];
+  const double along = std::hypot(tangential[0], tangential[1], tangential[2]);
+  const double most = settings_.static_friction * normal;
+  if (along <= most) return push;
+  std::array<double, 3> inside{};
+  for (int c = 0; c < 3; ++c) inside[c] = normal * inward_[c] + tangential[c] * (most / along);
+  return inside;
 }
 
 std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
@@ -188,38 +212,43 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
   if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ >= catch_up_duration_ns_) catch_up_ns_ = -1;
   for (int q = 1; q <= substeps; ++q) {
-    std::fill(loads_.begin(), loads_.end(), 0.0);
-    if (state_ == State::kEngaged && proxy_) {
-      // The substeps move the tool from the last period's tip to this one's in equal parts.
-      std::array<double, 3> tool;
-      for (int c = 0; c < 3; ++c)
-        tool[c] = last_tool_[c] + (tool_[c] - last_tool_[c]) * q / substeps;
-      const ProxyContact::Result touch = proxy_->Update(tool, regions.primary_state(), loads_);
-      if (touch.left_surface) {
-        // Off the face's rim: released; a new touch only after the tip has left the object.
-        state_ = State::kAwaitLiftOff;
-      } else if (touch.left_region) {
-        out_of_region_ = true;  // nothing pushed until the regions are under it again
-      } else if (out_of_region_ && touch.in_contact) {
-        out_of_region_ = false;  // back in a primary: its push ramps in again
-        ramp_start_ns_ = now_ns;
-      }
-      std::array<double, 3> push{};
-      if (state_ == State::kEngaged && touch.in_contact) {
-        push = Rendered(touch.force_on_object_n, now_ns);
-        proxy_->SpreadLoads(push, loads_);
-      } else {
-        // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push
-        // would be a force the object never gets back.
-        catch_up_ns_ = -1;
-      }
-      if (q == 1) first_push = push;
-    }
-    regions.StepPrimaryLoaded(loads_);
+    // The substeps move the tool from the last period's tip to this one's in equal parts.
+    SubstepPush step(*this, now_ns);
+    for (int c = 0; c < 3; ++c)
+      step.tool_m[c] = last_tool_[c] + (tool_[c] - last_tool_[c]) * q / substeps;
+    regions.StepPrimaryPushed(step);
+    if (q == 1) first_push = step.push_n;
   }
   last_push_ = first_push;
   AfterPeriod();
   return first_push;
+}
+
+void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
+                                       std::span<const double> compliance,
+                                       std::span<double> load) noexcept {
+  std::fill(load.begin(), load.end(), 0.0);
+  SlidingContact& c = contact_;
+  if (c.state_ != State::kEngaged || !c.proxy_) return;
+  const ProxyContact::Result touch = c.proxy_->Update(tool_m, predicted, compliance, load);
+  if (touch.left_surface) {
+    // Off the face's rim: released; a new touch only after the tip has left the object.
+    c.state_ = State::kAwaitLiftOff;
+  } else if (touch.left_region) {
+    c.out_of_region_ = true;  // nothing pushed until the regions are under it again
+  } else if (c.out_of_region_ && touch.in_contact) {
+    c.out_of_region_ = false;  // back in a primary: its push ramps in again
+    c.ramp_start_ns_ = now_ns_;
+  }
+  if (c.state_ == State::kEngaged && touch.in_contact) {
+    push_n = c.Rendered(touch, now_ns_);
+    c.proxy_->SpreadLoads(push_n, load);
+  } else {
+    // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push would
+    // be a force the object never gets back.
+    std::fill(load.begin(), load.end(), 0.0);
+    c.catch_up_ns_ = -1;
+  }
 }
 
 void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns,
@@ -231,6 +260,7 @@ void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns,
     return;
   }
   catch_up_ns_ = now_ns;
+  catch_up_anchored_ = false;
   held_push_ = last_push_;
   // Twice as long as the pause (what the tool did meanwhile comes back at half its pace), at most
   // kCatchUp_ns; none after no pause at all.

@@ -48,7 +48,6 @@ class SlidingContact {
   struct Binding {
     std::optional<ProxyContact> proxy;  ///< none: regions centred on an edge node
     LatticeIndex centre{};
-    std::vector<double> loads;  ///< one per proxy-loaded DOF of their primary
   };
   /**
    * Any thread, before the regions are installed (it allocates): the proxy over `regions`'
@@ -91,8 +90,9 @@ class SlidingContact {
   /**
    * New regions took over with the old ones' motion (the regions followed the proxy, or switched
    * configuration in contact) at `now_ns`, after a pause of `paused_ns` in which the user felt the
-   * last push held while the tool went on: the push blends from that held one to the spring's own
-   * over twice the pause (a smoothstep; at most kCatchUp_ns), so the force does not step where
+   * last push held while the tool went on: the push goes from that held one to the spring's own
+   * over twice the pause (a smoothstep; at most kCatchUp_ns; the spring pulling from a point that
+   * returns to the tool, so that it stays stiff), so the force does not step where
    * the tool moved meanwhile. `hold_expired`: the pause outlasted the hold and the push was
    * released: it ramps in again from zero instead.
    */
@@ -116,10 +116,26 @@ class SlidingContact {
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
-  // The push the object gets and the user feels back, from the spring's own `spring_n`: ramped in,
-  // or blended from the push held over a pause (CatchUp).
-  std::array<double, 3> Rendered(const std::array<double, 3>& spring_n,
-                                 std::int64_t now_ns) const noexcept;
+  // The push the object gets and the user feels back, from the spring's `touch` at the step's
+  // end: ramped in, or blended from the push held over a pause (CatchUp).
+  std::array<double, 3> Rendered(const ProxyContact::Result& touch, std::int64_t now_ns) noexcept;
+  // `push` with its tangential part at most μ_s times its normal part, and none if it would pull.
+  std::array<double, 3> InsideFrictionCone(const std::array<double, 3>& push) const noexcept;
+  // One primary substep's push, from the state at its end (EndOfStepLoad): the proxy moved for
+  // the tool at `tool_m`, the push rendered and spread over the face (zero unless engaged).
+  class SubstepPush final : public EndOfStepLoad {
+   public:
+    SubstepPush(SlidingContact& contact, std::int64_t now_ns)
+        : contact_(contact), now_ns_(now_ns) {}
+    void Load(const Eigen::VectorXd& predicted, std::span<const double> compliance,
+              std::span<double> load) noexcept override;
+    std::array<double, 3> tool_m{};
+    std::array<double, 3> push_n{};  ///< what it pushed, N
+
+   private:
+    SlidingContact& contact_;
+    std::int64_t now_ns_;
+  };
   // After a period's steps: where the regions should go (following the proxy).
   void AfterPeriod() noexcept;
 
@@ -129,7 +145,6 @@ class SlidingContact {
   State state_ = State::kAwaitLiftOff;
   std::optional<ProxyContact> proxy_;           // on the bound regions' primary
   LatticeIndex bound_centre_{};                 // the bound regions' centre
-  std::vector<double> loads_;                   // on the bound primary's proxy_loaded_dofs()
   std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
   std::array<double, 3> inward_{};              // the touched face's
   double face_m_ = 0;                           // where its plane is along its normal's axis, m
@@ -140,6 +155,9 @@ class SlidingContact {
   std::int64_t catch_up_ns_ = -1;    // the push blends back from held_push_ from here (−1: none)
   std::array<double, 3> last_push_{};  // the last period's push (the one a pause holds)
   std::array<double, 3> held_push_{};  // the push a pause held, blended from (CatchUp)
+  // Where the catching-up spring pulls from, less the tool (Rendered), once its first push is set.
+  std::array<double, 3> catch_up_offset_m_{};
+  bool catch_up_anchored_ = false;
   std::int64_t catch_up_duration_ns_ = 0;
 };
 

@@ -34,6 +34,9 @@ RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
   for (int i : owned_) step_over_mass_.push_back(h_ * h_ / mass_[i]);
   PrecomputeDamping();
   SetControlledDofs(controlled_);
+  loaded_compliance_.reserve(loaded_.size());
+  for (int i : loaded_) loaded_compliance_.push_back(h_ * h_ / (mass_[i] * Plus(i)));
+  end_of_step_load_.assign(loaded_.size(), 0.0);
 }
 
 RegionIntegrator::RegionIntegrator(const StiffnessOperator& stiffness,
@@ -93,9 +96,33 @@ const Eigen::VectorXd& RegionIntegrator::Forces() noexcept {
 void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<const double> load,
                             double dissipate_j, const PortWorkLimits& limits) noexcept {
   assert(prescribed_next.size() == prescribed_.size() && load.size() == loaded_.size());
-  const Eigen::VectorXd& ku = Forces();
   for (size_t k = 0; k < loaded_.size(); ++k) external_[loaded_[k]] = load[k];
-  const double h2 = h_ * h_;
+  const double swept = Predict();
+  Finish(prescribed_next, load, swept, dissipate_j, limits);
+}
+
+void RegionIntegrator::Step(std::span<const double> prescribed_next, EndOfStepLoad& rule,
+                            double dissipate_j, const PortWorkLimits& limits) noexcept {
+  assert(prescribed_next.size() == prescribed_.size());
+  for (int i : loaded_) external_[i] = 0.0;
+  double swept = Predict();
+  double* next = u_next_->data();
+  const double* up = u_previous_->data();
+  // The rule reads the state at t + h, the prescribed DOFs (a held node under a tool) included.
+  for (size_t k = 0; k < prescribed_.size(); ++k) next[prescribed_[k]] = prescribed_next[k];
+  rule.Load(*u_next_, loaded_compliance_, end_of_step_load_);
+  for (size_t k = 0; k < loaded_.size(); ++k) {
+    const int i = loaded_[k];
+    const double before = next[i] - up[i];
+    next[i] += loaded_compliance_[k] * end_of_step_load_[k];
+    const double after = next[i] - up[i];
+    if (energy_terms_) swept += damping_weight_[i] * (after * after - before * before);
+  }
+  Finish(prescribed_next, end_of_step_load_, swept, dissipate_j, limits);
+}
+
+double RegionIntegrator::Predict() noexcept {
+  const Eigen::VectorXd& ku = Forces();
   const double* u = u_->data();
   const double* up = u_previous_->data();
   double* next = u_next_->data();
@@ -114,6 +141,17 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
                 inv_plus_[k];
     }
   }
+  return swept;
+}
+
+void RegionIntegrator::Finish(std::span<const double> prescribed_next, std::span<const double> load,
+                              double swept, double dissipate_j,
+                              const PortWorkLimits& limits) noexcept {
+  const Eigen::VectorXd& ku = Forces();
+  const double h2 = h_ * h_;
+  const double* u = u_->data();
+  const double* up = u_previous_->data();
+  double* next = u_next_->data();
   load_scale_ = 1;
   load_work_refused_ = 0;
   if (limits.load_work_j < INFINITY && !loaded_.empty()) {

@@ -25,6 +25,28 @@ struct PortWorkLimits {
 };
 
 /**
+ * A load on a region's loaded DOFs that depends on where they end the step: a contact spring
+ * taken implicitly (ProxyContact). An explicit spring on a node much lighter than its stiffness
+ * rings at the substep rate and, being one-sided, gains energy at every bounce; one solved for the
+ * step's end is dissipative and needs no substep of its own (docs/model.md).
+ */
+class EndOfStepLoad {
+ public:
+  /**
+   * @param predicted   the state at t + h without this load (owned and prescribed DOFs)
+   * @param compliance  per loaded DOF, how far its u⁺ moves per newton of its load, m/N:
+   *                    h²/(m·(1 + d·h/2))
+   * @param load        written: the load, N, in loaded() order
+   * Never allocates or throws.
+   */
+  virtual void Load(const Eigen::VectorXd& predicted, std::span<const double> compliance,
+                    std::span<double> load) noexcept = 0;
+
+ protected:
+  ~EndOfStepLoad() = default;
+};
+
+/**
  * Central difference for one region: the same per-DOF update as CentralDifferenceIntegrator,
  *
  *   u⁺ = [h²/m·(f − (K_region u)) + 2u − (1 − d·h/2)·u⁻] / (1 + d·h/2),
@@ -78,6 +100,13 @@ class RegionIntegrator {
    */
   void Step(std::span<const double> prescribed_next, std::span<const double> load,
             double dissipate_j = 0, const PortWorkLimits& limits = PortWorkLimits{}) noexcept;
+  /**
+   * One substep whose load the loaded DOFs' own end of step decides (EndOfStepLoad): u⁺ is formed
+   * without it, `rule` gives the load from that, and the load is added to u⁺ (it enters linearly),
+   * so the step satisfies the equation of motion with that load. Its work counts as a load's.
+   */
+  void Step(std::span<const double> prescribed_next, EndOfStepLoad& rule, double dissipate_j = 0,
+            const PortWorkLimits& limits = PortWorkLimits{}) noexcept;
 
   /** Prescribed DOFs from index `first` on (in prescribed() order) are the port that
    *  PortWorkLimits::prescribed_work_j limits; the ones before (contact, supports) never are.
@@ -158,6 +187,11 @@ class RegionIntegrator {
 
  private:
   void PrecomputeDamping();
+  // u⁺ of the owned DOFs from external_; returns Σ damping_weight_·(u⁺ − u⁻)² over them.
+  double Predict() noexcept;
+  // The rest of a step once u⁺ of the owned DOFs is formed with `load`.
+  void Finish(std::span<const double> prescribed_next, std::span<const double> load, double swept,
+              double dissipate_j, const PortWorkLimits& limits) noexcept;
   double DampControlled(double dissipate_j, double* next, const double* up) noexcept;
   double DampControlledMixed(double beta, double q, double* next,
                              const double* up) noexcept;
@@ -176,6 +210,8 @@ class RegionIntegrator {
   std::vector<double> step_over_mass_;  // h²/m per owned DOF, in owned_ order
   std::vector<double> minus_;           // 1 − d·h/2 per owned DOF, in owned_ order
   std::vector<double> inv_plus_;        // 1/(1 + d·h/2) per owned DOF, in owned_ order
+  std::vector<double> loaded_compliance_;  // h²/(m·(1 + d·h/2)) per loaded DOF, m/N
+  std::vector<double> end_of_step_load_;   // what an EndOfStepLoad gave, per loaded DOF, N
   // The material damping's energy is damping_factor_ · Σ damping_weight_·(u⁺ − u⁻)²/(4h).
   // With one d over the owned DOFs: weight m, factor d, the sum the one-rate step always took
   // (bit for bit); else weight d·m, factor 1.

@@ -172,7 +172,6 @@ double AsyncRegions::SetUpProxy(const ContactSettings& contact) {
   HAPTICSIM_THROW_UNLESS(at != proxy_loaded_dofs_.end(),
                          "internal: the proxy cannot push the contact node it starts on");
   proxy_contact_slot_ = static_cast<int>(at - proxy_loaded_dofs_.begin());
-  proxy_spring_loads_.assign(proxy_loaded_dofs_.size(), 0.0);
   return proxy_stiffness_n_per_m_ / proxy.lightest_loaded_mass_kg();
 }
 
@@ -246,15 +245,49 @@ void AsyncRegions::SetRandomState(unsigned seed) {
   StartFrom(u, Eigen::VectorXd::Zero(u.size()));
 }
 
+// Region a's load on its inner Γ at t0: the inner region's force there, from its newest two
+// snapshots (force coupling), or from its displacements next to Γ (displacement coupling).
+void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
+  Region& region = *regions_[a];
+  const auto& inner_gamma = region.dofs->inner_interface;
+  RegionIntegrator& integrator = *region.integrator;
+  const Region& inner = *regions_[a - 1];
+  (void)inner.outward->TryReadLatestTwo(&region.inner);
+  // The schedule keeps the inner region less than one of its nominal periods behind. Never
+  // extrapolate its snapshots further than one of its steps (one substep): the line through
+  // two substeps' snapshots, carried a whole period of s substeps ahead, multiplies their
+  // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
+  // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
+  const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
+  const double t = std::min(t0, region.inner.newer.time_s + inner_step_s);
+  if (coupling_ == Coupling::kForce) {
+    for (size_t i = 0; i < inner_gamma.size(); ++i) {
+      region.load_values[i] =
+          -OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
+    }
+  } else {
+    // The inner region's force on Γ from its band: its displacements next to Γ on the line
+    // through its newest two states, Γ itself as this region has it now.
+    for (size_t i = 0; i < inner.band_layer.size(); ++i) {
+      region.band_u[inner.band_layer[i]] =
+          OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
+    }
+    const Eigen::VectorXd& u = integrator.u();
+    for (int dof : inner_gamma) region.band_u[dof] = u[dof];
+    inner.band->Apply(region.band_u, region.band_ku);
+    for (size_t i = 0; i < inner_gamma.size(); ++i)
+      region.load_values[i] = -region.band_ku[inner_gamma[i]];
+  }
+}
+
 void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* contact_next,
-                                std::array<double, 3>* reaction) noexcept {
+                                std::array<double, 3>* reaction, EndOfStepLoad* push) noexcept {
   const auto start = Clock::now();
   Region& region = *regions_[a];
   RegionIntegrator& integrator = *region.integrator;
   const double t0 = static_cast<double>(region.state_ticks) / ticks_per_second_;
   const double h = integrator.substep();
   const auto& outer_gamma = region.dofs->outer_interface;
-  const auto& inner_gamma = region.dofs->inner_interface;
   bool followed = true;  // this step's outer Γ is the outer region's own at the step's end
 
   if (contact_next != nullptr && !partition_.proxy_contact()) {
@@ -277,41 +310,17 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
           OnLine(region.outer.older, region.outer.newer, static_cast<int>(i), t);
     }
   }
-  if (a > 0) {
-    const Region& inner = *regions_[a - 1];
-    (void)inner.outward->TryReadLatestTwo(&region.inner);
-    // The schedule keeps the inner region less than one of its nominal periods behind. Never
-    // extrapolate its snapshots further than one of its steps (one substep): the line through
-    // two substeps' snapshots, carried a whole period of s substeps ahead, multiplies their
-    // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
-    // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
-    const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
-    const double t = std::min(t0, region.inner.newer.time_s + inner_step_s);
-    if (coupling_ == Coupling::kForce) {
-      for (size_t i = 0; i < inner_gamma.size(); ++i) {
-        region.load_values[i] =
-            -OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
-      }
-    } else {
-      // The inner region's force on Γ from its band: its displacements next to Γ on the line
-      // through its newest two states, Γ itself as this region has it now.
-      for (size_t i = 0; i < inner.band_layer.size(); ++i) {
-        region.band_u[inner.band_layer[i]] =
-            OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
-      }
-      const Eigen::VectorXd& u = integrator.u();
-      for (int dof : inner_gamma) region.band_u[dof] = u[dof];
-      inner.band->Apply(region.band_u, region.band_ku);
-      for (size_t i = 0; i < inner_gamma.size(); ++i)
-        region.load_values[i] = -region.band_ku[inner_gamma[i]];
-    }
-  }
+  if (a > 0) ReadInnerLoads(a, t0);
   double asked_inward = 0, asked_outward = 0;
   PortWorkLimits limits;
   if (control_ != InterfaceControl::kOff)
     ControlInterfaces(a, &asked_inward, &asked_outward, &limits);
-  integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward,
-                  limits);
+  if (push != nullptr) {
+    integrator.Step(region.prescribed_values, *push, asked_inward + asked_outward, limits);
+  } else {
+    integrator.Step(region.prescribed_values, region.load_values, asked_inward + asked_outward,
+                    limits);
+  }
   if (reaction != nullptr && !partition_.proxy_contact()) {
     for (int c = 0; c < 3; ++c) (*reaction)[c] = integrator.PrescribedReaction(c);
   }
@@ -331,12 +340,34 @@ std::array<double, 3> AsyncRegions::StepPrimary(
   return reaction;
 }
 
-void AsyncRegions::StepPrimaryLoaded(std::span<const double> loads) noexcept {
-  std::vector<double>& values = regions_[kPrimaryRegion]->load_values;
-  assert(partition_.proxy_contact() && loads.size() == values.size());
-  std::copy_n(loads.begin(), std::min(values.size(), loads.size()), values.begin());
-  StepRegionAt(kPrimaryRegion, nullptr, nullptr);
+void AsyncRegions::StepPrimaryPushed(EndOfStepLoad& push) noexcept {
+  assert(partition_.proxy_contact());
+  StepRegionAt(kPrimaryRegion, nullptr, nullptr, &push);
 }
+
+namespace {
+// The stability estimate's contact: a stroke's proxy at rest on its start node, the tool held
+// there. The spring pulls the contact node back to rest, −k·u⁺, taken at the step's end as every
+// proxy's push is (ProxyPush): u⁺ = ũ + c·f gives f = −k·ũ / (1 + k·c).
+class HeldToolSpring final : public EndOfStepLoad {
+ public:
+  HeldToolSpring(double stiffness_n_per_m, int contact_slot, const std::array<int, 3>& dofs)
+      : k_(stiffness_n_per_m), slot_(contact_slot), dofs_(dofs) {}
+  void Load(const Eigen::VectorXd& predicted, std::span<const double> compliance,
+            std::span<double> load) noexcept override {
+    std::fill(load.begin(), load.end(), 0.0);
+    for (int c = 0; c < 3; ++c) {
+      const auto slot = static_cast<std::size_t>(slot_ + c);
+      load[slot] = -k_ * predicted[dofs_[c]] / (1.0 + k_ * compliance[slot]);
+    }
+  }
+
+ private:
+  double k_;
+  int slot_;
+  std::array<int, 3> dofs_;
+};
+}  // namespace
 
 const Eigen::VectorXd& AsyncRegions::primary_state() const noexcept {
   return regions_[kPrimaryRegion]->integrator->u();
@@ -390,14 +421,9 @@ void AsyncRegions::AdvancePrimaryTo(std::int64_t ticks) noexcept {
   while (primary.state_ticks < ticks) {
     AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
     if (partition_.proxy_contact()) {
-      // A stroke's proxy at rest on its start node, the tool held there: the spring pulls the
-      // contact node back to rest, −k·u, as the linearised contact does in every period.
-      const std::array<double, 3> u = primary_contact_m();
-      for (int c = 0; c < 3; ++c) {
-        proxy_spring_loads_[static_cast<std::size_t>(proxy_contact_slot_ + c)] =
-            -proxy_stiffness_n_per_m_ * u[c];
-      }
-      StepPrimaryLoaded(proxy_spring_loads_);
+      HeldToolSpring spring(proxy_stiffness_n_per_m_, proxy_contact_slot_,
+                            partition_.contact_dofs());
+      StepPrimaryPushed(spring);
     } else {
       StepPrimary(held);
     }

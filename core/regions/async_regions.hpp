@@ -224,10 +224,10 @@ class AsyncRegions {
   std::array<double, 3> StepPrimary(const std::array<double, 3>& contact_next) noexcept;
   /**
    * Primary thread, when the tool touches through a stroke's proxy (RegionPartition::
-   * proxy_contact; StepPrimary does not drive the contact then): one primary step with `loads`
-   * on proxy_loaded_dofs(), in that order (ProxyContact::Update writes them), N.
+   * proxy_contact; StepPrimary does not drive the contact then): one primary step whose loads on
+   * proxy_loaded_dofs(), in that order, `push` gives from the step's end (ProxyPush).
    */
-  void StepPrimaryLoaded(std::span<const double> loads) noexcept;
+  void StepPrimaryPushed(EndOfStepLoad& push) noexcept;
   /** The primary's DOFs a stroke's proxy may push (ProxyContact::loaded_dofs on
    *  RegionPartition::PrimaryProxySurface); empty for a driven contact. */
   const std::vector<int>& proxy_loaded_dofs() const { return proxy_loaded_dofs_; }
@@ -423,7 +423,8 @@ class AsyncRegions {
   void PublishSurface(Region& region) noexcept;
   void BuildSurface();
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
-                    std::array<double, 3>* reaction) noexcept;
+                    std::array<double, 3>* reaction, EndOfStepLoad* push = nullptr) noexcept;
+  void ReadInnerLoads(RegionIndex region, double t0) noexcept;
   void ControlInterfaces(RegionIndex region, double* asked_inward, double* asked_outward,
                          PortWorkLimits* limits) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
@@ -479,11 +480,10 @@ class AsyncRegions {
   std::atomic<std::uint64_t> surface_request_{0};
 
   // A stroke's proxy (RegionPartition::proxy_contact): the primary's loaded DOFs, the spring,
-  // and for the stability estimate, the contact node's slot among them and a scratch load.
+  // and for the stability estimate, the contact node's slot among them.
   std::vector<int> proxy_loaded_dofs_;
   double proxy_stiffness_n_per_m_ = 0;
   int proxy_contact_slot_ = 0;
-  std::vector<double> proxy_spring_loads_;
 };
 
 /**

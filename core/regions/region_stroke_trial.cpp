@@ -68,7 +68,6 @@ class StrokeRun {
     CheckAgree(proxy_, *regions_);
     out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
     out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
-    loads_.assign(proxy_.loaded_dofs().size(), 0.0);
     budget_j_ = regions_->Energy();
   }
 
@@ -88,10 +87,9 @@ class StrokeRun {
     return ProxyWantsPrimaryAt(proxy_, centre_, regions_->partition().mesh().options().spacing_m);
   }
 
-  // Period n: the proxy touched and the primary stepped once per substep, the tool on its path at
-  // each substep's start (the spring is as stiff as the primary's own limit allows for a
-  // substep, not for a period held). The period's sample is its first substep's force. False
-  // when the trial ends in it.
+  // Period n: the primary stepped once per substep, the proxy touching with the tool on its path
+  // at each substep's start and the spring taken at the step's end (ProxyPush). The period's
+  // sample is its first substep's force. False when the trial ends in it.
   bool StepPeriod(long n) {
     const int substeps = regions_->schedule(kPrimaryRegion).substeps;
     for (int q = 0; q < substeps; ++q) {
@@ -99,7 +97,11 @@ class StrokeRun {
       const std::array<double, 3> moved =
           trajectory_.DisplacementAt((n + double(q) / substeps) * dt_);
       for (int c = 0; c < 3; ++c) tool[c] += moved[c];
-      const ProxyContact::Result touch = proxy_.Update(tool, regions_->primary_state(), loads_);
+      regions_->AdvanceSecondariesTo(regions_->state_ticks(kPrimaryRegion) +
+                                     regions_->period_ticks(kPrimaryRegion));
+      ProxyPush push(proxy_, tool);
+      regions_->StepPrimaryPushed(push);
+      const ProxyContact::Result& touch = push.touch;
       if (touch.left_surface) {
         recorder_.Stop(TrialOutcome::kLeftSurface);
         return false;
@@ -115,9 +117,6 @@ class StrokeRun {
         if (!recorder_.Record(n, touch.force_on_object_n)) return false;
         out_.stroke.proxy.push_back({proxy_.proxy_rest_m(), touch.in_contact, touch.sliding});
       }
-      regions_->AdvanceSecondariesTo(regions_->state_ticks(kPrimaryRegion) +
-                                     regions_->period_ticks(kPrimaryRegion));
-      regions_->StepPrimaryLoaded(loads_);
     }
     return true;
   }
@@ -143,7 +142,6 @@ class StrokeRun {
     regions_ = RegionsAround(scene_, next, state);
     proxy_.Rebind(regions_->partition().PrimaryProxySurface());
     CheckAgree(proxy_, *regions_);
-    loads_.assign(proxy_.loaded_dofs().size(), 0.0);
     runaway_periods_ = 0;
     centre_ = next;
     out_.moves.push_back({n, centre_});
@@ -162,7 +160,6 @@ class StrokeRun {
   double dt_;
   long steps_;
   TrialRecorder recorder_;
-  std::vector<double> loads_;
   double budget_j_ = 0;       // what the state held when the stroke started, J
   double work_before_j_ = 0;  // the contact's work on the regions before them, J
   int runaway_periods_ = 0;

@@ -29,7 +29,7 @@ struct RegionStrokeResult {
 /**
  * A stroke (input.waveform = "stroke") on the scene's asynchronous regions, in virtual time: the
  * tool moved by the ContactTrajectory from the contact node's rest position, touching through a
- * ProxyContact on the primary region (AsyncRegions::StepPrimaryLoaded), the proxy updated at each
+ * ProxyContact on the primary region (AsyncRegions::StepPrimaryPushed), the proxy updated at each
  * of the primary's substeps with the tool on its path. Whenever the proxy is more than ¾ of a node
  * from the node the primary is centred on, the primary follows it: new regions around the node
  * nearest the proxy (if that node is inside the face, so its normal is the face's), started from

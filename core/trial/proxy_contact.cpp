@@ -242,8 +242,20 @@ LatticeIndex ProxyContact::NearestNode() const {
   return at;
 }
 
+double ProxyContact::Compliance(const Patch& patch,
+                                std::span<const double> compliance) const noexcept {
+  double sum = 0;
+  for (int k = 0; k < patch.count; ++k) {
+    const auto j = static_cast<std::size_t>(k);
+    const int slot = slot_of_node_[static_cast<std::size_t>(patch.nodes[j])];
+    if (slot >= 0) sum += patch.weights[j] * patch.weights[j] * compliance[3 * slot];
+  }
+  return sum;
+}
+
 ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           const Eigen::VectorXd& u,
+                                          std::span<const double> compliance,
                                           std::span<double> loads) noexcept {
   std::fill(loads.begin(), loads.end(), 0.0);
   pushed_.count = 0;
@@ -295,7 +307,12 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   }
   result.in_contact = true;
   result.sliding = sliding_;
-  for (int c = 0; c < 3; ++c) result.force_on_object_n[c] = k * d[c];
+  result.offset_m = d;
+  // The spring taken at the step's end: the push f moves the surface under the proxy by C·f, so
+  // f = k·(d − C·f).
+  result.compliance_m_per_n = Compliance(corners, compliance);
+  for (int c = 0; c < 3; ++c)
+    result.force_on_object_n[c] = k * d[c] / (1.0 + k * result.compliance_m_per_n);
   pushed_.count = corners.count;  // (only the entries in use: a patch holds up to 289)
   std::copy_n(corners.nodes.begin(), corners.count, pushed_.nodes.begin());
   std::copy_n(corners.weights.begin(), corners.count, pushed_.weights.begin());

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/fem/elastic_model.hpp"
+#include "core/fem/region_integrator.hpp"
 #include "core/scene/scene.hpp"
 
 namespace hapticsim {
@@ -87,7 +88,10 @@ class ProxyContact {
   const std::array<double, 3>& start_m() const { return start_m_; }
 
   struct Result {
-    std::array<double, 3> force_on_object_n{};  ///< the spring's push on the surface, N
+    /// The spring's push on the surface, N, taken at the step's end: k·(offset − C·push).
+    std::array<double, 3> force_on_object_n{};
+    std::array<double, 3> offset_m{};  ///< tool − surface at the step's end without the push, m
+    double compliance_m_per_n = 0;     ///< C: how far the push moves the surface there, m/N
     bool in_contact = false;
     bool sliding = false;       ///< the proxy slid this period
     bool left_surface = false;  ///< the proxy reached the face's edge: no surface under it
@@ -95,10 +99,14 @@ class ProxyContact {
     /// (another region steps it): nothing was loaded. The regions must move under the proxy.
     bool left_region = false;
   };
-  /** One period: the proxy moved for the tool at `tool_m` (grid frame, m) over the state `u`,
-   *  and the loads on loaded_dofs() written to `loads`. Never allocates or throws. */
+  /**
+   * One step: the proxy moved for the tool at `tool_m` (grid frame, m) over `u`, the state at
+   * the step's end without the push, and the push on loaded_dofs() written to `loads`; the
+   * spring is taken at the step's end (EndOfStepLoad, `compliance` per loaded DOF, m/N), so that
+   * a light node under a stiff spring does not ring. Never allocates or throws.
+   */
   Result Update(const std::array<double, 3>& tool_m, const Eigen::VectorXd& u,
-                std::span<double> loads) noexcept;
+                std::span<const double> compliance, std::span<double> loads) noexcept;
   /** Writes to `loads` the push `force_on_object_n` spread as the last Update in contact spread
    *  its own (the same nodes and weights): a push blended or ramped by the caller. Zero loads if
    *  the last Update pushed nothing. Never allocates. */
@@ -144,6 +152,8 @@ class ProxyContact {
   // The deformed surface point at the proxy: the patch's weighted displacement.
   std::array<double, 3> SurfacePoint(const Patch& patch, const Eigen::VectorXd& u) const;
   bool ExposedFace(int i1, int i2) const;
+  // Σ w²·c over the patch's pushed nodes: how far a push moves the surface point, m/N.
+  double Compliance(const Patch& patch, std::span<const double> compliance) const noexcept;
   // Whether every node of the patch has its displacement in the state vector (ProxySurface::dof),
   // and whether every one is pushable or held (ProxySurface::loadable ≥ 0).
   bool Readable(const Patch& patch) const;
@@ -162,6 +172,26 @@ class ProxyContact {
   std::vector<int> loaded_dofs_;
   std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded
   double lightest_mass_kg_ = 0;
+};
+
+/**
+ * One step of a region or object pushed by a proxy (RegionIntegrator::Step with an
+ * EndOfStepLoad): the proxy touched with the tool at `tool_m` on the state at the step's end.
+ * The result is the last step's.
+ */
+class ProxyPush final : public EndOfStepLoad {
+ public:
+  ProxyPush(ProxyContact& proxy, const std::array<double, 3>& tool_m)
+      : proxy_(proxy), tool_m_(tool_m) {}
+  void Load(const Eigen::VectorXd& predicted, std::span<const double> compliance,
+            std::span<double> load) noexcept override {
+    touch = proxy_.Update(tool_m_, predicted, compliance, load);
+  }
+  ProxyContact::Result touch;
+
+ private:
+  ProxyContact& proxy_;
+  std::array<double, 3> tool_m_;
 };
 
 }  // namespace hapticsim

@@ -57,19 +57,21 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stabi
                               OwnedDofs(model), fixed, contact.loaded_dofs(), h);
   integrator.SetEnergyTerms(false);
   const std::vector<double> held_at_rest(fixed.size(), 0.0);
-  std::vector<double> loads(contact.loaded_dofs().size(), 0.0);
   const ContactTrajectory trajectory(scene.input, object.contact_normal());
   const long steps = scene.num_steps();
   TrialRecorder recorder(trajectory, dt, steps, &result);
   out.proxy.reserve(static_cast<std::size_t>(steps) + 1);
-  // Each substep: the proxy touched with the tool on its path, then one step; the period's sample
-  // is its first substep's force. False when the trial ends.
+  // Each substep: one step, the proxy touching with the tool on its path at the step's end (the
+  // spring taken there: ProxyPush); the period's sample is its first substep's force. False when
+  // the trial ends.
   const auto step_period = [&](long n) {
     for (int q = 0; q < result.substeps; ++q) {
       std::array<double, 3> tool = contact.start_m();
       const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt + q * h);
       for (int c = 0; c < 3; ++c) tool[c] += moved[c];
-      const ProxyContact::Result touch = contact.Update(tool, integrator.u(), loads);
+      ProxyPush push(contact, tool);
+      integrator.Step(held_at_rest, push);
+      const ProxyContact::Result& touch = push.touch;
       if (touch.left_surface) {
         recorder.Stop(TrialOutcome::kLeftSurface);
         return false;
@@ -78,7 +80,6 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stabi
         if (!recorder.Record(n, touch.force_on_object_n)) return false;
         out.proxy.push_back({contact.proxy_rest_m(), touch.in_contact, touch.sliding});
       }
-      integrator.Step(held_at_rest, loads);
       if (!std::isfinite(integrator.OwnedStateMaxAbs())) {
         recorder.Stop(TrialOutcome::kDivergedNonFinite);
         return false;

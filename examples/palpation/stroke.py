@@ -22,7 +22,7 @@ from palpate import parse_args, svg
 
 # The stroke: from node 4 of the middle row (x = 10 mm), 60 mm along +x, over 2 s (the first
 # quarter presses, the rest slides), with a 5 mm tip: on the phantom's 2.5 mm voxels a tip on one
-# cell's nodes diverges (docs/model.md), a tip two voxels wide does not.
+# cell's nodes runs away (docs/model.md), a tip two voxels wide does not.
 STROKE = ["input.waveform=stroke", "input.contact_node=4,8,0", "input.stroke_length=0.06",
           "input.frequency=0.5", "contact.radius=0.005", "adaptivity.primary_size=3"]
 

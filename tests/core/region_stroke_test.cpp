@@ -198,38 +198,61 @@ Scene SoftFineStroke(double radius_m) {
   return scene;
 }
 
-TEST(RegionStroke, OnALatticeFinerThanThePressIsDeepAWideTipSlidesWhereOneCellDiverges) {
-  // The tip on one cell's nodes dimples the surface under the proxy, and the proxy sliding over
-  // its own dimple diverges — on the regions and on the full-resolution object alike.
-  const RegionStrokeResult cell = RunRegionStroke(SoftFineStroke(0.0));
-  EXPECT_TRUE(cell.stroke.trial.diverged()) << TrialOutcomeName(cell.stroke.trial.outcome);
-  // A tip of 5 mm (two spacings) spreads the push and reads the surface over 16 nodes.
-  const Scene wide = SoftFineStroke(0.005);
-  const RegionStrokeResult run = RunRegionStroke(wide);
-  ASSERT_EQ(run.stroke.trial.outcome, TrialOutcome::kCompleted);
-  Scene full = wide;
-  full.solver.dt_s = 5e-5;  // the full-resolution object's limit with the spring: 77 µs
+// The stroke on the regions against the full-resolution one (its steps 50 µs, under the
+// object's limit with the spring: 77 µs), at the regions' sample times.
+struct FineStrokeCheck {
+  RegionStrokeResult run;
+  double lateral_n = 0, normal_n = 0, largest_step_n = 0, l2_percent = 0;
+  double reference_lateral_n = 0;
+};
+FineStrokeCheck StrokeAgainstTheFullResolution(const Scene& scene) {
+  FineStrokeCheck check{RunRegionStroke(scene)};
+  Scene full = scene;
+  full.solver.dt_s = 5e-5;
   const StrokeTrialResult reference = Reference(full);
-  ASSERT_EQ(reference.trial.outcome, TrialOutcome::kCompleted);
-  double lateral = 0, normal = 0;
-  for (const ForceSample& s : run.stroke.trial.samples) {
-    lateral = std::max(lateral, Lateral(s));
-    normal = std::max(normal, Normal(s));
-  }
-  // The reference's samples every 50 µs, the regions' every 1 ms: compare at the same times.
+  const std::vector<ForceSample>& samples = check.run.stroke.trial.samples;
   std::vector<ForceSample> matched;
-  for (std::size_t i = 0; i < run.stroke.trial.samples.size(); ++i)
+  for (std::size_t i = 0; i < samples.size() && 20 * i < reference.trial.samples.size(); ++i)
     matched.push_back(reference.trial.samples[20 * i]);
-  const ForceError e = CompareForces(run.stroke.trial.samples, matched);
+  for (const ForceSample& s : samples) {
+    check.lateral_n = std::max(check.lateral_n, Lateral(s));
+    check.normal_n = std::max(check.normal_n, Normal(s));
+  }
+  for (const ForceSample& s : reference.trial.samples)
+    check.reference_lateral_n = std::max(check.reference_lateral_n, Lateral(s));
+  check.largest_step_n = LargestStep(samples);
+  const std::vector<ForceSample> compared(samples.begin(),
+                                          samples.begin() + static_cast<long>(matched.size()));
+  check.l2_percent = CompareForces(compared, matched).l2_percent;
   std::printf(
-      "soft fine block, 5 mm tip: %zu moves, largest lateral %.5f N, normal %.4f N, "
-      "largest step %.4f N; against the full-resolution stroke relative L2 %.2f %%\n",
-      run.moves.size(), lateral, normal, LargestStep(run.stroke.trial.samples), e.l2_percent);
-  EXPECT_GE(run.moves.size(), 5u);
-  EXPECT_LT(lateral, 0.05);
-  EXPECT_GT(normal, 0.03);
-  EXPECT_LT(LargestStep(run.stroke.trial.samples), 0.1);
-  EXPECT_LT(e.l2_percent, 5.0);
+      "soft fine block, tip radius %.4f m: %s after %zu samples, %zu moves, largest lateral "
+      "%.5f N, normal %.4f N, largest step %.4f N; against the full-resolution stroke (largest "
+      "lateral %.5f N) relative L2 %.2f %%\n",
+      scene.contact.radius_m, std::string(TrialOutcomeName(check.run.stroke.trial.outcome)).c_str(),
+      samples.size(), check.run.moves.size(), check.lateral_n, check.normal_n, check.largest_step_n,
+      check.reference_lateral_n, check.l2_percent);
+  return check;
+}
+
+TEST(RegionStroke, OnALatticeFinerThanThePressIsDeepAWideTipSlidesWhereOneCellRunsAway) {
+  // A tip on one cell's nodes dimples the surface under the proxy, and the proxy, reading the
+  // surface from the same nodes, slides over its own dimple and runs away, on the regions and on
+  // the full-resolution object alike (measured: the reference 3.5 N lateral on a press of
+  // 0.06 N, frictionless; the regions 0.08 N, the stroke leaving its face early). With the
+  // spring taken at each step's start the light nodes also rang under it and the regions'
+  // stroke was stopped as diverged; taken at the step's end (ProxyPush) it is not, but the
+  // geometry still runs away.
+  const FineStrokeCheck cell = StrokeAgainstTheFullResolution(SoftFineStroke(0.0));
+  EXPECT_TRUE(cell.run.stroke.trial.diverged() || cell.lateral_n > 0.05 ||
+              cell.largest_step_n > 0.1);
+  // A tip of 5 mm (two spacings) spreads the push and reads the surface over 16 nodes.
+  const FineStrokeCheck wide = StrokeAgainstTheFullResolution(SoftFineStroke(0.005));
+  ASSERT_EQ(wide.run.stroke.trial.outcome, TrialOutcome::kCompleted);
+  EXPECT_GE(wide.run.moves.size(), 5u);
+  EXPECT_LT(wide.lateral_n, 0.05);
+  EXPECT_GT(wide.normal_n, 0.03);
+  EXPECT_LT(wide.largest_step_n, 0.1);
+  EXPECT_LT(wide.l2_percent, 5.0);
 }
 
 TEST(RegionStroke, AWideTipNeedsAPrimaryThatReachesIt) {

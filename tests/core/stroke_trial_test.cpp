@@ -180,7 +180,8 @@ TEST(ProxyContact, ATipsLoadsSumToItsForceSymmetricallyAndANarrowTipIsTheCells) 
     contact.radius_m = radius_m;
     ProxyContact proxy(model, object.contact_node(), object.contact_normal(), contact);
     std::vector<double> loads(proxy.loaded_dofs().size(), 0.0);
-    const ProxyContact::Result touch = proxy.Update(tool, u, loads);
+    const std::vector<double> compliance(loads.size(), 1e-6);  // m/N: the push is k·d/(1 + k·C)
+    const ProxyContact::Result touch = proxy.Update(tool, u, compliance, loads);
     EXPECT_TRUE(touch.in_contact);
     std::array<double, 3> sum{};
     for (std::size_t i = 0; i < loads.size(); ++i) sum[i % 3] += loads[i];

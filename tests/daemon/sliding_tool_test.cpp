@@ -10,10 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/regions/region_stroke_trial.hpp"
 #include "core/scene/contact_trajectory.hpp"
+#include "core/scene/scene_geometry.hpp"
+#include "core/scene/scene_toml.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "daemon/supervisor.hpp"
 #include "tests/support/play_device.hpp"
@@ -131,6 +134,58 @@ TEST(SlidingTool, WithoutFrictionTheDaemonSendsNoLateralForce) {
   EXPECT_LE(served.largest_step_n, 0.1);
   std::printf("frictionless: lateral at most %.4f N, normal up to %.3f N, %d moves\n", lateral,
               normal, served.moves);
+}
+
+// The palpation phantom at 5 mm voxels stroked by a point tip (contact.radius 0: the push on one
+// cell's four nodes), 60 mm along x at 3 mm, the regions following, and jolted mid-stroke (the
+// hand 1 mm deeper for 3 periods). With the spring taken at each substep's start, the light
+// nodes under the stiff spring rang at the substep rate and a jolt like this one (or a move of the
+// regions on threads) set them bouncing on and off the tool for the rest of the stroke: measured
+// 191 to 1,494 periods with a step over 0.15 N, up to 2 N, the port guard's slew off. Taken at the
+// step's end (ProxyPush), the jolt is felt, then it is over.
+TEST(SlidingTool, APointTipOnFineVoxelsJoltedMidStrokeSettlesInsteadOfChattering) {
+  Scene scene = LoadSceneFile(std::string(HAPTICSIM_EXAMPLES_DIR) + "/palpation/palpation.toml");
+  scene.geometry.spacing_m = 0.005;
+  LoadSceneGeometry(&scene);
+  scene.contact.model = ContactModel::kProxy;
+  scene.contact.radius_m = 0;
+  scene.adaptivity.primary_size = 4;
+  scene.input.contact_node = LatticeIndex{2, 4, 0};
+  HapticLoop::Options options;
+  options.port.max_force_rate_n_per_ms = 100;  // the force as simulated, not slewed
+  options.port.passivity = false;
+  HapticLoop loop(scene, options);
+  const RegionConfiguration configuration{4, scene.adaptivity.secondary_lod,
+                                          scene.adaptivity.secondary_rate_hz};
+  const auto smooth = [](double t) { return t <= 0 ? 0.0 : t >= 1 ? 1.0 : t * t * (3 - 2 * t); };
+  testing::SentForces sent;
+  int moves = 0, steps_after_jolt = 0;
+  double largest_before_jolt = 0;
+  std::int64_t release = 1'000'000'000;
+  for (int n = 0; n < 4000; ++n, release += 1'000'000) {
+    if (loop.contact_following() && loop.wanted_contact_node() != loop.centre_node()) {
+      loop.Reconfigure(SceneWith(scene, configuration, *loop.wanted_contact_node()),
+                       HapticLoop::Handover::kCarryMotion);
+      ++moves;
+    }
+    const double t = n * 1e-3;
+    const double in = smooth(t / 0.4) - smooth((t - 3.4) / 0.4);
+    const double jolt = n >= 1500 && n < 1503 ? 0.001 : 0.0;
+    const std::array<double, 3> tip{0.01 + 0.06 * smooth((t - 0.5) / 2.8), 0.02,
+                                    -0.002 + 0.005 * in + jolt};
+    testing::PlayPeriodInVirtualTime(loop, release, DeviceSample{n, release, tip, false});
+    sent.Pop(loop, [&](const std::array<double, 3>&, double step) {
+      if (n < 1500) largest_before_jolt = std::max(largest_before_jolt, step);
+      if (n >= 1510 && step > 0.15) ++steps_after_jolt;
+    });
+  }
+  std::printf(
+      "point tip on 5 mm voxels: %d moves, largest step before the jolt %.3f N, %d steps "
+      "over 0.15 N from 7 ms after it\n",
+      moves, largest_before_jolt, steps_after_jolt);
+  EXPECT_GE(moves, 8);
+  EXPECT_LT(largest_before_jolt, 0.1);
+  EXPECT_EQ(steps_after_jolt, 0);
 }
 
 // Regions restarted from rest under a sliding tool (a runaway's demotion, a move the check refused

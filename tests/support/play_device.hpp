@@ -2,6 +2,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -55,5 +56,27 @@ inline void PlayPeriodInVirtualTime(HapticLoop& loop, std::int64_t release_ns,
   }
   loop.PrimaryPeriod(release_ns, release_ns);
 }
+
+/**
+ * The forces a loop sends, popped after each period, each with its step from the one before it
+ * (N; 0 for the first): `each(force_n, step_n)`.
+ */
+class SentForces {
+ public:
+  template <typename Each>
+  void Pop(HapticLoop& loop, Each each) {
+    ForceRecord record;
+    while (loop.forces().Pop(&record)) {
+      const std::array<double, 3>& f = record.force_n;
+      const double step =
+          last_ ? std::hypot(f[0] - (*last_)[0], f[1] - (*last_)[1], f[2] - (*last_)[2]) : 0.0;
+      last_ = f;
+      each(f, step);
+    }
+  }
+
+ private:
+  std::optional<std::array<double, 3>> last_;
+};
 
 }  // namespace hapticsim::testing
