@@ -108,9 +108,20 @@ void ConfigurationSupervisor::ChooseForCentreIfMissed() {
   StartChoice(std::nullopt);
 }
 
+// A replacement of the regions that held the supervisor's thread long (commands wait meanwhile,
+// and a touch is held or waits for the new regions) is said, with where the time went.
+void ConfigurationSupervisor::SayIfSlow(const HapticLoop::ReplacementTimes& took) {
+  if (took.total_s < kSlowReplacement_s) return;
+  spdlog::warn(
+      "replacing the regions took {:.3f} s (building them {:.3f} s, the primary thread pausing "
+      "{:.3f} s, the old secondary threads stopping {:.3f} s); commands waited meanwhile",
+      took.total_s, took.build_s, took.pause_s, took.join_s);
+}
+
 void ConfigurationSupervisor::RestartFromRest(const char* why) {
   try {
     loop_.Reconfigure(SceneWith(scene_, active(), loop_.centre_node()));
+    SayIfSlow(loop_.last_replacement());
   } catch (const Error& e) {
     // Only a hung primary thread gets here (the scene is the running one): the watchdog's
     // pings stop and systemd restarts the daemon.
@@ -277,6 +288,7 @@ void ConfigurationSupervisor::ApplyMove(const RegionsMover::Outcome& moved, std:
                         moved.CarriesMotionFrom(loop_.centre_node())
                             ? HapticLoop::Handover::kCarryMotion
                             : HapticLoop::Handover::kRampIn);
+      SayIfSlow(loop_.last_replacement());
     } catch (const Error&) {
       mover_.NotApplied(moved);  // a demotion or a move back is tried again at the next tick
       throw;

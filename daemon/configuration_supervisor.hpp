@@ -81,6 +81,8 @@ class ConfigurationSupervisor {
   static constexpr double kHoverBeforeRecentre_s = 0.2;  // not every node a passing tool crosses
   /** The rest after a touch before regions that restart from rest may move. */
   static constexpr double kSettleBeforeReconfigure_s = 1.0;  // e^(−d t / 2) < 1 % at d = 10 1/s
+  /** A replacement of the regions this long is logged with where its time went (SayIfSlow). */
+  static constexpr double kSlowReplacement_s = 0.25;
 
  private:
   Scene SceneAtCentre() const;
@@ -93,6 +95,7 @@ class ConfigurationSupervisor {
   bool MoveRegions(std::int64_t now_ns);
   void ApplyMove(const RegionsMover::Outcome& moved, std::int64_t now_ns);
   void CheckOverload(std::int64_t now_ns);
+  static void SayIfSlow(const HapticLoop::ReplacementTimes& took);
 
   const Scene scene_;
   HapticLoop& loop_;

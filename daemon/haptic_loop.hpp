@@ -146,6 +146,12 @@ class HapticLoop {
    *         left as it was).
    */
   void Reconfigure(const Scene& scene, Handover handover = Handover::kFromRest);
+  /** How long the last Reconfigure took, and where (s): building the new regions, waiting for the
+   *  primary to pause, joining the old secondary threads; all of it. Supervisor thread only. */
+  struct ReplacementTimes {
+    double build_s = 0, pause_s = 0, join_s = 0, total_s = 0;
+  };
+  const ReplacementTimes& last_replacement() const { return last_replacement_; }
   /** The object's deformed surface as the running regions published it (TakeSurface). */
   struct SurfaceFrame {
     /** Regions installed since the loop was made when it was taken: changes with every
@@ -399,6 +405,7 @@ class HapticLoop {
   std::atomic<bool> running_{false}, stop_{false}, stop_secondaries_{false};
   std::thread primary_thread_;
   std::vector<std::thread> secondary_threads_;
+  ReplacementTimes last_replacement_;
   std::vector<std::int64_t> lead_ns_;
   double tick_ns_ = 0;
   double primary_period_ns_ = 0;

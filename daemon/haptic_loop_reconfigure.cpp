@@ -52,6 +52,8 @@ std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {
 }
 
 void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
+  const std::int64_t start_ns = NowNs();
+  last_replacement_ = ReplacementTimes{};
   auto regions = std::make_unique<AsyncRegions>(scene);  // the slow part, while the loop runs
   // What can throw or allocate of a sliding tool's proxy over them, made before any pause.
   std::optional<SlidingContact::Binding> binding;
@@ -78,11 +80,14 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     restart = unapplied;
   }
   const bool carrying = restart == RegionRestart::kCarryingMotion;
+  const std::int64_t built_ns = NowNs();
+  last_replacement_.build_s = (built_ns - start_ns) * 1e-9;
   if (!running_.load()) {
     if (carrying) regions->RestoreState(regions_->CaptureState());
     handover_.SetRestartWhileStopped(restart);
     ForgetSleep();
     Install(scene, std::move(regions), std::move(binding));
+    last_replacement_.total_s = last_replacement_.build_s;
     return;
   }
   handover_.RequestPause(carrying);
@@ -98,7 +103,10 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
     }
     SleepUntilMonotonicNs(NowNs() + 100'000);
   }
+  const std::int64_t paused_ns = NowNs();
+  last_replacement_.pause_s = (paused_ns - built_ns) * 1e-9;
   StopSecondaries();
+  last_replacement_.join_s = (NowNs() - paused_ns) * 1e-9;
   // Nothing steps the old regions now: their motion is the new ones' start.
   if (carrying) regions->RestoreState(regions_->CaptureState());
   ForgetSleep();
@@ -108,6 +116,7 @@ void HapticLoop::Reconfigure(const Scene& scene, Handover handover) {
   const std::int64_t resume_at = NextPrimaryRelease(NowNs() + 2'000'000 + lead_ns_.back());
   StartSecondaries(resume_at);
   handover_.Resume(restart, resume_at);
+  last_replacement_.total_s = (NowNs() - start_ns) * 1e-9;
 }
 
 }  // namespace hapticsim

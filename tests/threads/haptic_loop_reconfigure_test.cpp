@@ -45,6 +45,15 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
       const bool odd = k % 2 == 1;
       loop.Reconfigure(SceneWith(scene, RegionConfiguration{odd ? 3 : 2, 2, 600},
                                  odd ? LatticeIndex{6, 6, 0} : LatticeIndex{3, 9, 0}));
+      // Where the replacement's time went (the supervisor logs a slow one): its parts add up.
+      const HapticLoop::ReplacementTimes& took = loop.last_replacement();
+      EXPECT_GT(took.build_s, 0);
+      EXPECT_GT(took.pause_s, 0);
+      EXPECT_GE(took.join_s, 0);
+      EXPECT_GE(took.total_s, took.build_s + took.pause_s + took.join_s);
+      EXPECT_LT(took.total_s, took.build_s + took.pause_s + took.join_s + 0.5);
+      std::printf("replacement %d: %.1f ms (building %.1f, pausing %.1f, joining %.1f)\n", k,
+                  1e3 * took.total_s, 1e3 * took.build_s, 1e3 * took.pause_s, 1e3 * took.join_s);
       ++replaced;
     }
   });
