@@ -30,6 +30,7 @@
 #include "tools/hapticsim/deformation_watch.hpp"
 #include "tools/hapticsim/device_report.hpp"
 #include "tools/hapticsim/line_chart.hpp"
+#include "tools/hapticsim/scene_object_front.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -42,6 +43,7 @@ struct SoakOptions {
   double warm_up_s = -1;  // default: a tenth of the run, at least 5 s
   std::string daemon;
   std::string error_map;
+  std::string scene;  // --scene: the object served and touched (default: the paper's cube)
   std::string report_dir = "soak-report";
   std::string input = "walk";
   unsigned seed = 1;
@@ -223,6 +225,7 @@ int RunSoak(const SoakOptions& o) {
     if (!o.error_map.empty()) {
       c << "[supervisor]\nerror_map = \"" << fs::absolute(o.error_map).string() << "\"\n";
     }
+    if (!o.scene.empty()) c << "[scene]\nfile = \"" << fs::absolute(o.scene).string() << "\"\n";
   }
   std::cerr << "hapticsim soak: " << daemon << " for " << o.duration_s
             << " s in a private network namespace; report in " << dir.string() << "/\n";
@@ -304,6 +307,10 @@ int RunSoak(const SoakOptions& o) {
   device::MotionSettings motion_settings;
   motion_settings.kind = o.input;
   motion_settings.seed = o.seed;
+  if (!o.scene.empty()) {  // the device's presses and walk over the scene's object, at its middle
+    MeetSceneObject(o.scene, &motion_settings);
+    motion_settings.at_m = {motion_settings.extent_m[0] / 2, motion_settings.extent_m[1] / 2};
+  }
   device::DeviceMotion motion(motion_settings);
   device::SessionSettings settings;
   settings.duration_s = o.duration_s;
@@ -444,6 +451,7 @@ int RunSoak(const SoakOptions& o) {
         {"html", (dir / "soak.html").string()},
         {"daemon_log", log.string()}}}};
   summary["deformation_rate_hz"] = o.deformation_rate_hz;
+  summary["scene"] = o.scene.empty() ? "the paper's cube" : fs::absolute(o.scene).string();
   summary.update(deformation.Summary());
   nlohmann::json full = summary;
   full["device"] = ReportJson(report);
@@ -457,8 +465,9 @@ int RunSoak(const SoakOptions& o) {
   if (o.json) {
     std::cout << summary.dump(2) << "\n";
   } else {
-    std::cout << "hapticsimd soak, " << o.duration_s << " s (" << o.input << " input over shared "
-              << "memory, forces also watched on LCM" << (o.cpu_load ? ", " : "")
+    std::cout << "hapticsimd soak, " << o.duration_s << " s on "
+              << (o.scene.empty() ? "the paper's cube" : o.scene) << " (" << o.input
+              << " input over shared memory, forces also watched on LCM" << (o.cpu_load ? ", " : "")
               << (o.cpu_load ? std::to_string(o.cpu_load) + " busy threads beside, given " +
                                    std::to_string(std::lround(load_cpu_s)) + " s of CPU"
                              : "")
@@ -525,6 +534,12 @@ Command AddSoakCommand(CLI::App& parent, int argc, char** argv) {
                   "hapticsimd to run (default: the one built next to "
                   "this hapticsim)");
   app->add_option("--error-map", options->error_map, "Error map for the daemon (default: none)");
+  app->add_option("--scene", options->scene,
+                  "Scene file of the object the daemon serves and the device touches: its "
+                  "geometry, materials, supports and contact (contact.model = \"proxy\": a tool "
+                  "that slides), the device's input over its front as `hapticsim device --scene` "
+                  "puts it (default: the paper's cube). --switch-every's pins must suit it")
+      ->check(CLI::ExistingFile);
   app->add_option("--report", options->report_dir,
                   "Directory for soak.json, soak.html and the "
                   "daemon's log")
