@@ -243,8 +243,8 @@ void HapticLoop::ApplyRestart(std::int64_t release_ns) noexcept {
       break;
     case RegionRestart::kCarryingMotion:
       // The new regions hold the contact where the last period before the pause left it (a
-      // sliding tool's proxy goes on where it was, Install bound it to them, and its push blends
-      // back from the one held).
+      // sliding tool's proxy goes on where it was, Install bound it to them, and its push comes
+      // back from the one held: SlidingContact::CatchUp).
       if (sliding_) {
         // The pause held the push for at most kMaxHold_s (PrimaryPeriod), then released it.
         const double paused_ns = static_cast<double>(held_periods_) * primary_period_ns_;

@@ -117,7 +117,8 @@ class SlidingContact {
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
   // The push the object gets and the user feels back, from the spring's `touch` at the step's
-  // end: ramped in, or blended from the push held over a pause (CatchUp).
+  // end: ramped in, or brought back from the push held over a pause (CatchUp: the spring anchored
+  // where it gave that push, the anchor returning to the tool).
   std::array<double, 3> Rendered(const ProxyContact::Result& touch, std::int64_t now_ns) noexcept;
   // `push` with its tangential part at most μ_s times its normal part, and none if it would pull.
   std::array<double, 3> InsideFrictionCone(const std::array<double, 3>& push) const noexcept;
@@ -152,9 +153,9 @@ class SlidingContact {
   bool following_ = false;           // the regions should follow the proxy (onto wanted_)
   bool out_of_region_ = false;       // the proxy slid out of the primary: nothing pushed
   std::int64_t ramp_start_ns_ = -1;  // the force ramps in from here (−1: no ramp)
-  std::int64_t catch_up_ns_ = -1;    // the push blends back from held_push_ from here (−1: none)
+  std::int64_t catch_up_ns_ = -1;    // the push comes back from held_push_ from here (−1: none)
   std::array<double, 3> last_push_{};  // the last period's push (the one a pause holds)
-  std::array<double, 3> held_push_{};  // the push a pause held, blended from (CatchUp)
+  std::array<double, 3> held_push_{};  // the push a pause held, come back from (CatchUp)
   // Where the catching-up spring pulls from, less the tool (Rendered), once its first push is set.
   std::array<double, 3> catch_up_offset_m_{};
   bool catch_up_anchored_ = false;

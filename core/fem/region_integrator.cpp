@@ -104,6 +104,7 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, std::span<c
 void RegionIntegrator::Step(std::span<const double> prescribed_next, EndOfStepLoad& rule,
                             double dissipate_j, const PortWorkLimits& limits) noexcept {
   assert(prescribed_next.size() == prescribed_.size());
+  assert(!(limits.load_work_j < INFINITY));  // the rule's load is rendered as given
   for (int i : loaded_) external_[i] = 0.0;
   double swept = Predict();
   double* next = u_next_->data();

@@ -104,6 +104,9 @@ class RegionIntegrator {
    * One substep whose load the loaded DOFs' own end of step decides (EndOfStepLoad): u⁺ is formed
    * without it, `rule` gives the load from that, and the load is added to u⁺ (it enters linearly),
    * so the step satisfies the equation of motion with that load. Its work counts as a load's.
+   * Extra damping asked for (`dissipate_j`) is applied after, to the state the load left: the
+   * load then matches the step's end only to that damping's share. `limits` must not limit the
+   * load (the rule's caller renders exactly the load it gave): load_work_j stays infinite.
    */
   void Step(std::span<const double> prescribed_next, EndOfStepLoad& rule, double dissipate_j = 0,
             const PortWorkLimits& limits = PortWorkLimits{}) noexcept;

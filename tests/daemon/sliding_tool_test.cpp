@@ -13,11 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "core/regions/async_regions.hpp"
 #include "core/regions/region_stroke_trial.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/scene/scene_geometry.hpp"
 #include "core/scene/scene_toml.hpp"
+#include "daemon/contact_object.hpp"
 #include "daemon/haptic_loop.hpp"
+#include "daemon/sliding_contact.hpp"
 #include "daemon/supervisor.hpp"
 #include "tests/support/play_device.hpp"
 
@@ -186,6 +189,64 @@ TEST(SlidingTool, APointTipOnFineVoxelsJoltedMidStrokeSettlesInsteadOfChattering
   EXPECT_GE(moves, 8);
   EXPECT_LT(largest_before_jolt, 0.1);
   EXPECT_EQ(steps_after_jolt, 0);
+}
+
+// The push after a move's pause (SlidingContact::CatchUp), played on the contact itself: the tool
+// slid on 0.3 mm over a 5 ms pause. The first push is the one held, to rounding; then the spring,
+// anchored where it gave that push, comes back to the tool over twice the pause without a step and
+// inside the friction cone, and is the spring's own once the catch-up is over.
+TEST(SlidingTool, AfterAPauseThePushComesBackFromTheHeldOneInsideTheFrictionCone) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.contact.model = ContactModel::kProxy;
+  AsyncRegions regions(scene);
+  const ContactObject object = ContactObject::Of(scene);
+  SlidingContact contact(object, scene.contact, 0.1);
+  contact.Bind(contact.Prepare(regions));
+  const LatticeIndex centre = regions.partition().contact_node();
+  const auto period = [&](const std::array<double, 3>& tip, std::int64_t now, bool step) {
+    contact.Update(tip, now, step ? std::optional<LatticeIndex>(centre) : std::nullopt);
+    if (!step) return std::array<double, 3>{};
+    regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
+                                 regions.period_ticks(kPrimaryRegion));
+    return contact.StepPeriod(regions, now);
+  };
+  const auto lateral = [](const std::array<double, 3>& f) { return std::hypot(f[0], f[1]); };
+  // Down 4 mm into the middle of the front face over 0.2 s, then 1 mm along x over 0.1 s: sliding.
+  std::array<double, 3> tip = {0.125, 0.125, -0.001};
+  std::int64_t now = 1'000'000'000;
+  std::array<double, 3> push{};
+  for (int n = 0; n < 300; ++n, now += 1'000'000) {
+    tip[2] = -0.001 + 0.005 * std::min(1.0, n / 200.0);
+    if (n >= 200) tip[0] += 1e-5;
+    push = period(tip, now, true);
+  }
+  ASSERT_GT(push[2], 0.1);  // pushing into the face (+z)
+  const std::array<double, 3> held = push;
+  for (int n = 0; n < 5; ++n, now += 1'000'000) {  // paused: the tool slides on, nothing steps
+    tip[0] += 6e-5;
+    period(tip, now, false);
+  }
+  contact.CatchUp(now, 5'000'000, false);
+  double largest_step = 0;
+  std::array<double, 3> last = held;
+  for (int n = 0; n < 40; ++n, now += 1'000'000) {
+    tip[0] += 1e-5;
+    push = period(tip, now, true);
+    if (n == 0) {
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(push[c], held[c], 1e-9) << c;
+    }
+    EXPECT_LE(lateral(push), 0.5 * push[2] * (1 + 1e-9)) << "period " << n;
+    largest_step =
+        std::max(largest_step, std::hypot(push[0] - last[0], push[1] - last[1], push[2] - last[2]));
+    last = push;
+  }
+  // Caught up (10 ms) and sliding again: the spring's own, at μ_k.
+  EXPECT_NEAR(lateral(push) / push[2], 0.4, 0.02);
+  EXPECT_LT(largest_step, 0.02);
+  std::printf(
+      "after a 5 ms pause: held (%.4f, %.4f, %.4f) N, first push (the same), largest step "
+      "%.4f N, lateral/normal caught up %.4f\n",
+      held[0], held[1], held[2], largest_step, lateral(push) / push[2]);
 }
 
 // Regions restarted from rest under a sliding tool (a runaway's demotion, a move the check refused
