@@ -246,7 +246,6 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
   } else {
     // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push would
     // be a force the object never gets back.
-    std::fill(load.begin(), load.end(), 0.0);
     c.catch_up_ns_ = -1;
   }
 }
