@@ -263,12 +263,21 @@ TEST_F(HapticsimdEndToEnd, ACommandChangesTheErrorTargetAndTheSupervisorReconfig
   EXPECT_LT(weakest, -0.5) << "the force was dropped across the switch\n" << daemon_->Log();
 }
 
-// Contact anywhere: a touch on another surface node moves the regions there at once (their
-// coupling verified behind them) and pushes back with its force ramped in, within 20 ms.
-TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
-  Client client;
+// What one touch off centre measured (HapticsimdEndToEnd.ATouchOffCentre...).
+struct RecentringRun {
+  double touch_to_force_ms = 0;
+  int waited = 0;           // periods flagged waiting for the regions to move
+  int pushing_back = 0;     // answers in the held press pushing back over 0.3 N
+  int near_late = 0;        // answers from a period woken late or just after one
+  double largest_jump = 0;  // N, between answers of periods woken on time
+  size_t answers = 0;
+};
+
+// Hovers over surface node (2, 3, 0), presses 6 mm in over 600 ms and holds; checks what the
+// daemon says it did and measures the force it answered with.
+void TouchOffCentre(Client& client, testing::BackgroundProcess& daemon, RecentringRun* run) {
   ASSERT_TRUE(client.WaitForStatus([](const status_t& s) { return s.contact_node[2] == 0; }, 30))
-      << daemon_->Log();
+      << daemon.Log();
   const double h = kEdge / 12;
   auto next = Clock::now();
   for (std::int64_t seq = 1; seq <= 1500; ++seq) {  // a brief hover over (2, 3, 0), then 6 mm in
@@ -285,17 +294,18 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
   EXPECT_EQ(status->contact_node[2], 0);
   EXPECT_GE(status->reconfigurations, 1);
   EXPECT_EQ(status->runaways, 0);
-  EXPECT_NE(daemon_->Log().find("regions centred on contact node (2, 3, 0)"), std::string::npos)
-      << daemon_->Log();
-  EXPECT_NE(daemon_->Log().find("around contact node (2, 3, 0) checked"), std::string::npos)
+  EXPECT_NE(daemon.Log().find("regions centred on contact node (2, 3, 0)"), std::string::npos)
+      << daemon.Log();
+  EXPECT_NE(daemon.Log().find("around contact node (2, 3, 0) checked"), std::string::npos)
       << "the check behind the move\n"
-      << daemon_->Log();
-  int waited = 0, pushing_back = 0, near_late = 0;
+      << daemon.Log();
   std::int64_t touch_down_us = -1, first_force_us = -1;  // seq 51 is the first input inside
-  double previous = 0, largest_jump = 0;
+  double previous = 0;
   const std::vector<force_feedback_t> forces = client.Forces();
   std::vector<Wake> wakes;
-  for (const force_feedback_t& f : forces) wakes.push_back({f.period, f.utime});
+  for (const force_feedback_t& f : forces) {
+    wakes.push_back({f.period, f.utime, (f.flags & force_feedback_t::FLAG_INPUT_STALE) != 0});
+  }
   const std::vector<bool> near_late_wake = NearALateWake(wakes);
   for (size_t i = 0; i < forces.size(); ++i) {
     const force_feedback_t& f = forces[i];
@@ -304,35 +314,61 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
     if (f.seq > 50 && f.force[2] != 0 && first_force_us < 0) first_force_us = f.utime;
     if (!(f.flags & force_feedback_t::FLAG_IN_CONTACT)) {
       EXPECT_EQ(f.force[2], 0.0) << "force without contact at seq " << f.seq;
-      if (f.seq > 50 && (f.flags & force_feedback_t::FLAG_RECONFIGURING)) ++waited;
+      if (f.seq > 50 && (f.flags & force_feedback_t::FLAG_RECONFIGURING)) ++run->waited;
     } else {
       // Off the node the map was made for: the error is the mapped node's, flagged as clamped.
       EXPECT_TRUE(f.flags & force_feedback_t::FLAG_LOOKUP_CLAMPED) << f.seq;
-      if (f.seq > 1300 && f.force[2] < -0.3) ++pushing_back;
+      if (f.seq > 1300 && f.force[2] < -0.3) ++run->pushing_back;
     }
     if (f.flags & force_feedback_t::FLAG_INPUT_STALE) continue;  // zeroed once the device stops
     if (near_late_wake[i]) {
-      ++near_late;  // the machine's hiccup, not the re-centring's (tests/support/late_wakes.hpp)
+      ++run->near_late;  // the machine's hiccup, not the re-centring's
+                         // (tests/support/late_wakes.hpp)
     } else {
-      largest_jump = std::max(largest_jump, std::abs(f.force[2] - previous));
+      run->largest_jump = std::max(run->largest_jump, std::abs(f.force[2] - previous));
     }
     previous = f.force[2];
   }
-  const double touch_to_force_ms = (first_force_us - touch_down_us) * 1e-3;
+  ASSERT_GE(touch_down_us, 0);
+  ASSERT_GE(first_force_us, 0) << "no force after the touch";
+  run->touch_to_force_ms = (first_force_us - touch_down_us) * 1e-3;
+  run->answers = forces.size();
   std::printf(
       "re-centring: %.1f ms from touch-down to the first force (%d periods flagged waiting); "
       "largest force step %.4f N over periods woken on time; %d of %zu answers near a late "
       "wake\n",
-      touch_to_force_ms, waited, largest_jump, near_late, forces.size());
-  ASSERT_GE(touch_down_us, 0);
-  ASSERT_GE(first_force_us, 0) << "no force after the touch";
-  EXPECT_LE(touch_to_force_ms, 20.0) << "from touch-down to the first force\n" << daemon_->Log();
-  EXPECT_GT(pushing_back, 100) << daemon_->Log();
-  EXPECT_LT(largest_jump, 0.1) << "a force step across the re-centring";
-  EXPECT_LT(near_late, static_cast<int>(forces.size()) / 4)
-      << "answers from periods woken late, of " << forces.size();
-  daemon_->Signal(SIGTERM);
-  EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
+      run->touch_to_force_ms, run->waited, run->largest_jump, run->near_late, run->answers);
+}
+
+// Contact anywhere: a touch on another surface node moves the regions there at once (their
+// coupling verified behind them) and pushes back with its force ramped in, within 20 ms.
+TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
+  // The force's smoothness is measured over the periods woken on time, so it needs most of them
+  // to be: where the machine woke a quarter or more of them late (measured once in CI: 657 of
+  // 1,600, against 0–5 on a quiet machine and 89–182 beside three busy threads), the touch is
+  // made again, on a fresh daemon, up to three times.
+  RecentringRun run;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    if (attempt > 1) {
+      TearDown();
+      SetUp();
+    }
+    run = RecentringRun{};
+    Client client;
+    TouchOffCentre(client, *daemon_, &run);
+    if (HasFatalFailure()) return;
+    daemon_->Signal(SIGTERM);
+    EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
+    if (run.near_late < static_cast<int>(run.answers) / 4) break;
+    std::printf("attempt %d: %d of %zu answers came from periods woken late; touching again\n",
+                attempt, run.near_late, run.answers);
+  }
+  EXPECT_LE(run.touch_to_force_ms, 20.0) << "from touch-down to the first force\n"
+                                         << daemon_->Log();
+  EXPECT_GT(run.pushing_back, 100) << daemon_->Log();
+  EXPECT_LT(run.largest_jump, 0.1) << "a force step across the re-centring";
+  EXPECT_LT(run.near_late, static_cast<int>(run.answers) / 4)
+      << "answers from periods woken late, of " << run.answers << ", in each of three touches";
 }
 
 TEST_F(HapticsimdEndToEnd, APinnedConfigurationHoldsUntilReleasedAndAnOutOfRangeOneIsRefused) {

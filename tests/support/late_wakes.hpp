@@ -13,29 +13,43 @@
 namespace hapticsim {
 
 struct Wake {
-  std::int64_t period = 0;    // the primary period, counting every one
+  std::int64_t period = 0;    // the primary period, counting every one answered
   std::int64_t utime_us = 0;  // when it ran
+  // Answered on stale input: the loop may have idled waiting for input, and an idle loop goes
+  // back on its release grid at the next release after the input came (HapticLoop::PrimaryThread),
+  // so the periods counted no longer say when the next answers are due.
+  bool input_stale = false;
 };
 
 /**
  * For each answer: true if its period, or one of the `after` periods before it, woke more than
- * `late_us` later than the earliest-woken period of the run says it should have.
+ * `late_us` later than the earliest-woken period of its stretch says it should have. A stretch is
+ * a run of answers to fresh input, over which the release grid stays put; answers to stale input
+ * are never counted near a late wake (the tests leave them out).
  */
 inline std::vector<bool> NearALateWake(const std::vector<Wake>& wakes, double period_us = 1000,
                                        double late_us = 250, std::int64_t after = 3) {
   std::vector<bool> near(wakes.size(), false);
-  if (wakes.empty()) return near;
-  double earliest = 1e300;  // utime − period · period_us: the release grid's origin, or later
-  for (const Wake& w : wakes) {
-    earliest = std::min(
-        earliest, static_cast<double>(w.utime_us) - static_cast<double>(w.period) * period_us);
-  }
-  std::int64_t last_late_period = -1'000'000;
-  for (size_t i = 0; i < wakes.size(); ++i) {
-    const double lateness = static_cast<double>(wakes[i].utime_us) -
-                            static_cast<double>(wakes[i].period) * period_us - earliest;
-    if (lateness > late_us) last_late_period = wakes[i].period;
-    near[i] = wakes[i].period - last_late_period <= after;
+  auto offset = [&](const Wake& w) {  // utime − period · period_us: the grid's origin, or later
+    return static_cast<double>(w.utime_us) - static_cast<double>(w.period) * period_us;
+  };
+  size_t begin = 0;
+  while (begin < wakes.size()) {
+    if (wakes[begin].input_stale) {
+      ++begin;
+      continue;
+    }
+    size_t end = begin;
+    double earliest = 1e300;
+    for (; end < wakes.size() && !wakes[end].input_stale; ++end) {
+      earliest = std::min(earliest, offset(wakes[end]));
+    }
+    std::int64_t last_late_period = -1'000'000;
+    for (size_t i = begin; i < end; ++i) {
+      if (offset(wakes[i]) - earliest > late_us) last_late_period = wakes[i].period;
+      near[i] = wakes[i].period - last_late_period <= after;
+    }
+    begin = end;
   }
   return near;
 }

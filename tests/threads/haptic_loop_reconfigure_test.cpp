@@ -104,7 +104,9 @@ struct PressResult {
 // The force changes between periods (z) of a press: over the periods woken on time, and over all.
 void MeasureJumps(PressResult* result) {
   std::vector<Wake> wakes;
-  for (const ForceRecord& f : result->forces) wakes.push_back({f.period, f.utime_us});
+  for (const ForceRecord& f : result->forces) {
+    wakes.push_back({f.period, f.utime_us, (f.flags & force_flags::kInputStale) != 0});
+  }
   const std::vector<bool> near_late = NearALateWake(wakes);
   double previous = 0;
   for (size_t i = 0; i < result->forces.size(); ++i) {
@@ -289,7 +291,9 @@ struct SwitchWindow {
 
 std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces) {
   std::vector<Wake> wakes;
-  for (const ForceRecord& f : forces) wakes.push_back({f.period, f.utime_us});
+  for (const ForceRecord& f : forces) {
+    wakes.push_back({f.period, f.utime_us, (f.flags & force_flags::kInputStale) != 0});
+  }
   const std::vector<bool> near_late = NearALateWake(wakes);
   auto held = [&](size_t i) {
     return (forces[i].flags & force_flags::kReconfiguring) &&
@@ -421,7 +425,9 @@ TEST(HapticLoopReconfigure, ASlidingToolsRegionsFollowItWithTheForceHeldAndBlend
     const bool in_contact = f.flags & force_flags::kInContact;
     if (in_contact && (f.flags & force_flags::kReconfiguring)) {
       ++held;
-      if (!kSanitized) EXPECT_LT(f.force_n[2], -0.05) << "the push was dropped during a move";
+      if (!kSanitized) {
+        EXPECT_LT(f.force_n[2], -0.05) << "the push was dropped during a move";
+      }
     }
     if (last && in_contact && (last->flags & force_flags::kInContact)) {
       largest = std::max(
