@@ -28,10 +28,17 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   const bool after_gap = held_;
   held_ = false;
   if (!object_.Inside(tip_m)) {
+    if (SlipsOff(tip_m, now_ns)) return Advance(now_ns, centre);
     state_ = State::kFree;
+    slipping_off_ = false;
     fresh_tips_ = 0;
     wanted_ = NearestContactNode(object_.NearestPoint(tip_m));
     return {};
+  }
+  if (slipping_off_) {
+    // Back inside while slipping off: the node goes on from its own path to the tip again.
+    slipping_off_ = false;
+    CatchUpFromOwnPath(now_ns);
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
@@ -64,10 +71,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     // Input that came late by more than the resampler continues over (a driver that stalled for
     // a few milliseconds) moves the tip several periods' worth in one. The node catches up from
     // its own path instead, from where that path is now: on from the last period at its velocity.
-    const double dt = last_ns_ > 0 ? static_cast<double>(now_ns - last_ns_) * 1e-9 : 0.0;
-    std::array<double, 3> here = displacement_;
-    for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
-    CatchUp(here, now_ns);
+    CatchUpFromOwnPath(now_ns);
   }
   tip_step_ = fresh_tips_ > 0 ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
   last_tip_ = tip_m;
@@ -80,6 +84,30 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
   if (state_ == State::kFree || state_ == State::kAwaitLiftOff) return {};
   held_ = state_ == State::kEngaged;
   return Advance(now_ns, centre);
+}
+
+bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns) noexcept {
+  if (state_ != State::kEngaged) return false;
+  if (slipping_off_) return ramping_;  // until the node is back at rest
+  // Outside the object but still pressed along the entry face's normal: the tip went off a
+  // face sideways (over a step of a curved object's staircase, past its rim), not out of it.
+  double pressed = 0, node_depth = 0;
+  for (int c = 0; c < 3; ++c) {
+    pressed += (tip_m[c] - entry_[c]) * inward_[c];
+    node_depth += displacement_[c] * inward_[c];
+  }
+  if (pressed <= kDeepTouchDown_m || node_depth <= kDeepTouchDown_m) return false;
+  slipping_off_ = true;
+  CatchUpFromOwnPath(now_ns);
+  ramp_duration_ns_ = kSlipOff_ns;
+  return true;
+}
+
+void ContactTracker::CatchUpFromOwnPath(std::int64_t now_ns) noexcept {
+  const double dt = last_ns_ > 0 ? static_cast<double>(now_ns - last_ns_) * 1e-9 : 0.0;
+  std::array<double, 3> here = displacement_;
+  for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
+  CatchUp(here, now_ns);
 }
 
 bool ContactTracker::TipJumped(const std::array<double, 3>& tip_m) const noexcept {
@@ -152,8 +180,11 @@ ContactTracker::Contact ContactTracker::Advance(
     if (tau >= 1) ramping_ = false;
   }
   const std::array<double, 3> own_path = OwnPathInside(since_s);
+  // Slipping off, the node goes back to rest (its own surface point) instead of to the tip.
+  const double to_tip = slipping_off_ ? 0.0 : 1.0;
   for (int c = 0; c < 3; ++c) {
-    contact.displacement_m[c] = (1 - weight) * own_path[c] + weight * (tip_[c] - entry_[c]);
+    contact.displacement_m[c] =
+        (1 - weight) * own_path[c] + weight * to_tip * (tip_[c] - entry_[c]);
   }
   if (last_ns_ > 0 && now_ns > last_ns_) {
     const double dt = static_cast<double>(now_ns - last_ns_) * 1e-9;
@@ -168,11 +199,13 @@ ContactTracker::Contact ContactTracker::Advance(
 void ContactTracker::RestartFromRest() noexcept {
   state_ = State::kAwaitLiftOff;
   held_ = false;
+  slipping_off_ = false;
 }
 
 void ContactTracker::RestartKeepingContact() noexcept {
   if (state_ == State::kEngaged) state_ = State::kWaiting;
   held_ = false;
+  slipping_off_ = false;
 }
 
 void ContactTracker::CatchUpFrom(const std::array<double, 3>& held_m,

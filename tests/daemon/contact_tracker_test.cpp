@@ -232,6 +232,80 @@ TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
   EXPECT_NEAR(tracker.Update(tip, 101 * kMs, middle).displacement_m[2], 0.01, 1e-15);
 }
 
+// A tip that goes off the object sideways while pressed in (here past the cube's side edge, 3 mm
+// deep; on a curved object over a step of its voxel staircase) lets the node go back to rest over
+// kSlipOff_ns, in contact meanwhile, instead of dropping it in one period; one going straight out
+// lets go at once (ATouchOnTheCentredNode…: from 4 mm in to 1 mm out).
+TEST(ContactTracker, ATipThatGoesOffSidewaysPressedInLetsTheNodeGoBackToRestSmoothly) {
+  ContactTracker tracker(CubeBox(), 0.1);
+  const LatticeIndex edge{12, 6, 0};  // on the side edge x = 0.25
+  tracker.Update({0.2495, 0.125, -0.001}, 0, edge);
+  std::int64_t t = 0;
+  for (int n = 1; n <= 60; ++n) {  // 3 mm in, then held
+    tracker.Update({0.2495, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
+  }
+  // Sideways at 5 mm/s (a step of 5 µm a period: no jump to catch up with), 3 mm deep: out of
+  // the cube after 100 periods.
+  double previous = 0.003, previous_step = 0, largest_change = 0;
+  int engaged_outside = 0;
+  bool released = false;
+  for (int n = 1; n <= 200 && !released; ++n) {
+    const std::array<double, 3> tip{0.2495 + 5e-6 * n, 0.125, 0.003};
+    const ContactTracker::Contact c = tracker.Update(tip, t += kMs, edge);
+    if (!c.engaged) {
+      released = true;
+      largest_change = std::max(largest_change, std::abs(0.0 - previous - previous_step));
+      break;
+    }
+    if (tip[0] > 0.25) ++engaged_outside;
+    const double d = c.displacement_m[2];
+    largest_change = std::max(largest_change, std::abs((d - previous) - previous_step));
+    previous_step = d - previous;
+    previous = d;
+  }
+  ASSERT_TRUE(released) << "still engaged 200 periods on";
+  EXPECT_NEAR(engaged_outside, ContactTracker::kSlipOff_ns / kMs, 1);
+  EXPECT_LT(previous, 1e-5) << "let go away from rest";
+  // Its per-period step into the object changed by at most a few per cent of the 3 mm it let go
+  // of (smoothstep over 20 periods: 3 mm · 6/20² = 45 µm); at once it would be all 3 mm.
+  EXPECT_LT(largest_change, 60e-6);
+  EXPECT_TRUE(tracker.outside());
+}
+
+TEST(ContactTracker, BackInsideWhileSlippingOffTheNodeCatchesUpWithTheTipAgain) {
+  ContactTracker tracker(CubeBox(), 0.1);
+  const LatticeIndex edge{12, 6, 0};
+  tracker.Update({0.2497, 0.125, -0.001}, 0, edge);
+  std::int64_t t = 0;
+  for (int n = 1; n <= 60; ++n) {  // 3 mm in, then held
+    tracker.Update({0.2497, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
+  }
+  // Sideways at 5 mm/s, out over the edge for 9 periods, then back in along the same line.
+  double previous = 0.003, previous_step = 0, largest_change = 0, d = 0;
+  double shallowest = 0.003;
+  int outside = 0;
+  for (int n = 1; n <= 200; ++n) {
+    const double x = 0.2497 + 5e-6 * (n <= 65 ? n : std::max(0, 130 - n));
+    outside += x > 0.25;
+    const ContactTracker::Contact c = tracker.Update({x, 0.125, 0.003}, t += kMs, edge);
+    ASSERT_TRUE(c.engaged) << n;
+    d = c.displacement_m[2];
+    shallowest = std::min(shallowest, d);
+    if (n > 1) largest_change = std::max(largest_change, std::abs((d - previous) - previous_step));
+    previous_step = d - previous;
+    previous = d;
+  }
+  EXPECT_EQ(outside, 9);
+  EXPECT_NEAR(d, 0.003, 1e-12) << "back with the tip";
+  // Turned back from going to rest to the tip within kCatchUp_ns: a larger change of step than
+  // letting go alone makes, but no step (let go at once, the node would have dropped all 3 mm in
+  // one period, and touched again ramped in from zero).
+  std::printf(
+      "back inside: the node let go of %.2f mm; %.1f µm most change of its step between periods\n",
+      (0.003 - shallowest) * 1e3, largest_change * 1e6);
+  EXPECT_LT(largest_change, 200e-6);
+}
+
 TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};

@@ -87,12 +87,20 @@ TEST(HapticsimdOnAnOrgan, PressesAndAWalkOverItsFrontKeepTheForceRightUnderLoad)
   EXPECT_GT(walk["contact_answers"].get<int>(), 2000) << walk.dump();
   EXPECT_GE(walk["daemon"]["reconfigurations"].get<int>(), 5) << walk.dump();
   EXPECT_LT(walk["max_force_step_in_contact_n"].get<double>(), 0.25) << walk.dump();
+  // Across lift-offs too: where the walk went off a step of the organ's staircase still pressed
+  // in, its node was let go in one period (0.5 N, the port guard's slew ceiling, where it had
+  // pressed with 0.56 N); it slips off now (ContactTracker::kSlipOff_ns; measured 0.225 and
+  // 0.234 N, what is left being lift-offs of a node dragged sideways and the port guard's
+  // passivity controller at the end of a slip).
+  EXPECT_LT(walk["max_force_step_any_n"].get<double>(), 0.3) << walk.dump();
   std::printf(
       "organ: press peaks quiet %.4f, loaded %.4f N (static %.4f N); walk under load: %d answers "
-      "in contact, %d region moves, largest step %.3f N, largest force %.3f N\n",
+      "in contact, %d region moves, largest step %.3f N (%.3f N across lift-offs too), largest "
+      "force %.3f N\n",
       quiet["press_peaks_n"][1].get<double>(), loaded["press_peaks_n"][1].get<double>(), expected,
       walk["contact_answers"].get<int>(), walk["daemon"]["reconfigurations"].get<int>(),
-      walk["max_force_step_in_contact_n"].get<double>(), walk["max_force_n"].get<double>());
+      walk["max_force_step_in_contact_n"].get<double>(), walk["max_force_step_any_n"].get<double>(),
+      walk["max_force_n"].get<double>());
 }
 
 }  // namespace
