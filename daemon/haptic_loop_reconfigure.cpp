@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include "core/error.hpp"
+#include "core/regions/release_lead.hpp"
 #include "daemon/haptic_loop.hpp"
 #include "rt/monotonic_clock.hpp"
 
@@ -35,15 +37,17 @@ void HapticLoop::Install(const Scene& scene, std::unique_ptr<AsyncRegions> regio
   std::vector<std::unique_ptr<DeadlineMonitor>> replaced(
       std::make_move_iterator(monitors_.begin() + 1), std::make_move_iterator(monitors_.end()));
   monitors_.resize(1);
-  lead_ns_.assign(static_cast<size_t>(count), 0);
+  std::vector<double> nominal_period_ns{nominal_ns(kPrimaryRegion)};
   for (int a = 1; a < count; ++a) {
     monitors_.push_back(std::make_unique<DeadlineMonitor>(nominal_ns(a) * 1e-9));
     // The a-th secondary thread's statistics run on across reconfigurations.
     if (a - 1 < static_cast<int>(replaced.size())) monitors_.back()->CarryOver(*replaced[a - 1]);
-    // Each coarser region is released ahead of the finer one by 1.25 of the finer's period, so
-    // its boundary is published before the finer region needs it (as in RealTimeSchedule).
-    lead_ns_[a] = lead_ns_[a - 1] + static_cast<std::int64_t>(1.25 * nominal_ns(a - 1));
+    nominal_period_ns.push_back(nominal_ns(a));
   }
+  // Each outer region released ahead of the inner one, so that its boundary is published before
+  // the inner one needs it, and at one rate reads the inner band of its own time (as in
+  // RealTimeSchedule).
+  lead_ns_ = ReleaseLeadsNs(nominal_period_ns);
 }
 
 std::int64_t HapticLoop::NextPrimaryRelease(std::int64_t not_before_ns) const {

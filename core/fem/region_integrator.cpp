@@ -122,6 +122,15 @@ void RegionIntegrator::Step(std::span<const double> prescribed_next, EndOfStepLo
   Finish(prescribed_next, end_of_step_load_, swept, dissipate_j, limits);
 }
 
+double RegionIntegrator::NextBeforeLoads(int owned_slot) noexcept {
+  const Eigen::VectorXd& ku = Forces();
+  const auto k = static_cast<size_t>(owned_slot);
+  const int i = owned_[k];
+  return (step_over_mass_[k] * (external_[i] - ku[i]) + 2.0 * (*u_)[i] -
+          minus_[k] * (*u_previous_)[i]) *
+         inv_plus_[k];
+}
+
 double RegionIntegrator::Predict() noexcept {
   const Eigen::VectorXd& ku = Forces();
   const double* u = u_->data();

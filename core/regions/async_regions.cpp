@@ -115,9 +115,15 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
           region->band_layer.push_back(dof);
         }
       }
+      const std::vector<int>& owned = region->integrator->owned();
+      for (int dof : region->band_layer) {
+        const auto at = std::find(owned.begin(), owned.end(), dof);
+        region->band_layer_slot.push_back(at == owned.end() ? -1
+                                                            : static_cast<int>(at - owned.begin()));
+      }
       const int gamma = static_cast<int>(dofs.outer_interface.size());
       const int outward_width =
-          coupling_ == Coupling::kForce ? gamma : static_cast<int>(region->band_layer.size());
+          coupling_ == Coupling::kForce ? gamma : 2 * static_cast<int>(region->band_layer.size());
       region->inward = std::make_unique<BoundaryChannel>(gamma);
       region->outward = std::make_unique<BoundaryChannel>(outward_width);
       region->outer = BoundaryChannel::ReadPair(gamma);
@@ -191,9 +197,18 @@ void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
     const auto& gamma = region.dofs->outer_interface;
     for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
   } else {
-    const Eigen::VectorXd& u = region.integrator->u();
-    for (size_t i = 0; i < region.band_layer.size(); ++i)
-      region.outward_values[i] = u[region.band_layer[i]];
+    RegionIntegrator& integrator = *region.integrator;
+    const Eigen::VectorXd& u = integrator.u();
+    const size_t n = region.band_layer.size();
+    // Where the next step puts the band only matters to an outer region with steps as long.
+    const bool next_read = regions_[a + 1]->period_ticks == region.period_ticks;
+    for (size_t i = 0; i < n; ++i) {
+      const double now = u[region.band_layer[i]];
+      const int slot = region.band_layer_slot[i];
+      region.outward_values[i] = now;
+      region.outward_values[n + i] =
+          next_read && slot >= 0 ? integrator.NextBeforeLoads(slot) : now;
+    }
   }
   region.outward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
                           region.outward_values);
@@ -258,8 +273,18 @@ void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
   // two substeps' snapshots, carried a whole period of s substeps ahead, multiplies their
   // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
   // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
+  //
+  // With steps as long as this region's, the inner region is at t0 itself (stepped in order, or
+  // on threads released as ReleaseLeadsNs says), except on a thread that takes its period's
+  // substeps at once: its later ones come before the inner region has taken its own. Those read
+  // the band where the inner region's next step will put it, which the inner region published
+  // with its state (displacement exchange; exact one substep on: 2 substeps a period exchange as
+  // in order), and hold that beyond. The line carried on instead overshoots through a mode that
+  // turns most of the way from substep to substep: hapticsimd serving the organ sample
+  // (2 substeps at one rate) pressed with 1.4 N where the static solution is 0.16 N.
   const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
-  const double t = std::min(t0, region.inner.newer.time_s + inner_step_s);
+  const bool equal_steps = inner.period_ticks == region.period_ticks;
+  const double t = std::min(t0, region.inner.newer.time_s + (equal_steps ? 0.0 : inner_step_s));
   if (coupling_ == Coupling::kForce) {
     for (size_t i = 0; i < inner_gamma.size(); ++i) {
       region.load_values[i] =
@@ -267,10 +292,13 @@ void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
     }
   } else {
     // The inner region's force on Γ from its band: its displacements next to Γ on the line
-    // through its newest two states, Γ itself as this region has it now.
-    for (size_t i = 0; i < inner.band_layer.size(); ++i) {
+    // through its newest two states (or next, as above), Γ itself as this region has it now.
+    const size_t n = inner.band_layer.size();
+    const bool next = equal_steps && t0 > region.inner.newer.time_s;
+    for (size_t i = 0; i < n; ++i) {
       region.band_u[inner.band_layer[i]] =
-          OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
+          next ? region.inner.newer.values[n + i]
+               : OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
     }
     const Eigen::VectorXd& u = integrator.u();
     for (int dof : inner_gamma) region.band_u[dof] = u[dof];

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/regions/release_lead.hpp"
 #include "core/trial/trial_recorder.hpp"
 #include "rt/deadline_monitor.hpp"
 #include "rt/monotonic_clock.hpp"
@@ -66,14 +67,12 @@ RunGrid MakeGrid(const AsyncRegions& regions, double stretch, long steps) {
   const int count = regions.num_regions();
   grid.tick_ns = stretch * 1e9 / static_cast<double>(regions.ticks_per_second());
   grid.nominal_ticks.assign(static_cast<size_t>(count), 0);
-  grid.lead_ns.assign(static_cast<size_t>(count), 0);
+  std::vector<double> nominal_ns(static_cast<size_t>(count), 0.0);
   for (int a = 0; a < count; ++a) {
     grid.nominal_ticks[a] = regions.period_ticks(a) * regions.schedule(a).substeps;
-    if (a > 0) {
-      grid.lead_ns[a] = grid.lead_ns[a - 1] +
-                        static_cast<std::int64_t>(1.25 * grid.nominal_ticks[a - 1] * grid.tick_ns);
-    }
+    nominal_ns[a] = static_cast<double>(grid.nominal_ticks[a]) * grid.tick_ns;
   }
+  grid.lead_ns = ReleaseLeadsNs(nominal_ns);
   grid.end_ticks = (steps + 1) * grid.nominal_ticks[kPrimaryRegion];
   // Far enough ahead for the outer regions' leads.
   grid.origin_ns = MonotonicNowNs() + 20'000'000 + grid.lead_ns.back();

@@ -59,12 +59,13 @@ struct FaultCounts {
  *
  * Phases follow the virtual-time schedule: the primary's step over [tᵢ, tᵢ₊₁] is released at
  * wall time tᵢ (its force at tᵢ is out at once); region a's step over [Tⱼ, Tⱼ₊₁] is released
- * lead(a) before Tⱼ, with lead(a) = lead(a − 1) + 1.25 periods of region a − 1, so its Γ at Tⱼ₊₁
- * is published before the region inwards needs it. The extra quarter period keeps neighbours
- * from waking at the same instant, so the outer region deterministically reads the inner state
- * just before Tⱼ and extrapolates — which is where a threaded run may differ from the
- * virtual-time one (the virtual schedule uses the inner state at Tⱼ itself when Tⱼ falls on the
- * inner region's grid).
+ * lead(a) before Tⱼ (ReleaseLeadsNs, the daemon's rule too), so its Γ at Tⱼ₊₁ is published
+ * before the region inwards needs it. At one rate, half a period ahead, it reads the inner state
+ * at Tⱼ itself, and its later substeps the inner band the inner region published as its next
+ * step's: the virtual-time run's exchange. At different rates, 1.25 periods of region a − 1
+ * ahead, the outer region deterministically reads the inner state just before Tⱼ and
+ * extrapolates — which is where a threaded run may differ from the virtual-time one (the
+ * virtual schedule uses the inner state at Tⱼ itself when Tⱼ falls on the inner region's grid).
  *
  * Threads: Run() starts and joins the two region threads; call it from one thread.
  */
