@@ -28,7 +28,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   const bool after_gap = held_;
   held_ = false;
   if (!object_.Inside(tip_m)) {
-    if (SlipsOff(tip_m, now_ns)) return Advance(now_ns, centre);
+    if (SlipsOff(tip_m, now_ns, after_gap)) return Advance(now_ns, centre);
     state_ = State::kFree;
     slipping_off_ = false;
     fresh_tips_ = 0;
@@ -36,8 +36,10 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     return {};
   }
   if (slipping_off_) {
-    // Back inside while slipping off: the node goes on from its own path to the tip again.
+    // Back inside while slipping off: the node goes on from its own path to the tip again (the
+    // tip's last step, from outside, is no jump to catch up with).
     slipping_off_ = false;
+    fresh_tips_ = 0;
     CatchUpFromOwnPath(now_ns);
   }
   if (state_ == State::kAwaitLiftOff) return {};
@@ -86,9 +88,14 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
   return Advance(now_ns, centre);
 }
 
-bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns) noexcept {
+bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                              bool after_gap) noexcept {
   if (state_ != State::kEngaged) return false;
-  if (slipping_off_) return ramping_;  // until the node is back at rest
+  if (slipping_off_) {
+    // Input back after a gap: the slip goes on from where the node was held, at rest.
+    if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
+    return ramping_;  // until the node is back at rest
+  }
   // Outside the object but still pressed along the entry face's normal: the tip went off a
   // face sideways (over a step of a curved object's staircase, past its rim), not out of it.
   double pressed = 0, node_depth = 0;
@@ -203,7 +210,12 @@ void ContactTracker::RestartFromRest() noexcept {
 }
 
 void ContactTracker::RestartKeepingContact() noexcept {
-  if (state_ == State::kEngaged) state_ = State::kWaiting;
+  // Slipping off, the tip is outside: nothing to engage again.
+  if (slipping_off_) {
+    state_ = State::kFree;
+  } else if (state_ == State::kEngaged) {
+    state_ = State::kWaiting;
+  }
   held_ = false;
   slipping_off_ = false;
 }

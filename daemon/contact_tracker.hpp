@@ -121,8 +121,9 @@ class ContactTracker {
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
   // Outside the object: true while an engaged contact slips off (kSlipOff_ns), starting it if
-  // the tip left sideways while still pressed in.
-  bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns) noexcept;
+  // the tip left sideways while still pressed in (or through the far side of a part thinner
+  // than the press: the test is the depth past the entry face's plane).
+  bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns, bool after_gap) noexcept;
   // The node catches up (CatchUp) from where its own path has taken it by now.
   void CatchUpFromOwnPath(std::int64_t now_ns) noexcept;
   // The ramp's own path `since_s` after it started, its outward part along the entry face's

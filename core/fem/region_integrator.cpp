@@ -76,6 +76,7 @@ void RegionIntegrator::SetControlledDofs(std::vector<int> dofs) {
 
 void RegionIntegrator::Reset() {
   for (auto& b : buffers_) b.setZero();
+  external_.setZero();  // no load from before: NextBeforeLoads reads it
   ku_.setZero();
   ku_valid_ = true;  // K·0 = 0: no product needed (a region put to sleep is reset in 1 kHz time)
   std::fill(prescribed_reaction_.begin(), prescribed_reaction_.end(), 0.0);
@@ -321,6 +322,7 @@ RegionIntegrator::Energies RegionIntegrator::BothEnergies() noexcept {
 void RegionIntegrator::SetState(const Eigen::VectorXd& u, const Eigen::VectorXd& u_previous) {
   *u_ = u;
   *u_previous_ = u_previous;
+  external_.setZero();  // a load on another state does not carry over
   ku_valid_ = false;
 }
 

@@ -177,10 +177,11 @@ class RegionIntegrator {
   const std::vector<int>& owned() const { return owned_; }
   /**
    * Where the next Step puts the owned DOF at `owned_slot` (its place in owned()) before any
-   * load, controller or limit acts: central difference from the state now, the same arithmetic
-   * to the last bit. Explicit, it needs nothing of the next step: a neighbour a step ahead reads
-   * it as this region's next state (AsyncRegions::PublishOutward). Computes K·u if not yet
-   * (the next Step reuses it).
+   * controller or limit acts, a loaded DOF's load held at the last step's (none after Reset or
+   * SetState): central difference from the state now, the same arithmetic to the last bit.
+   * Explicit, it needs nothing else of the next step: a neighbour a step ahead reads it as this
+   * region's next state (AsyncRegions::PublishOutward). Computes K·u if not yet (the next Step
+   * reuses it).
    */
   double NextBeforeLoads(int owned_slot) noexcept;
   const std::vector<int>& prescribed() const { return prescribed_; }

@@ -200,8 +200,8 @@ void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
     RegionIntegrator& integrator = *region.integrator;
     const Eigen::VectorXd& u = integrator.u();
     const size_t n = region.band_layer.size();
-    // Where the next step puts the band only matters to an outer region with steps as long.
-    const bool next_read = regions_[a + 1]->period_ticks == region.period_ticks;
+    // Where the next step puts the band only matters to an outer region at this one's rate.
+    const bool next_read = AtOneRate(a);
     for (size_t i = 0; i < n; ++i) {
       const double now = u[region.band_layer[i]];
       const int slot = region.band_layer_slot[i];
@@ -260,6 +260,14 @@ void AsyncRegions::SetRandomState(unsigned seed) {
   StartFrom(u, Eigen::VectorXd::Zero(u.size()));
 }
 
+// Regions `inner` and inner + 1 at one rate, in steps as long: the link whose outer thread is
+// released half a period ahead (ReleaseLeadsNs) and reads the inner band's next step.
+bool AsyncRegions::AtOneRate(RegionIndex inner) const noexcept {
+  const Region& a = *regions_[inner];
+  const Region& b = *regions_[inner + 1];
+  return a.schedule.rate_hz == b.schedule.rate_hz && a.period_ticks == b.period_ticks;
+}
+
 // Region a's load on its inner Γ at t0: the inner region's force there, from its newest two
 // snapshots (force coupling), or from its displacements next to Γ (displacement coupling).
 void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
@@ -274,16 +282,18 @@ void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
   // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
   // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
   //
-  // With steps as long as this region's, the inner region is at t0 itself (stepped in order, or
-  // on threads released as ReleaseLeadsNs says), except on a thread that takes its period's
-  // substeps at once: its later ones come before the inner region has taken its own. Those read
-  // the band where the inner region's next step will put it, which the inner region published
-  // with its state (displacement exchange; exact one substep on: 2 substeps a period exchange as
-  // in order), and hold that beyond. The line carried on instead overshoots through a mode that
-  // turns most of the way from substep to substep: hapticsimd serving the organ sample
-  // (2 substeps at one rate) pressed with 1.4 N where the static solution is 0.16 N.
+  // At this region's rate in steps as long (AtOneRate), the inner region is at t0 itself
+  // (stepped in order, or on threads released as ReleaseLeadsNs says), except on a thread that
+  // takes its period's substeps at once: its later ones come before the inner region has taken
+  // its own. Those read the band where the inner region's next step will put it, which the inner
+  // region published with its state (displacement exchange; one substep on, exact but for a
+  // prescribed DOF in the band, which is held: 2 substeps a period exchange as in order), and
+  // hold that beyond. The line carried on instead overshoots through a mode that turns most of
+  // the way from substep to substep: hapticsimd serving the organ sample (2 substeps at one
+  // rate) pressed with 1.4 N where the static solution is 0.16 N.
+  // (The force exchange publishes no next step: it keeps the line, one substep at most.)
   const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
-  const bool equal_steps = inner.period_ticks == region.period_ticks;
+  const bool equal_steps = coupling_ != Coupling::kForce && AtOneRate(a - 1);
   const double t = std::min(t0, region.inner.newer.time_s + (equal_steps ? 0.0 : inner_step_s));
   if (coupling_ == Coupling::kForce) {
     for (size_t i = 0; i < inner_gamma.size(); ++i) {

@@ -425,6 +425,7 @@ class AsyncRegions {
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction, EndOfStepLoad* push = nullptr) noexcept;
   void ReadInnerLoads(RegionIndex region, double t0) noexcept;
+  bool AtOneRate(RegionIndex inner) const noexcept;  // the link outwards of `inner`: see .cpp
   void ControlInterfaces(RegionIndex region, double* asked_inward, double* asked_outward,
                          PortWorkLimits* limits) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;

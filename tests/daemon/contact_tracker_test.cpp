@@ -306,6 +306,38 @@ TEST(ContactTracker, BackInsideWhileSlippingOffTheNodeCatchesUpWithTheTipAgain) 
   EXPECT_LT(largest_change, 200e-6);
 }
 
+// Input that stops while the node slips off holds it; back (still outside), the slip goes on
+// from where it was held instead of jumping to where its ramp's clock got to.
+TEST(ContactTracker, AGapWhileSlippingOffGoesOnFromWhereTheNodeWasHeld) {
+  ContactTracker tracker(CubeBox(), 0.1);
+  const LatticeIndex edge{12, 6, 0};
+  tracker.Update({0.2495, 0.125, -0.001}, 0, edge);
+  std::int64_t t = 0;
+  for (int n = 1; n <= 60; ++n) {
+    tracker.Update({0.2495, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
+  }
+  std::array<double, 3> tip{};
+  double d = 0.003;
+  for (int n = 1; n <= 105; ++n) {  // out of the cube from the 101st period: 5 periods slipping
+    tip = {0.2495 + 5e-6 * n, 0.125, 0.003};
+    d = tracker.Update(tip, t += kMs, edge).displacement_m[2];
+  }
+  ASSERT_GT(tip[0], 0.25);
+  for (int n = 0; n < 30; ++n) {  // a 30 ms gap: longer than the slip itself
+    const ContactTracker::Contact held = tracker.Hold(t += kMs, edge);
+    ASSERT_TRUE(held.engaged);
+    EXPECT_EQ(held.displacement_m[2], d);
+  }
+  const ContactTracker::Contact back = tracker.Update(tip, t += kMs, edge);
+  ASSERT_TRUE(back.engaged) << "the slip went on";
+  EXPECT_NEAR(back.displacement_m[2], d, 1e-9) << "from where it was held";
+  bool released = false;
+  for (int n = 0; n < 40 && !released; ++n) {
+    released = !tracker.Update(tip, t += kMs, edge).engaged;
+  }
+  EXPECT_TRUE(released);
+}
+
 TEST(ContactTracker, InputBackAfterAGapRampsFromTheHeldDisplacement) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex middle{6, 6, 0};

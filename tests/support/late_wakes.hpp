@@ -25,7 +25,8 @@ struct Wake {
  * For each answer: true if its period, or one of the `after` periods before it, woke more than
  * `late_us` later than the earliest-woken period of its stretch says it should have. A stretch is
  * a run of answers to fresh input, over which the release grid stays put; answers to stale input
- * are never counted near a late wake (the tests leave them out).
+ * are never counted near a late wake (a test that measures steps across them counts those as on
+ * time).
  */
 inline std::vector<bool> NearALateWake(const std::vector<Wake>& wakes, double period_us = 1000,
                                        double late_us = 250, std::int64_t after = 3) {
