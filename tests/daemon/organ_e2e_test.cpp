@@ -90,8 +90,8 @@ TEST(HapticsimdOnAnOrgan, PressesAndAWalkOverItsFrontKeepTheForceRightUnderLoad)
   // Across lift-offs the step is reported, not bounded: where the walk went off a step of the
   // organ's staircase still pressed in, the node now slips off (ContactTracker::kSlipOff_ns), but
   // a node dragged along its entry face and lifted off through it lets go of its sideways push at
-  // once, as a lift-off does (the node contact does not slide): measured 0.23 N in most runs,
-  // 0.49–0.50 N (the port guard's slew ceiling) in 2 of 14.
+  // once, as a lift-off does (the node contact does not slide): measured 0.15–0.24 N in most
+  // walks, 0.49–0.50 N (the port guard's slew ceiling) in 4 of 29 (this test's and traced).
   std::printf(
       "organ: press peaks quiet %.4f, loaded %.4f N (static %.4f N); walk under load: %d answers "
       "in contact, %d region moves, largest step %.3f N (%.3f N across lift-offs too), largest "
