@@ -40,7 +40,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     // tip's last step, from outside, is no jump to catch up with).
     slipping_off_ = false;
     fresh_tips_ = 0;
-    CatchUpFromOwnPath(now_ns);
+    CatchUp(OwnPathNow(now_ns), now_ns);
   }
   if (state_ == State::kAwaitLiftOff) return {};
   if (state_ == State::kFree) {
@@ -73,7 +73,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
     // Input that came late by more than the resampler continues over (a driver that stalled for
     // a few milliseconds) moves the tip several periods' worth in one. The node catches up from
     // its own path instead, from where that path is now: on from the last period at its velocity.
-    CatchUpFromOwnPath(now_ns);
+    CatchUp(OwnPathNow(now_ns), now_ns);
   }
   tip_step_ = fresh_tips_ > 0 ? Minus(tip_m, last_tip_) : std::array<double, 3>{};
   last_tip_ = tip_m;
@@ -105,16 +105,15 @@ bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t n
   }
   if (pressed <= kDeepTouchDown_m || node_depth <= kDeepTouchDown_m) return false;
   slipping_off_ = true;
-  CatchUpFromOwnPath(now_ns);
-  ramp_duration_ns_ = kSlipOff_ns;
+  StartRamp(OwnPathNow(now_ns), velocity_, kSlipOff_ns, now_ns);
   return true;
 }
 
-void ContactTracker::CatchUpFromOwnPath(std::int64_t now_ns) noexcept {
+std::array<double, 3> ContactTracker::OwnPathNow(std::int64_t now_ns) const noexcept {
   const double dt = last_ns_ > 0 ? static_cast<double>(now_ns - last_ns_) * 1e-9 : 0.0;
   std::array<double, 3> here = displacement_;
   for (int c = 0; c < 3; ++c) here[c] += velocity_[c] * dt;
-  CatchUp(here, now_ns);
+  return here;
 }
 
 bool ContactTracker::TipJumped(const std::array<double, 3>& tip_m) const noexcept {

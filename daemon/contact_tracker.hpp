@@ -124,8 +124,8 @@ class ContactTracker {
   // the tip left sideways while still pressed in (or through the far side of a part thinner
   // than the press: the test is the depth past the entry face's plane).
   bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns, bool after_gap) noexcept;
-  // The node catches up (CatchUp) from where its own path has taken it by now.
-  void CatchUpFromOwnPath(std::int64_t now_ns) noexcept;
+  // Where the node's own path has taken it by now: on from the last period at its velocity.
+  std::array<double, 3> OwnPathNow(std::int64_t now_ns) const noexcept;
   // The ramp's own path `since_s` after it started, its outward part along the entry face's
   // normal removed.
   std::array<double, 3> OwnPathInside(double since_s) const noexcept;

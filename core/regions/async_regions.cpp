@@ -115,11 +115,11 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
           region->band_layer.push_back(dof);
         }
       }
-      const std::vector<int>& owned = region->integrator->owned();
+      const std::vector<int>& owned = region->integrator->owned();  // ascending (RegionDofs)
       for (int dof : region->band_layer) {
-        const auto at = std::find(owned.begin(), owned.end(), dof);
-        region->band_layer_slot.push_back(at == owned.end() ? -1
-                                                            : static_cast<int>(at - owned.begin()));
+        const auto at = std::lower_bound(owned.begin(), owned.end(), dof);
+        region->band_layer_slot.push_back(
+            at == owned.end() || *at != dof ? -1 : static_cast<int>(at - owned.begin()));
       }
       const int gamma = static_cast<int>(dofs.outer_interface.size());
       const int outward_width =
@@ -260,12 +260,11 @@ void AsyncRegions::SetRandomState(unsigned seed) {
   StartFrom(u, Eigen::VectorXd::Zero(u.size()));
 }
 
-// Regions `inner` and inner + 1 at one rate, in steps as long: the link whose outer thread is
-// released half a period ahead (ReleaseLeadsNs) and reads the inner band's next step.
+// Regions `inner` and inner + 1 at one rate (and so in steps as long: ScheduleRegions gives
+// neighbours at one rate the same substeps): the link whose outer thread is released half a
+// period ahead (ReleaseLeadsNs) and reads the inner band's next step.
 bool AsyncRegions::AtOneRate(RegionIndex inner) const noexcept {
-  const Region& a = *regions_[inner];
-  const Region& b = *regions_[inner + 1];
-  return a.schedule.rate_hz == b.schedule.rate_hz && a.period_ticks == b.period_ticks;
+  return regions_[inner]->schedule.rate_hz == regions_[inner + 1]->schedule.rate_hz;
 }
 
 // Region a's load on its inner Γ at t0: the inner region's force there, from its newest two

@@ -14,7 +14,7 @@ namespace hapticsim {
 
 /** The DOF sets one region works on. */
 struct RegionDofs {
-  std::vector<int> owned;            ///< integrated by this region (inner interface included)
+  std::vector<int> owned;  ///< integrated by this region (inner interface included), ascending
   std::vector<int> fixed;            ///< supports this region touches, held at zero
   std::vector<int> inner_interface;  ///< Γ with the next region inwards: owned, and loaded with
                                      ///< that region's forces (empty for the primary)
