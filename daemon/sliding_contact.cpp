@@ -132,7 +132,7 @@ void SlidingContact::TryEngage(const std::optional<LatticeIndex>& centre,
     return;
   }
   proxy_->PlaceUnder(tool_);
-  last_tool_ = tool_;
+  last_tool_ = stepped_tool_ = tool_;
   state_ = State::kEngaged;
   out_of_region_ = following_ = false;
   catch_up_ns_ = -1;
@@ -150,6 +150,12 @@ SlidingContact::Contact SlidingContact::Answer() const noexcept {
   return contact;
 }
 
+double SlidingContact::CatchUpLag(std::int64_t now_ns) const noexcept {
+  if (catch_up_ns_ < 0 || now_ns - catch_up_ns_ >= catch_up_duration_ns_) return 0.0;
+  const double tau = static_cast<double>(now_ns - catch_up_ns_) / catch_up_duration_ns_;
+  return 1.0 - tau * tau * (3 - 2 * tau);
+}
+
 double SlidingContact::RampScale(std::int64_t now_ns) const noexcept {
   if (ramp_start_ns_ < 0 || ramp_ns_ <= 0) return 1.0;
   const double tau = std::clamp(static_cast<double>(now_ns - ramp_start_ns_) / ramp_ns_, 0.0, 1.0);
@@ -163,19 +169,20 @@ std::array<double, 3> SlidingContact::Rendered(const ProxyContact::Result& touch
   const double k = RampScale(now_ns) * settings_.stiffness_n_per_m;
   const double over = 1.0 + k * touch.compliance_m_per_n;
   std::array<double, 3> offset = touch.offset_m;
-  if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ < catch_up_duration_ns_ && k > 0) {
+  const double lag = CatchUpLag(now_ns);
+  if (lag > 0 && k > 0) {
     // Catching up after a pause, the spring pulls from where it gave the held push, and that
-    // point goes back to the tool: offset − (1 − w)·δ, δ set so that the first push is the held
-    // one. The spring stays stiff throughout: a held force blended out without it drove a light
-    // node through the surface under the tool. What the fading δ adds is kept inside the friction
-    // cone (InsideFrictionCone): the user never feels more than μ_s times the normal force.
+    // point goes back to the tool: offset − lag·δ, δ set so that the first push is the held
+    // one (the tool the proxy follows lags as well: StepPeriod; δ is what the new regions' own
+    // response differs by). The spring stays stiff throughout: a held force blended out without
+    // it drove a light node through the surface under the tool. What the fading δ adds is kept
+    // inside the friction cone (InsideFrictionCone): the user never feels more than μ_s times the
+    // normal force.
     if (!catch_up_anchored_) {
       for (int c = 0; c < 3; ++c) catch_up_offset_m_[c] = offset[c] - held_push_[c] * over / k;
       catch_up_anchored_ = true;
     }
-    const double tau = static_cast<double>(now_ns - catch_up_ns_) / catch_up_duration_ns_;
-    const double w = tau * tau * (3 - 2 * tau);
-    for (int c = 0; c < 3; ++c) offset[c] -= (1 - w) * catch_up_offset_m_[c];
+    for (int c = 0; c < 3; ++c) offset[c] -= lag * catch_up_offset_m_[c];
   }
   std::array<double, 3> push{};
   for (int c = 0; c < 3; ++c) push[c] = k * offset[c] / over;
@@ -212,13 +219,18 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
   if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ >= catch_up_duration_ns_) catch_up_ns_ = -1;
   for (int q = 1; q <= substeps; ++q) {
-    // The substeps move the tool from the last period's tip to this one's in equal parts.
+    // The substeps move the tool from the last period's tip to this one's in equal parts; after a
+    // pause, less what it moved while the regions stood still, given back over the catch-up.
     SubstepPush step(*this, now_ns);
-    for (int c = 0; c < 3; ++c)
-      step.tool_m[c] = last_tool_[c] + (tool_[c] - last_tool_[c]) * q / substeps;
+    const double lag = CatchUpLag(now_ns);
+    for (int c = 0; c < 3; ++c) {
+      step.tool_m[c] = last_tool_[c] + (tool_[c] - last_tool_[c]) * q / substeps -
+                       lag * catch_up_tool_m_[c];
+    }
     regions.StepPrimaryPushed(step);
     if (q == 1) first_push = step.push_n;
   }
+  stepped_tool_ = tool_;
   last_push_ = first_push;
   AfterPeriod();
   return first_push;
@@ -261,6 +273,12 @@ void SlidingContact::CatchUp(std::int64_t now_ns, std::int64_t paused_ns,
   catch_up_ns_ = now_ns;
   catch_up_anchored_ = false;
   held_push_ = last_push_;
+  // The regions stood still where the last period before the pause left them, the tool did not:
+  // the proxy follows the tool less that motion, given back over the catch-up, so the tissue
+  // takes up where it stopped. (Lifting out further than the spring was compressed, the tool
+  // was off the tissue the pause held: the push went to nothing, and the tissue sprang back up
+  // into the tool in the next periods — 0.12 N → 0 → 0.06 N on the palpation phantom.)
+  for (int c = 0; c < 3; ++c) catch_up_tool_m_[c] = tool_[c] - stepped_tool_[c];
   // Twice as long as the pause (what the tool did meanwhile comes back at half its pace), at most
   // kCatchUp_ns; none after no pause at all.
   catch_up_duration_ns_ = std::min(kCatchUp_ns, 2 * paused_ns);

@@ -92,9 +92,11 @@ class SlidingContact {
    * configuration in contact) at `now_ns`, after a pause of `paused_ns` in which the user felt the
    * last push held while the tool went on: the push goes from that held one to the spring's own
    * over twice the pause (a smoothstep; at most kCatchUp_ns; the spring pulling from a point that
-   * returns to the tool, so that it stays stiff), so the force does not step where
-   * the tool moved meanwhile. `hold_expired`: the pause outlasted the hold and the push was
-   * released: it ramps in again from zero instead.
+   * returns to the tool, so that it stays stiff), so the force does not step where the tool moved
+   * meanwhile. The proxy follows the tool less what it moved in the pause, given back over the
+   * same smoothstep: the tissue takes up where it stood still (a tool lifted off it meanwhile
+   * still touches it). `hold_expired`: the pause outlasted the hold and the push was released: it
+   * ramps in again from zero instead.
    */
   void CatchUp(std::int64_t now_ns, std::int64_t paused_ns, bool hold_expired) noexcept;
   /** The longest a push blends back after a pause (CatchUp), ns: the node contact's catch-up. */
@@ -116,6 +118,9 @@ class SlidingContact {
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
+  // How much of what a pause held back is still to be given back (CatchUp): 1 → 0 by a
+  // smoothstep over the catch-up, 0 outside one.
+  double CatchUpLag(std::int64_t now_ns) const noexcept;
   // The push the object gets and the user feels back, from the spring's `touch` at the step's
   // end: ramped in, or brought back from the push held over a pause (CatchUp: the spring anchored
   // where it gave that push, the anchor returning to the tool).
@@ -147,6 +152,7 @@ class SlidingContact {
   std::optional<ProxyContact> proxy_;           // on the bound regions' primary
   LatticeIndex bound_centre_{};                 // the bound regions' centre
   std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
+  std::array<double, 3> stepped_tool_{};        // the tip of the last period the regions stepped
   std::array<double, 3> inward_{};              // the touched face's
   double face_m_ = 0;                           // where its plane is along its normal's axis, m
   std::optional<LatticeIndex> wanted_;
@@ -158,6 +164,9 @@ class SlidingContact {
   std::array<double, 3> held_push_{};  // the push a pause held, come back from (CatchUp)
   // Where the catching-up spring pulls from, less the tool (Rendered), once its first push is set.
   std::array<double, 3> catch_up_offset_m_{};
+  // How far the tool moved while the regions stood still (CatchUp): the proxy's tool lags by it,
+  // less and less over the catch-up.
+  std::array<double, 3> catch_up_tool_m_{};
   bool catch_up_anchored_ = false;
   std::int64_t catch_up_duration_ns_ = 0;
 };

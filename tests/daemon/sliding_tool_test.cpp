@@ -192,61 +192,120 @@ TEST(SlidingTool, APointTipOnFineVoxelsJoltedMidStrokeSettlesInsteadOfChattering
 }
 
 // The push after a move's pause (SlidingContact::CatchUp), played on the contact itself: the tool
-// slid on 0.3 mm over a 5 ms pause. The first push is the one held, to rounding; then the spring,
-// anchored where it gave that push, comes back to the tool over twice the pause without a step and
-// inside the friction cone, and is the spring's own once the catch-up is over.
+// slid on 0.3 mm over a 5 ms pause. The first push is the one held, to rounding; then the push
+// comes back to the tool's over twice the pause without a step and inside the friction cone, and
+// once caught up it is the push of the same path played without the pause.
 TEST(SlidingTool, AfterAPauseThePushComesBackFromTheHeldOneInsideTheFrictionCone) {
   Scene scene = Stroke(0.5, 0.4);
   scene.contact.model = ContactModel::kProxy;
-  AsyncRegions regions(scene);
-  const ContactObject object = ContactObject::Of(scene);
-  SlidingContact contact(object, scene.contact, 0.1);
-  contact.Bind(contact.Prepare(regions));
-  const LatticeIndex centre = regions.partition().contact_node();
-  const auto period = [&](const std::array<double, 3>& tip, std::int64_t now, bool step) {
-    contact.Update(tip, now, step ? std::optional<LatticeIndex>(centre) : std::nullopt);
-    if (!step) return std::array<double, 3>{};
-    regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
-                                 regions.period_ticks(kPrimaryRegion));
-    return contact.StepPeriod(regions, now);
-  };
-  const auto lateral = [](const std::array<double, 3>& f) { return std::hypot(f[0], f[1]); };
-  // Down 4 mm into the middle of the front face over 0.2 s, then 1 mm along x over 0.1 s: sliding.
-  std::array<double, 3> tip = {0.125, 0.125, -0.001};
-  std::int64_t now = 1'000'000'000;
-  std::array<double, 3> push{};
-  for (int n = 0; n < 300; ++n, now += 1'000'000) {
-    tip[2] = -0.001 + 0.005 * std::min(1.0, n / 200.0);
-    if (n >= 200) tip[0] += 1e-5;
-    push = period(tip, now, true);
-  }
-  ASSERT_GT(push[2], 0.1);  // pushing into the face (+z)
-  const std::array<double, 3> held = push;
-  for (int n = 0; n < 5; ++n, now += 1'000'000) {  // paused: the tool slides on, nothing steps
-    tip[0] += 6e-5;
-    period(tip, now, false);
-  }
-  contact.CatchUp(now, 5'000'000, false);
-  double largest_step = 0;
-  std::array<double, 3> last = held;
-  for (int n = 0; n < 40; ++n, now += 1'000'000) {
-    tip[0] += 1e-5;
-    push = period(tip, now, true);
-    if (n == 0) {
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(push[c], held[c], 1e-9) << c;
+  constexpr int kPause = 5, kAfter = 40;
+  // Down 4 mm into the middle of the front face over 0.2 s, 1 mm along x over 0.1 s (the tissue
+  // dragged along, the proxy still stuck), 0.3 mm in 5 ms (paused or not), then on at 10 mm/s:
+  // the push of each period from the fifth before the pause, one held through it.
+  const auto slide = [&](bool paused) {
+    AsyncRegions regions(scene);
+    SlidingContact contact(ContactObject::Of(scene), scene.contact, 0.1);
+    contact.Bind(contact.Prepare(regions));
+    const LatticeIndex centre = regions.partition().contact_node();
+    std::array<double, 3> tip = {0.125, 0.125, -0.001}, push{};
+    std::vector<std::array<double, 3>> pushes;
+    std::int64_t now = 1'000'000'000;
+    for (int n = 0; n < 300 + kPause + kAfter; ++n, now += 1'000'000) {
+      tip[2] = -0.001 + 0.005 * std::min(1.0, n / 200.0);
+      if (n >= 200) tip[0] += n >= 300 && n < 300 + kPause ? 6e-5 : 1e-5;
+      const bool step = !paused || n < 300 || n >= 300 + kPause;
+      if (paused && n == 300 + kPause) contact.CatchUp(now, kPause * 1'000'000, false);
+      contact.Update(tip, now, step ? std::optional<LatticeIndex>(centre) : std::nullopt);
+      if (step) {
+        regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
+                                     regions.period_ticks(kPrimaryRegion));
+        push = contact.StepPeriod(regions, now);
+      }
+      if (n >= 295) pushes.push_back(push);
     }
-    EXPECT_LE(lateral(push), 0.5 * push[2] * (1 + 1e-9)) << "period " << n;
-    largest_step =
-        std::max(largest_step, std::hypot(push[0] - last[0], push[1] - last[1], push[2] - last[2]));
-    last = push;
+    return pushes;
+  };
+  const auto plain = slide(false), paused = slide(true);
+  const auto lateral = [](const std::array<double, 3>& f) { return std::hypot(f[0], f[1]); };
+  const auto step = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  const std::array<double, 3> held = paused[4 + kPause];
+  ASSERT_GT(held[2], 0.1);  // pushing into the face (+z)
+  double largest_step = 0;
+  for (std::size_t n = 5 + kPause; n < paused.size(); ++n) {
+    EXPECT_LE(lateral(paused[n]), 0.5 * paused[n][2] * (1 + 1e-9)) << "period " << n;
+    largest_step = std::max(largest_step, step(paused[n], paused[n - 1]));
   }
-  // Caught up (10 ms) and sliding again: the spring's own, at μ_k.
-  EXPECT_NEAR(lateral(push) / push[2], 0.4, 0.02);
-  EXPECT_LT(largest_step, 0.02);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(paused[5 + kPause][c], held[c], 1e-9) << c;
+  EXPECT_LT(largest_step, 0.025);
+  // Caught up (10 ms) and on for 30 ms: the push without the pause.
+  EXPECT_LT(step(paused.back(), plain.back()), 0.05 * plain.back()[2]);
   std::printf(
       "after a 5 ms pause: held (%.4f, %.4f, %.4f) N, first push (the same), largest step "
-      "%.4f N, lateral/normal caught up %.4f\n",
-      held[0], held[1], held[2], largest_step, lateral(push) / push[2]);
+      "%.4f N; 40 ms on (%.4f, %.4f, %.4f) N, without the pause (%.4f, %.4f, %.4f) N\n",
+      held[0], held[1], held[2], largest_step, paused.back()[0], paused.back()[1],
+      paused.back()[2], plain.back()[0], plain.back()[1], plain.back()[2]);
+}
+
+// A move's pause as the tool lifts out (the end of a stroke): the regions stand still while the
+// tool rises further than the spring was compressed, so against the tissue where the pause left
+// it the tool is off the surface. The push must still come back from the held one, the tissue
+// following the tool up from where it was, not drop to nothing and spring back up into the tool
+// (through hapticsimd on the palpation phantom beside load: 0.12 N → 0 → 0.06 N in a period).
+TEST(SlidingTool, AfterAPauseWhileLiftingOutThePushComesBackFromTheHeldOneNotFromZero) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.contact.model = ContactModel::kProxy;
+  constexpr int kPauseAt = 322, kPause = 9;
+  // Pressed 1.5 mm into the front face's middle over 0.2 s, held 0.1 s, then lifted at 20 mm/s
+  // (the device's stroke) to 0.9 mm and held there: the push, one per period, paused or not.
+  const auto lift = [&](bool paused) {
+    AsyncRegions regions(scene);
+    SlidingContact contact(ContactObject::Of(scene), scene.contact, 0.1);
+    contact.Bind(contact.Prepare(regions));
+    const LatticeIndex centre = regions.partition().contact_node();
+    std::vector<std::array<double, 3>> pushes;
+    std::array<double, 3> push{};
+    std::int64_t now = 1'000'000'000;
+    for (int n = 0; n < 400; ++n, now += 1'000'000) {
+      const double depth =
+          n < 200 ? 0.0015 * n / 200 : std::clamp(0.0015 - 2e-5 * (n - 300), 0.0009, 0.0015);
+      const bool step = !paused || n < kPauseAt || n >= kPauseAt + kPause;
+      if (paused && n == kPauseAt + kPause) contact.CatchUp(now, kPause * 1'000'000, false);
+      const double z = n == 0 ? -0.001 : depth;  // touched from outside
+      contact.Update({0.125, 0.125, z}, now,
+                     step ? std::optional<LatticeIndex>(centre) : std::nullopt);
+      if (step) {
+        regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
+                                     regions.period_ticks(kPrimaryRegion));
+        push = contact.StepPeriod(regions, now);
+      }
+      pushes.push_back(push);  // held through the pause
+    }
+    return pushes;
+  };
+  const auto plain = lift(false), paused = lift(true);
+  const auto step = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  const std::array<double, 3> held = paused[kPauseAt + kPause - 1];
+  // Lifted further than the spring was compressed (k = 1000 N/m): off the paused tissue.
+  ASSERT_LT(held[2] / scene.contact.stiffness_n_per_m, 2e-5 * kPause);
+  ASSERT_GT(held[2], 0.02);
+  double largest_step = 0;
+  for (int n = kPauseAt + kPause; n < kPauseAt + 40; ++n) {
+    largest_step = std::max(largest_step, step(paused[n], paused[n - 1]));
+  }
+  const std::array<double, 3> first = paused[kPauseAt + kPause];
+  EXPECT_NEAR(first[2], held[2], 1e-9) << "the first push after the pause is not the held one";
+  EXPECT_LT(largest_step, 0.02);
+  // Caught up (18 ms), the push is the one without the pause.
+  EXPECT_LT(step(paused[kPauseAt + 40], plain[kPauseAt + 40]), 0.01);
+  std::printf(
+      "a 9 ms pause lifting out: held %.4f N (%.4f N without the pause), first push %.4f N, "
+      "largest step after %.4f N; 31 ms after it %.4f N (%.4f N without)\n",
+      held[2], plain[kPauseAt + kPause - 1][2], first[2], largest_step, paused[kPauseAt + 40][2],
+      plain[kPauseAt + 40][2]);
 }
 
 // Regions restarted from rest under a sliding tool (a runaway's demotion, a move the check refused
