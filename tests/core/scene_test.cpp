@@ -73,6 +73,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BadValue{"solver.dt=0", "solver.dt must be finite and > 0"},
                       BadValue{"solver.dt=nan", "solver.dt"},
                       BadValue{"material.damping=inf", "material.damping"},
+                      BadValue{"geometry.spacing_m=nan", "geometry.spacing_m must be finite"},
+                      BadValue{"geometry.spacing_m=-0.005", "geometry.spacing_m"},
                       BadValue{"input.waveform=square", "\"press\", \"sine\" or \"stroke\""},
                       BadValue{"input.frequency=abc", "input.frequency = 'abc' is not a number"},
                       BadValue{"input.amplitude=0.3", "below mesh.edge"},
