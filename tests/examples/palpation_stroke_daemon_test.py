@@ -4,10 +4,12 @@ it (at 5 mm voxels) with a tool that slides (contact.model = "proxy"), and the s
 stroking 60 mm across its front face over shared memory, in real time. The stiffer inclusion must
 show as a bump in the force the device received; the regions must have followed the proxy across
 the face; the lateral force must stay within the static friction's cone; and the force must not
-step by more than 0.25 N between answers, the soak's bound beside load (measured: 0.05 to 0.08 N,
-in two runs of eight 0.17–0.18 N: a late wake on this shared machine steps a sliding force too;
-the cube's stroke keeps under 0.1 N quiet and loaded, HapticsimdSlidingTool). A control phantom whose inclusion is as soft
-as the tissue shows no bump beyond the block's own shape (measured: 4.3 %).
+step by more than 0.12 N between answers. The largest step left is the friction's own: the
+lateral force falling from μ_s to μ_k times the normal as the proxy slips, 0.1 × up to 0.77 N
+(measured 0.055–0.076 N quiet, 0.061–0.083 N beside two busy threads, 11 runs). Before the
+proxy followed the tool through a move's pause (SlidingContact::CatchUp), a tool lifting out
+during one dropped the force to nothing for a period: 0.11–0.18 N. A control phantom whose
+inclusion is as soft as the tissue shows no bump beyond the block's own shape (measured: 4.3 %).
 
 Usage: palpation_stroke_daemon_test.py HAPTICSIM HAPTICSIMD   (exit 0: passed; 1: what failed is
 printed)"""
@@ -26,7 +28,7 @@ def check_rows(summary, rows):
     if not summary["largest_lateral_to_normal"] <= 0.5 * 1.05:
         wrong.append("the lateral force reached %.3f × the normal, above μ_s = 0.5"
                      % summary["largest_lateral_to_normal"])
-    if not summary["largest_step_N"] < 0.25:
+    if not summary["largest_step_N"] < 0.12:
         wrong.append("the force stepped by %.3f N between answers" % summary["largest_step_N"])
     if summary["lost_answers"] != 0:
         wrong.append("%d answers were lost" % summary["lost_answers"])
