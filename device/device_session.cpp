@@ -157,8 +157,8 @@ class AnswerTally {
     if (finite) TakeForce(a, contact);
     if (settings_.keep_trace && a.seq >= 1 && a.seq < static_cast<std::int64_t>(tips_.size())) {
       const auto seq = static_cast<std::size_t>(a.seq);
-      report_.trace.push_back(
-          {(sent_ns_[seq] - first_sent_ns_) * 1e-9, tips_[seq], a.force_n, a.flags});
+      report_.trace.push_back({(sent_ns_[seq] - first_sent_ns_) * 1e-9, tips_[seq], a.force_n,
+                               a.flags, a.error_percent});
     }
     previous_ = a;
     if (last_burst_end_ >= 0 && a.seq > last_burst_end_) ++report_.answers_after_last_burst;

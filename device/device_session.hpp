@@ -32,6 +32,7 @@ struct TracePoint {
   std::array<double, 3> position_m{};  ///< that input's tip, object frame
   std::array<double, 3> force_n{};     ///< on the user
   std::int32_t flags = 0;
+  double error_percent = -1;  ///< the error the daemon reported with it, % (−1: unknown)
 };
 
 /** Round-trip latency percentiles, µs (input sent → the first force answering it received). */

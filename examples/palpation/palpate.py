@@ -78,6 +78,8 @@ def parse_args(doc, out, daemon=False):
     if daemon:
         parser.add_argument("--hapticsimd", help="default: next to --hapticsim's build folder, "
                             "daemon/hapticsimd")
+        parser.add_argument("--no-map", action="store_true",
+                            help="serve without an error map (the error is then unknown, -1)")
     parser.add_argument("--scene", default=os.path.join(HERE, "palpation.toml"))
     parser.add_argument("--out", default=out)
     args = parser.parse_args()

@@ -2,18 +2,23 @@
 """Strokes the phantom through the daemon: hapticsimd serves the phantom, at 5 mm voxels, with a
 tool that slides (contact.model = "proxy", a 10 mm tip), and the simulated device (hapticsim device
 --input stroke) strokes its front face three times, 60 mm along x across the inclusion, 4 s a
-stroke, over shared memory in real time. The force each answer carried is drawn against the tool's position, so the
-stiffer inclusion shows as a bump, as an engineer feels it through a device.
+stroke, over shared memory in real time. The force each answer carried is drawn against the
+tool's position, so the stiffer inclusion shows as a bump, as an engineer feels it through a
+device. The daemon is given the phantom's error map, made first over stroke_map.toml (a few
+seconds), so each answer says how wrong its force is and the supervisor keeps the regions where
+the map says they are right.
 
 Usage: stroke_daemon.py [--hapticsim PATH] [--hapticsimd PATH] [--scene FILE.toml] [--out DIR]
+                        [--no-map]
 
 Writes DIR/stroke-daemon.csv (the tool's x in mm, the normal and the lateral force on the user in N,
 one row per answer in contact while sliding, from the second stroke on: the first starts with the
 regions moving onto the touch) and DIR/stroke-daemon.svg, with the daemon's log, its config and
 scene, and the device's trace and report; prints the normal force over the inclusion's centre
 against plain tissue (x = 15 and 65 mm; each the mean within 2.5 mm), how far the lateral force
-went (μ_s = 0.5 by default), the largest force step between answers, and how often the regions
-followed the proxy.
+went (μ_s = 0.5 by default), the largest force step between answers, how often the regions
+followed the proxy, and the error the daemon reported over the slides (DIR/stroke.hsmap is the
+map).
 Make the phantom first: python3 make_phantom.py phantom.nii (next to the scene)."""
 import csv
 import json
@@ -37,6 +42,7 @@ START_M = (0.010, 0.020)
 LENGTH_M = 0.06
 FREQUENCY_HZ = 0.25
 STROKES = 3
+MAP_GRID = os.path.join(os.path.dirname(os.path.abspath(__file__)), "stroke_map.toml")
 TOOL = ["contact.model=proxy", "contact.radius=0.01", "geometry.spacing_m=0.005",
         "adaptivity.primary_size=4"]
 
@@ -65,13 +71,22 @@ def daemon_scene(hapticsim, scene, out):
         return path, tomllib.load(f)["input"]["amplitude"]
 
 
-def start_daemon(hapticsimd, scene, out, socket):
+def make_map(hapticsim, scene, out):
+    """The error map of `scene` over MAP_GRID (hapticsim sweep; a few seconds), in `out`."""
+    path = os.path.join(out, "stroke.hsmap")
+    print("stroke_daemon: making its error map (%s) ..." % MAP_GRID, file=sys.stderr)
+    run([hapticsim, "sweep", "--scene", scene, "--grid", MAP_GRID, "--out", path],
+        "hapticsim sweep")
+    return path
+
+
+def start_daemon(hapticsimd, scene, out, socket, error_map):
     """hapticsimd on `scene`, device input over shared memory only (nothing on the network)."""
     config = os.path.join(out, "stroke-daemon.toml")
     with open(config, "w") as f:
         f.write('[scene]\nfile = "%s"\n[device]\ninput = "shm"\n[shm]\nenabled = true\n'
                 'socket = "%s"\n[lcm]\nenabled = false\n[control]\nenabled = false\n'
-                % (scene, socket))
+                '[supervisor]\nerror_map = "%s"\n' % (scene, socket, error_map))
     log = open(os.path.join(out, "stroke-daemon.log"), "w")
     daemon = subprocess.Popen([hapticsimd, "--config", config], stdout=log, stderr=log)
     deadline = time.time() + 60
@@ -88,9 +103,9 @@ def start_daemon(hapticsimd, scene, out, socket):
 
 
 def slides(trace):
-    """(x mm, normal N, lateral N) of every answer in contact in the middle of a slide (a phase of
-    0.25 to 0.65 of its stroke: the press is done, the lift not begun), from the second stroke on;
-    and the largest force step between answers in contact from there."""
+    """(x mm, normal N, lateral N, the error reported %) of every answer in contact in the middle
+    of a slide (a phase of 0.25 to 0.65 of its stroke: the press is done, the lift not begun), from
+    the second stroke on; and the largest force step between answers in contact from there."""
     points, largest_step, last = [], 0.0, None
     with open(trace) as f:
         for row in csv.DictReader(f):
@@ -104,15 +119,17 @@ def slides(trace):
             last = force if contact else None
             phase = (t * FREQUENCY_HZ) % 1
             if contact and 0.25 < phase < 0.65:
-                points.append((float(row["x_m"]) * 1e3, -force[2], math.hypot(force[0], force[1])))
+                points.append((float(row["x_m"]) * 1e3, -force[2], math.hypot(force[0], force[1]),
+                               float(row["error_percent"])))
     return points, largest_step
 
 
 def main():
     args = parse_args(__doc__, "stroke-daemon-out", daemon=True)
     scene, amplitude = daemon_scene(args.hapticsim, args.scene, args.out)
+    error_map = "" if args.no_map else make_map(args.hapticsim, scene, args.out)
     socket = os.path.join(tempfile.mkdtemp(prefix="hsim-"), "hapticsimd.sock")
-    daemon, log = start_daemon(args.hapticsimd, scene, args.out, socket)
+    daemon, log = start_daemon(args.hapticsimd, scene, args.out, socket, error_map)
     trace = os.path.join(args.out, "stroke-daemon-trace.csv")
     try:
         command = [args.hapticsim, "device", "--transport", "shm", "--shm-socket", socket,
@@ -134,11 +151,11 @@ def main():
     csv_path = os.path.join(args.out, "stroke-daemon.csv")
     with open(csv_path, "w") as f:
         f.write("x_mm,normal_force_N,lateral_force_N\n")
-        for x, normal, lateral in points:
+        for x, normal, lateral, _ in points:
             f.write("%.6g,%.9g,%.9g\n" % (x, normal, lateral))
     plot = os.path.join(args.out, "stroke-daemon.svg")
     bins = {}  # the strokes' answers averaged per 0.5 mm of the tool's way: one curve
-    for x, normal, _ in points:
+    for x, normal, _, _ in points:
         bins.setdefault(round(x * 2) / 2, []).append(normal)
     curve = [(x, sum(v) / len(v)) for x, v in sorted(bins.items())]
     svg(curve, plot, (32.5, 47.5),
@@ -146,18 +163,24 @@ def main():
         % (STROKES - 1))
 
     def at(x_mm):
-        near = [normal for x, normal, _ in points if abs(x - x_mm) <= 2.5]
+        near = [normal for x, normal, _, _ in points if abs(x - x_mm) <= 2.5]
         return sum(near) / len(near)
 
     with open(log) as f:
         moves = f.read().count("regions centred on contact node")
     plain = (at(15.0) + at(65.0)) / 2
+    known = [error for _, _, _, error in points if error >= 0]
     print(json.dumps({"answers_in_slides": len(points), "regions_moved": moves,
                       "force_over_inclusion_N": at(40.0), "force_over_plain_tissue_N": plain,
                       "ratio": at(40.0) / plain,
                       "largest_lateral_to_normal": device["max_lateral_to_normal"],
                       "largest_step_N": largest_step, "lost_answers": device["lost_answers"],
-                      "late_answers": device["late_answers"], "csv": csv_path, "plot": plot},
+                      "late_answers": device["late_answers"],
+                      # How wrong the force was, as the daemon said with each answer (its map's
+                      # worst force-magnitude error where the regions were, % of the peak).
+                      "error_percent_reported": [min(known), max(known)] if known else None,
+                      "answers_error_unknown": len(points) - len(known),
+                      "csv": csv_path, "plot": plot},
                      indent=2))
 
 

@@ -43,12 +43,12 @@ struct DeviceOptions {
 void WriteTrace(const std::string& path, const std::vector<device::TracePoint>& trace) {
   std::ofstream out(path);
   HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": cannot write it");
-  out << "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,in_contact,flags\n";
+  out << "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,in_contact,flags,error_percent\n";
   char row[256];
   for (const device::TracePoint& p : trace) {
-    std::snprintf(row, sizeof row, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%d\n", p.t_s,
+    std::snprintf(row, sizeof row, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%d,%.4g\n", p.t_s,
                   p.position_m[0], p.position_m[1], p.position_m[2], p.force_n[0], p.force_n[1],
-                  p.force_n[2], (p.flags & 1) ? 1 : 0, p.flags);
+                  p.force_n[2], (p.flags & 1) ? 1 : 0, p.flags, p.error_percent);
     out << row;
   }
   HAPTICSIM_THROW_UNLESS(out.good(), "--trace " + path + ": writing it failed (disk full?)");
@@ -174,7 +174,7 @@ Command AddDeviceCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--trace", options->trace_file,
                   "Write every answer as CSV: the input's time and tip (m), the force (N), "
-                  "in contact, flags")
+                  "in contact, flags and the error the daemon reported, %")
       ->capture_default_str();
   app->add_option("--frequency", options->motion.frequency_hz,
                   "Press, sine and stroke frequency, Hz")
