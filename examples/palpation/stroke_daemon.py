@@ -24,6 +24,7 @@ import csv
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -167,7 +168,12 @@ def main():
         return sum(near) / len(near)
 
     with open(log) as f:
-        moves = f.read().count("regions centred on contact node")
+        text = f.read()
+    moves = text.count("regions centred on contact node")
+    # The secondary rates the daemon ran, in order: its start's, then each it switched to.
+    rates = [int(rate) for rate in re.findall(
+        r"(?:info configuration|reconfigured): primary_size \d+, secondary_lod \d+, "
+        r"secondary_rate (\d+) Hz", text)]
     plain = (at(15.0) + at(65.0)) / 2
     known = [error for _, _, _, error in points if error >= 0]
     print(json.dumps({"answers_in_slides": len(points), "regions_moved": moves,
@@ -180,6 +186,7 @@ def main():
                       # worst force-magnitude error where the regions were, % of the peak).
                       "error_percent_reported": [min(known), max(known)] if known else None,
                       "answers_error_unknown": len(points) - len(known),
+                      "secondary_rates_hz_run": rates,
                       "csv": csv_path, "plot": plot},
                      indent=2))
 

@@ -4,7 +4,8 @@ it (at 5 mm voxels) with a tool that slides (contact.model = "proxy"), and the s
 stroking 60 mm across its front face over shared memory, in real time. The stiffer inclusion must
 show as a bump in the force the device received; the regions must have followed the proxy across
 the face; every answer must carry the error its map gives (made first over stroke_map.toml), within
-the 7 % target; the lateral force must stay within the static friction's cone; and the force must not
+the 7 % target, and the supervisor must leave the 600 Hz the map says diverges over the
+inclusion's far edge, which it keeps on the control; the lateral force must stay within the static friction's cone; and the force must not
 step by more than 0.12 N between answers. The largest step left is the friction's own: the
 lateral force falling from μ_s to μ_k times the normal as the proxy slips, 0.1 × up to 0.77 N
 (measured 0.055–0.084 N quiet, 0.061–0.085 N beside two busy threads, 16 runs). Before the
@@ -38,11 +39,26 @@ def check_rows(summary, rows):
     elif not 0 <= summary["error_percent_reported"][1] <= 7:
         wrong.append("the error reported reached %.3f %%, above the 7 %% target"
                      % summary["error_percent_reported"][1])
+    # The lookup follows the material under the regions: the map says a primary of 4 at 600 Hz
+    # diverges pressed over the inclusion's far edge (nodes 10 and 12), so the daemon must leave
+    # 600 Hz on the way there; on the control phantom it has no reason to.
+    if not summary["secondary_rates_hz_run"][:1] == [600] or \
+            not any(rate > 600 for rate in summary["secondary_rates_hz_run"]):
+        wrong.append("the secondary ran at %s Hz: the map asks it to leave 600 Hz before the "
+                     "inclusion's far edge" % summary["secondary_rates_hz_run"])
     if summary["lost_answers"] != 0:
         wrong.append("%d answers were lost" % summary["lost_answers"])
     return wrong
 
 
+def check_control(summary):
+    if summary["secondary_rates_hz_run"] != [600]:
+        return ["on the control phantom the secondary ran at %s Hz: its map keeps 600 Hz"
+                % summary["secondary_rates_hz_run"]]
+    return []
+
+
 if __name__ == "__main__":
     sys.exit(check_bump(sys.argv[1], "stroke_daemon.py", check_rows, least_bump=0.25,
-                        control_within=0.08, extra_args=["--hapticsimd", sys.argv[2]]))
+                        control_within=0.08, extra_args=["--hapticsimd", sys.argv[2]],
+                        check_control=check_control))

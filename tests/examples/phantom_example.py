@@ -34,11 +34,12 @@ def run_on_phantom(hapticsim, folder, scene_text, script, extra_args=()):
     return summary, rows
 
 
-def check_bump(hapticsim, script, check_rows, least_bump, control_within, extra_args=()):
-    """The test: `check_rows(summary, rows)` returns what is wrong with the run's output; the
-    inclusion must raise the force by more than `least_bump` (a fraction), the control's ratio
-    stay within `control_within` of one. `extra_args` go to the script. Returns the exit status,
-    printing what failed."""
+def check_bump(hapticsim, script, check_rows, least_bump, control_within, extra_args=(),
+               check_control=lambda summary: []):
+    """The test: `check_rows(summary, rows)` returns what is wrong with the run's output, and
+    `check_control(summary)` what is wrong with the control's; the inclusion must raise the force
+    by more than `least_bump` (a fraction), the control's ratio stay within `control_within` of
+    one. `extra_args` go to the script. Returns the exit status, printing what failed."""
     with open(os.path.join(EXAMPLE, "palpation.toml")) as f:
         scene_text = f.read()
     failures = []
@@ -59,6 +60,7 @@ def check_bump(hapticsim, script, check_rows, least_bump, control_within, extra_
         control, _ = run_on_phantom(hapticsim, os.path.join(work, "control"), control_text, script,
                                     extra_args)
         print("inclusion as soft as the tissue:", json.dumps(control))
+        failures += check_control(control)
         if not abs(control["ratio"] - 1) < control_within:
             failures.append("the control phantom shows a bump of %.3f" % control["ratio"])
     finally:
