@@ -3,6 +3,7 @@
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -29,7 +30,11 @@ std::string FaultName(PortGuard::Fault fault, const PortGuardSettings& port) {
 }  // namespace
 
 LoopEventLog::LoopEventLog(HapticLoop& loop, const DaemonConfig& config)
-    : loop_(loop), config_(config), overrun_(HapticLoop::NowNs()) {
+    : loop_(loop),
+      config_(config),
+      overrun_(HapticLoop::NowNs()),
+      held_reconfigurations_(loop.reconfigurations()),
+      held_since_ns_(HapticLoop::NowNs()) {
   MatchMissLoggers(HapticLoop::NowNs());
 }
 
@@ -79,11 +84,47 @@ void LoopEventLog::ReadBoundaryAge() {
   }
 }
 
+// A secondary thread woken late, but by less than its own period, has not missed its deadline;
+// yet the region inwards may have needed its Γ before it was published, and stepped on holding
+// the newest (at one rate it is released only half a period ahead: ReleaseLeadsNs). Such steps
+// are off the exchange the error map measured: said every kHeldBoundaryWindow_ns per link, where
+// they were at least kHeldBoundaryShare of the inner region's steps (a quiet machine: about 0.3 %
+// on the organ sample; beside two busy threads 12–23 %).
+void LoopEventLog::ReadHeldBoundaries(std::int64_t now) {
+  const AsyncRegions& regions = loop_.regions();
+  if (loop_.reconfigurations() != held_reconfigurations_) {  // new regions count from zero
+    held_reconfigurations_ = loop_.reconfigurations();
+    held_seen_.fill(0);
+  }
+  for (int inner = 0; inner + 1 < regions.num_regions(); ++inner) {
+    const std::int64_t held = regions.held_boundary_steps(inner);
+    held_unsaid_[inner] += std::max<std::int64_t>(0, held - held_seen_[inner]);
+    held_seen_[inner] = held;
+  }
+  if (now - held_since_ns_ < kHeldBoundaryWindow_ns) return;
+  const double window_s = (now - held_since_ns_) * 1e-9;
+  for (int inner = 0; inner + 1 < regions.num_regions(); ++inner) {
+    const double steps =
+        window_s * regions.schedule(inner).rate_hz * regions.schedule(inner).substeps;
+    const double share = static_cast<double>(held_unsaid_[inner]) / steps;
+    if (share < kHeldBoundaryShare) continue;
+    spdlog::warn(
+        "boundary late: the {} region's Γ came after the {} region needed it in {} of its steps "
+        "({:.1f} %) over {:.1f} s, which held the newest Γ (its thread was late for them: by less "
+        "than its own period, not a deadline miss of its own)",
+        regions.partition().RegionName(inner + 1), regions.partition().RegionName(inner),
+        held_unsaid_[inner], 100 * share, window_s);
+  }
+  held_unsaid_.fill(0);
+  held_since_ns_ = now;
+}
+
 LoopEventLog::Misses LoopEventLog::ReadDeadlines(std::int64_t now) {
   MatchMissLoggers(now);
   black_box_.Drain(loop_);
   ReadStalls();
   ReadBoundaryAge();
+  ReadHeldBoundaries(now);
   Misses misses{};
   for (int r = 0; r < loop_.regions().num_regions(); ++r) {
     DeadlineEvent event;

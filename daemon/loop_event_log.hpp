@@ -35,11 +35,15 @@ class LoopEventLog {
   void Flush(std::int64_t now_ns);
 
   static constexpr size_t kBlackBoxCycles = 100;  // primary periods (0.1 s at 1 kHz)
+  /** Steps that held a late Γ are said per this window, where at least this share of steps. */
+  static constexpr std::int64_t kHeldBoundaryWindow_ns = 10'000'000'000;
+  static constexpr double kHeldBoundaryShare = 0.01;
 
  private:
   void MatchMissLoggers(std::int64_t now_ns);
   void ReadStalls();
   void ReadBoundaryAge();
+  void ReadHeldBoundaries(std::int64_t now_ns);
 
   HapticLoop& loop_;
   const DaemonConfig& config_;
@@ -49,6 +53,11 @@ class LoopEventLog {
   // Per region, as last logged.
   std::array<std::int64_t, HapticLoop::kMaxRegions> stalls_seen_{}, skipped_seen_{};
   bool boundary_stale_ = false;  // the secondary region has not run for kStaleBoundary_s
+  // Per inner region: its steps that held their outer Γ (AsyncRegions::held_boundary_steps) as
+  // last read from the regions of `held_reconfigurations_`, and those not said yet since
+  // `held_since_ns_`.
+  std::array<std::int64_t, HapticLoop::kMaxRegions> held_seen_{}, held_unsaid_{};
+  std::int64_t held_reconfigurations_ = 0, held_since_ns_ = 0;
   std::int64_t faults_seen_ = 0, rearms_seen_ = 0;
   std::int64_t last_fault_dump_ns_ = -1;  // none yet (CLOCK_MONOTONIC starts at boot)
 };

@@ -246,6 +246,10 @@ void AsyncRegions::Reset() {
   PublishInitialSnapshots();
 }
 
+std::int64_t AsyncRegions::held_boundary_steps(RegionIndex inner) const noexcept {
+  return regions_[inner]->held_boundary_steps.load(std::memory_order_relaxed);
+}
+
 bool AsyncRegions::RegionAtRest(RegionIndex region, double tolerance_m) const noexcept {
   return regions_[region]->integrator->OwnedStateMaxAbs() <= tolerance_m;
 }
@@ -366,6 +370,8 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   if (region.inward && (!followed || integrator.PrescribedWorkRefused() > 0)) {
     region.last_inexact_follow_ticks.store(region.state_ticks, std::memory_order_release);
   }
+  if (region.inward && !followed)
+    region.held_boundary_steps.fetch_add(1, std::memory_order_relaxed);
   PublishStep(a);
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
 }

@@ -252,13 +252,14 @@ class AsyncRegions {
   /** A secondary region woken more of its periods late than this skips them (SkipRegion)
    *  instead of stepping them: the daemon's threads and RealTimeSchedule alike. */
   static constexpr int kSkipAfterLatePeriods = 3;
-  /**
-   * How far the primary's newest boundary from region 1 was behind the primary's step time at
-   * its last step, s (0 with no secondary region). Any thread (relaxed atomic).
-   */
+  /** How far the primary's newest boundary from region 1 was behind the primary's step time at
+   *  its last step, s (0 with no secondary region). Any thread (relaxed atomic). */
   double primary_boundary_age_s() const noexcept {
     return primary_boundary_age_s_.load(std::memory_order_relaxed);
   }
+  /** Region `inner`'s steps whose outer Γ the outer region had not published up to their end
+   *  (held: its thread was late for them), since construction. Any thread (relaxed atomic). */
+  std::int64_t held_boundary_steps(RegionIndex inner) const noexcept;
   /**
    * Virtual time: steps the secondary regions (outermost first, recursively) until region 1 can
    * supply Γ at `ticks`, as the primary's next step needs.
@@ -403,7 +404,6 @@ class AsyncRegions {
    */
   std::vector<double> FreeDecayEnergies(int periods_per_checkpoint, int checkpoints,
                                         unsigned seed = 11);
-
   /** Compute time spent in a region's steps since Reset, s. */
   double compute_seconds(RegionIndex region) const;
 

@@ -68,6 +68,9 @@ struct AsyncRegions::Region {
   // region's snapshot at that time (held for a late outer region, or port-limited). Stored
   // before the band is published (release), read after it (acquire).
   std::atomic<std::int64_t> last_inexact_follow_ticks{INT64_MIN};
+  // Its steps whose outer Γ the outer region had not published up to their end
+  // (held_boundary_steps).
+  std::atomic<std::int64_t> held_boundary_steps{0};
   // As the inner side of the link outwards:
   double outer_gamma_work = 0;  // work done on this region by moving its outer Γ
   double outward_taken = 0;     // what its controller took out for that link

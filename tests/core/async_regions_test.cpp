@@ -136,6 +136,41 @@ TEST(AsyncRegions, AtOneRateInSubstepsASecondaryAPeriodAheadReadsThePrimarysNext
   EXPECT_LT(largest_backlog_j, 1e-6 * peak_stored_j);
 }
 
+// A primary step whose outer Γ the secondary had not published up to the step's end holds it,
+// and is counted (the daemon logs the count: the secondary's thread was late for the primary,
+// though not by a period of its own). In order, none; with the secondary left behind for ten
+// steps, exactly those ten; in order again, no more — at one rate and at 600 Hz.
+TEST(AsyncRegions, PrimaryStepsThatHadToHoldTheirBoundaryAreCounted) {
+  for (const double rate_hz : {1000.0, 600.0}) {
+    AsyncRegions regions(Adaptive(3, 2, rate_hz));
+    regions.Reset();
+    const auto step = [&](bool advance) {
+      const std::int64_t end =
+          regions.state_ticks(kPrimaryRegion) + regions.period_ticks(kPrimaryRegion);
+      if (advance) regions.AdvanceSecondariesTo(end);
+      (void)regions.StepPrimary({0.0, 0.0, 1e-4});
+    };
+    for (int n = 0; n < 100; ++n) step(true);
+    EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), 0) << rate_hz << " Hz";
+    // Left behind: the secondary's newest Γ covers at most the step it was last advanced for
+    // (at 600 Hz its period covers part of the next primary step too).
+    const std::int64_t covered_ticks = regions.state_ticks(1);
+    int beyond = 0;
+    for (int n = 0; n < 10; ++n) {
+      beyond +=
+          regions.state_ticks(kPrimaryRegion) + regions.period_ticks(kPrimaryRegion) > covered_ticks
+              ? 1
+              : 0;
+      step(false);
+    }
+    EXPECT_GE(beyond, 9);
+    EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), beyond) << rate_hz << " Hz";
+    for (int n = 0; n < 100; ++n) step(true);
+    EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), beyond) << rate_hz << " Hz";
+    EXPECT_EQ(regions.held_boundary_steps(1), 0) << "the outermost region has no outer Γ";
+  }
+}
+
 // The same under fast inputs, where one step's flow across Γ is a large share of the regions'
 // energies: the port limits must leave an exchange in lock-step alone (a 20 Hz sine on
 // primary_size 1 lost 44 % to them before lock-step was recognised).
