@@ -38,11 +38,14 @@ inline std::vector<ForceRecord> PlayDevice(
 
 /**
  * hapticsimd's threads played on this one, for one primary period at `release_ns`: the input
- * (if any) arrives at the release, the secondary regions step in virtual time up to one primary
- * step ahead (unless one of them may not: parked or paused), then the primary period runs as if
- * woken on time. Deterministic: no clock is read. With several primary substeps a period, its
- * later substeps see the secondaries' boundary as of the first (as behind a secondary thread a
- * little late), not the virtual-time trial's exchange before every substep.
+ * (if any) arrives at the release, the secondary regions step in virtual time until they supply
+ * the primary's boundary to the period's end (unless one of them may not: parked or paused), as
+ * threads released ahead of the primary do (ReleaseLeadsNs), then the primary period runs as if
+ * woken on time. Deterministic: no clock is read. With several primary substeps a period, a
+ * secondary at the primary's rate reads the band the primary publishes as its next step's
+ * (AsyncRegions::ReadInnerLoads), as on threads. (Until 2026-12-06 the secondaries went one
+ * substep ahead only, as behind a thread a little late: the organ's walk played so counted 891
+ * periods over the energy tolerance, the threads' order none.)
  */
 inline void PlayPeriodInVirtualTime(HapticLoop& loop, std::int64_t release_ns,
                                     const std::optional<DeviceSample>& input) {
@@ -52,7 +55,8 @@ inline void PlayPeriodInVirtualTime(HapticLoop& loop, std::int64_t release_ns,
   for (int r = 1; r < regions.num_regions() && may_step; ++r) may_step &= loop.SecondaryMayStep(r);
   if (may_step) {
     regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
-                                 regions.period_ticks(kPrimaryRegion));
+                                 regions.schedule(kPrimaryRegion).substeps *
+                                     regions.period_ticks(kPrimaryRegion));
   }
   loop.PrimaryPeriod(release_ns, release_ns);
 }
