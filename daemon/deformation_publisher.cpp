@@ -1,6 +1,7 @@
 #include "daemon/deformation_publisher.hpp"
 
 #include <pthread.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -8,6 +9,7 @@
 
 #include "daemon/lcm_bridge.hpp"
 #include "daemon/shm_server.hpp"
+#include "rt/background_priority.hpp"
 
 namespace hapticsim {
 
@@ -50,6 +52,9 @@ deformation_t DeformationPublisher::Message(const HapticLoop::SurfaceFrame& fram
 
 void DeformationPublisher::Run() {
   pthread_setname_np(pthread_self(), "hsim-deform");
+  // Its frames are for the eye: where two cores are short, the region threads go first.
+  if (!BackOffFromRealTimeThreads())
+    spdlog::warn("deformation thread: could not lower its priority");
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config_.deformation_rate_hz));
   HapticLoop::SurfaceFrame frame;
   std::int64_t next_ns = HapticLoop::NowNs(), ids_sent_ns = 0, number = 0;

@@ -15,6 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/fem/static_solver.hpp"
@@ -25,6 +26,7 @@
 #include "tests/support/box_stl.hpp"
 #include "tests/support/daemon_harness.hpp"
 #include "tests/support/private_socket.hpp"
+#include "tests/support/process_threads.hpp"
 #include "tests/support/run_command.hpp"
 
 namespace hapticsim {
@@ -113,6 +115,14 @@ TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthA
   testing::Client client;
   testing::WaitUntilServing(daemon);
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // asleep at rest: frames still
+  // The frames give way to the region threads where the CPUs are short: their thread runs at
+  // nice 10, the regions' at the daemon's own 0.
+  for (const auto& [thread, nice] :
+       {std::pair<const char*, int>{"hsim-deform", 10}, {"hsim-primary", 0}, {"hsim-region1", 0}}) {
+    const pid_t tid = testing::ThreadOf(daemon.pid(), thread);
+    ASSERT_GT(tid, 0) << "no thread named " << thread;
+    EXPECT_EQ(testing::NiceOf(daemon.pid(), tid), nice) << thread;
+  }
 
   // The default cube: 13 nodes per axis, the touched node (6, 6, 0) in the middle of the front
   // face; pressing in is +z. 1 cm in over 0.5 s, then held for 0.8 s.

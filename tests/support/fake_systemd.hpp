@@ -1,7 +1,8 @@
 #pragma once
 
 // systemd's notify protocol without systemd, for tests of a real hapticsimd: the test is the
-// notify socket. And a thread of a running process found by name, to stop it alone (ptrace).
+// notify socket (and, from process_threads.hpp, a thread of a running process found by name, to
+// stop it alone with ptrace).
 // Needs HAPTICSIMD_PATH, the daemon under test.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
@@ -18,21 +19,10 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/process_threads.hpp"
 #include "tests/support/run_command.hpp"
 
 namespace hapticsim::testing {
-
-// The kernel thread id of process `pid`'s thread named `name` (-1: none).
-inline pid_t ThreadOf(int pid, const std::string& name) {
-  const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
-  for (const auto& task : std::filesystem::directory_iterator(tasks)) {
-    std::ifstream comm(task.path() / "comm");
-    std::string comm_name;
-    std::getline(comm, comm_name);
-    if (comm_name == name) return static_cast<pid_t>(std::stol(task.path().filename().string()));
-  }
-  return -1;
-}
 
 // systemd's side of the notify protocol, without systemd: a datagram socket the daemon is
 // started against (NOTIFY_SOCKET; WATCHDOG_USEC 0.2 s, so it pings every 0.1 s), and what it said.
