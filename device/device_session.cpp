@@ -202,6 +202,7 @@ class AnswerTally {
         report_.press_peaks_n[press] = std::max(report_.press_peaks_n[press], magnitude);
       }
     }
+    if (contact) TakeError(a.error_percent);
     const double normal = -a.force_n[2], lateral = std::hypot(a.force_n[0], a.force_n[1]);
     if (contact && !stale && normal > 0.05) {
       report_.largest_lateral_n = std::max(report_.largest_lateral_n, lateral);
@@ -214,6 +215,17 @@ class AnswerTally {
       report_.largest_force_step_n =
           std::max(report_.largest_force_step_n, StepBetween(a, *previous_));
     }
+  }
+
+  void TakeError(double error_percent) {
+    if (!(error_percent >= 0)) {
+      ++report_.contact_answers_error_unknown;
+      return;
+    }
+    if (report_.error_percent_lowest < 0 || error_percent < report_.error_percent_lowest) {
+      report_.error_percent_lowest = error_percent;
+    }
+    report_.error_percent_highest = std::max(report_.error_percent_highest, error_percent);
   }
 
   // Every input the answer names (first_seq … seq: those the daemon's period took), each with

@@ -78,6 +78,10 @@ struct SessionReport {
   double largest_lateral_ratio = 0;
   std::vector<TracePoint> trace;  ///< every answer, with keep_trace
   std::int64_t contact_answers = 0;
+  /// In contact: the lowest and highest error the daemon reported with its answers, % (its map's
+  /// where the regions were; −1 while none said one), and the answers that said none (no map).
+  double error_percent_lowest = -1, error_percent_highest = -1;
+  std::int64_t contact_answers_error_unknown = 0;
   std::int32_t flags_seen = 0;  ///< every FLAG_* bit any answer carried
   std::int64_t answers_after_last_burst = 0;
   std::optional<status_t> status;          ///< the daemon's last status (LCM)

@@ -1282,6 +1282,13 @@ TEST(HapticsimdSlidingTool, AStrokeSlidesAtKineticFrictionAndTheRegionsFollowItU
     EXPECT_GE(slides.lowest_ratio, 0.4 * 0.95) << what;
     EXPECT_LE(slides.highest_ratio, 0.4 * 1.05) << what;
     EXPECT_GT(slides.mean_normal_n, 0.3) << what;
+    // Every answer in contact said how wrong it is: the map's error where the regions were,
+    // within the target the supervisor chose for.
+    const nlohmann::json& error = report["error_percent_in_contact"];
+    EXPECT_EQ(error["answers_without"], 0) << what;
+    EXPECT_GT(error["lowest"].get<double>(), 0.0) << what;
+    EXPECT_LE(error["lowest"].get<double>(), error["highest"].get<double>()) << what;
+    EXPECT_LE(error["highest"].get<double>(), 7.0) << what;
     std::printf(
         "stroke with %s: lateral/normal %.4f … %.4f while sliding, normal %.3f N, largest "
         "step %.4f N, %d late answers\n",

@@ -81,6 +81,10 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
                         {"max_force_step_any_n", r.largest_force_step_any_n},
                         {"max_force_n", r.largest_force_n},
                         {"contact_answers", r.contact_answers},
+                        {"error_percent_in_contact",
+                         {{"lowest", r.error_percent_lowest},
+                          {"highest", r.error_percent_highest},
+                          {"answers_without", r.contact_answers_error_unknown}}},
                         {"flags_seen", FlagNames(r.flags_seen)},
                         {"answers_after_last_bad_input", r.answers_after_last_burst}};
   if (!r.press_peaks_n.empty()) out["press_peaks_n"] = r.press_peaks_n;
@@ -186,6 +190,13 @@ std::string ReportText(const device::SessionReport& r) {
       peaks += value;
     }
     text << "  press peaks                " << peaks << " N\n";
+  }
+  if (r.error_percent_highest >= 0) {
+    add("  error reported in contact  %.3f–%.3f %% of the peak (%lld answers said none)",
+        r.error_percent_lowest, r.error_percent_highest,
+        static_cast<long long>(r.contact_answers_error_unknown));
+  } else if (r.contact_answers > 0) {
+    text << "  error reported in contact  none (the daemon has no error map)\n";
   }
   text << "  flags seen                 " << FlagNames(r.flags_seen) << "\n";
   if (r.status) {
