@@ -48,10 +48,11 @@ TOOL = ["contact.model=proxy", "contact.radius=0.01", "geometry.spacing_m=0.005"
         "adaptivity.primary_size=4"]
 
 
-def run(command, what):
+def run(command, what, hint=""):
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
-        sys.exit("stroke_daemon: %s failed:\n%s%s" % (what, result.stdout, result.stderr.strip()))
+        sys.exit("stroke_daemon: %s failed:\n%s%s%s"
+                 % (what, result.stdout, result.stderr.strip(), hint))
     return result.stdout
 
 
@@ -77,7 +78,8 @@ def make_map(hapticsim, scene, out):
     path = os.path.join(out, "stroke.hsmap")
     print("stroke_daemon: making its error map (%s) ..." % MAP_GRID, file=sys.stderr)
     run([hapticsim, "sweep", "--scene", scene, "--grid", MAP_GRID, "--out", path],
-        "hapticsim sweep")
+        "hapticsim sweep", "\n(its grid is %s, made for the phantom's front row of nodes; "
+        "--no-map serves without a map)" % MAP_GRID)
     return path
 
 
