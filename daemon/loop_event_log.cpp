@@ -35,6 +35,9 @@ LoopEventLog::LoopEventLog(HapticLoop& loop, const DaemonConfig& config)
       overrun_(HapticLoop::NowNs()),
       held_reconfigurations_(loop.reconfigurations()),
       held_since_ns_(HapticLoop::NowNs()) {
+  for (int inner = 0; inner + 1 < loop.regions().num_regions(); ++inner) {
+    held_seen_[inner] = loop.regions().held_boundary_steps(inner);  // since the start: not said
+  }
   MatchMissLoggers(HapticLoop::NowNs());
 }
 
@@ -88,8 +91,9 @@ void LoopEventLog::ReadBoundaryAge() {
 // yet the region inwards may have needed its Γ before it was published, and stepped on holding
 // the newest (at one rate it is released only half a period ahead: ReleaseLeadsNs). Such steps
 // are off the exchange the error map measured: said every kHeldBoundaryWindow_ns per link, where
-// they were at least kHeldBoundaryShare of the inner region's steps (a quiet machine: about 0.3 %
-// on the organ sample; beside two busy threads 12–23 %).
+// they were at least kHeldBoundaryShare of the inner region's nominal steps in the window (a
+// window with the regions asleep or paused reads low; a quiet machine: about 0.3 % on the organ
+// sample; beside two busy threads 11–23 %).
 void LoopEventLog::ReadHeldBoundaries(std::int64_t now) {
   const AsyncRegions& regions = loop_.regions();
   if (loop_.reconfigurations() != held_reconfigurations_) {  // new regions count from zero

@@ -229,8 +229,10 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     }
     regions.StepPrimaryPushed(step);
     if (q == 1) first_push = step.push_n;
+    // Where the regions last had the tool, lag included: a pause before the catch-up is over
+    // owes what was still to be given back too.
+    stepped_tool_ = step.tool_m;
   }
-  stepped_tool_ = tool_;
   last_push_ = first_push;
   AfterPeriod();
   return first_push;
@@ -257,7 +259,9 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
     c.proxy_->SpreadLoads(push_n, load);
   } else {
     // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push would
-    // be a force the object never gets back.
+    // be a force the object never gets back. The tool's lag goes with it, so a touch again in
+    // the next substeps would start at the tool's full depth: it ramps in instead.
+    if (c.catch_up_ns_ >= 0) c.ramp_start_ns_ = now_ns_;
     c.catch_up_ns_ = -1;
   }
 }

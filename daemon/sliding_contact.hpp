@@ -152,7 +152,7 @@ class SlidingContact {
   std::optional<ProxyContact> proxy_;           // on the bound regions' primary
   LatticeIndex bound_centre_{};                 // the bound regions' centre
   std::array<double, 3> tool_{}, last_tool_{};  // this period's tip and the last period's
-  std::array<double, 3> stepped_tool_{};        // the tip of the last period the regions stepped
+  std::array<double, 3> stepped_tool_{};  // the tool the regions' last substep had (lag included)
   std::array<double, 3> inward_{};              // the touched face's
   double face_m_ = 0;                           // where its plane is along its normal's axis, m
   std::optional<LatticeIndex> wanted_;

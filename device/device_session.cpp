@@ -154,6 +154,7 @@ class AnswerTally {
     const bool contact = a.flags & force_feedback_t::FLAG_IN_CONTACT;
     if (!finite) ++report_.nonfinite_forces;
     if (contact) ++report_.contact_answers;
+    if (contact) TakeError(a.error_percent);  // finite or not: every answer in contact counts
     if (finite) TakeForce(a, contact);
     if (settings_.keep_trace && a.seq >= 1 && a.seq < static_cast<std::int64_t>(tips_.size())) {
       const auto seq = static_cast<std::size_t>(a.seq);
@@ -202,7 +203,6 @@ class AnswerTally {
         report_.press_peaks_n[press] = std::max(report_.press_peaks_n[press], magnitude);
       }
     }
-    if (contact) TakeError(a.error_percent);
     const double normal = -a.force_n[2], lateral = std::hypot(a.force_n[0], a.force_n[1]);
     if (contact && !stale && normal > 0.05) {
       report_.largest_lateral_n = std::max(report_.largest_lateral_n, lateral);

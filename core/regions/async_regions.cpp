@@ -330,6 +330,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   const double h = integrator.substep();
   const auto& outer_gamma = region.dofs->outer_interface;
   bool followed = true;  // this step's outer Γ is the outer region's own at the step's end
+  bool held = false;     // … it is not: the outer region had not got that far (late)
 
   if (contact_next != nullptr && !partition_.proxy_contact()) {
     for (int c = 0; c < 3; ++c) region.prescribed_values[c] = (*contact_next)[c];
@@ -343,6 +344,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
         static_cast<double>(region.state_ticks + region.period_ticks) / ticks_per_second_;
     // On the line between the two snapshots, not held short of it nor clamped to a later one.
     followed = region.outer.older.time_s <= end && end <= region.outer.newer.time_s;
+    held = end > region.outer.newer.time_s;
     if (a == kPrimaryRegion) {
       primary_boundary_age_s_.store(t0 + h - t, std::memory_order_relaxed);
     }
@@ -370,8 +372,7 @@ void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* cont
   if (region.inward && (!followed || integrator.PrescribedWorkRefused() > 0)) {
     region.last_inexact_follow_ticks.store(region.state_ticks, std::memory_order_release);
   }
-  if (region.inward && !followed)
-    region.held_boundary_steps.fetch_add(1, std::memory_order_relaxed);
+  if (held) region.held_boundary_steps.fetch_add(1, std::memory_order_relaxed);
   PublishStep(a);
   region.compute_s += std::chrono::duration<double>(Clock::now() - start).count();
 }

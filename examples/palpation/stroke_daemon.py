@@ -173,9 +173,11 @@ def main():
         text = f.read()
     moves = text.count("regions centred on contact node")
     # The secondary rates the daemon ran, in order: its start's, then each it switched to.
-    rates = [int(rate) for rate in re.findall(
-        r"(?:info configuration|reconfigured): primary_size \d+, secondary_lod \d+, "
-        r"secondary_rate (\d+) Hz", text)]
+    rates = []
+    for rate in re.findall(r"(?:info configuration|reconfigured): primary_size \d+, "
+                           r"secondary_lod \d+, secondary_rate (\d+) Hz", text):
+        if not rates or rates[-1] != int(rate):  # a switch of the primary's size alone
+            rates.append(int(rate))
     plain = (at(15.0) + at(65.0)) / 2
     known = [error for _, _, _, error in points if error >= 0]
     print(json.dumps({"answers_in_slides": len(points), "regions_moved": moves,

@@ -139,7 +139,7 @@ TEST(AsyncRegions, AtOneRateInSubstepsASecondaryAPeriodAheadReadsThePrimarysNext
 // A primary step whose outer Γ the secondary had not published up to the step's end holds it,
 // and is counted (the daemon logs the count: the secondary's thread was late for the primary,
 // though not by a period of its own). In order, none; with the secondary left behind for ten
-// steps, exactly those ten; in order again, no more — at one rate and at 600 Hz.
+// steps, exactly those ten; in order again, or far ahead, no more — at one rate and at 600 Hz.
 TEST(AsyncRegions, PrimaryStepsThatHadToHoldTheirBoundaryAreCounted) {
   for (const double rate_hz : {1000.0, 600.0}) {
     AsyncRegions regions(Adaptive(3, 2, rate_hz));
@@ -167,6 +167,13 @@ TEST(AsyncRegions, PrimaryStepsThatHadToHoldTheirBoundaryAreCounted) {
     EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), beyond) << rate_hz << " Hz";
     for (int n = 0; n < 100; ++n) step(true);
     EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), beyond) << rate_hz << " Hz";
+    // A secondary far ahead is not late: its Γ is there, only not on the step's line.
+    for (int n = 0; n < 100; ++n) {
+      regions.AdvanceSecondariesTo(regions.state_ticks(kPrimaryRegion) +
+                                   4 * regions.period_ticks(1));
+      step(false);
+    }
+    EXPECT_EQ(regions.held_boundary_steps(kPrimaryRegion), beyond) << rate_hz << " Hz, ahead";
     EXPECT_EQ(regions.held_boundary_steps(1), 0) << "the outermost region has no outer Γ";
   }
 }

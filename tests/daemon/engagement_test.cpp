@@ -338,7 +338,8 @@ TEST(Substeps, APrimaryTakingSubstepsMovesTheContactAsTheOfflineScheduleDoes) {
     // its secondaries a whole period ahead first, as the daemon's threads are.
     const std::array<double, 3> to = loop.regions().primary_contact_m();
     twin.AdvanceSecondariesTo(twin.state_ticks(kPrimaryRegion) +
-                              2 * twin.period_ticks(kPrimaryRegion));
+                              twin.schedule(kPrimaryRegion).substeps *
+                                  twin.period_ticks(kPrimaryRegion));
     std::array<double, 3> reaction{};
     for (int q = 1; q <= 2; ++q) {
       std::array<double, 3> at;

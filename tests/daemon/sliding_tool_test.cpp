@@ -252,14 +252,19 @@ TEST(SlidingTool, AfterAPauseThePushComesBackFromTheHeldOneInsideTheFrictionCone
 // tool rises further than the spring was compressed, so against the tissue where the pause left
 // it the tool is off the surface. The push must still come back from the held one, the tissue
 // following the tool up from where it was, not drop to nothing and spring back up into the tool
-// (through hapticsimd on the palpation phantom beside load: 0.12 N → 0 → 0.06 N in a period).
+// (through hapticsimd on the palpation phantom beside load: 0.12 N → 0 → 0.06 N in a period) —
+// also when a second pause comes before the first's catch-up is over (a switch of configuration
+// right after a follow): what was still owed is owed on.
 TEST(SlidingTool, AfterAPauseWhileLiftingOutThePushComesBackFromTheHeldOneNotFromZero) {
   Scene scene = Stroke(0.5, 0.4);
   scene.contact.model = ContactModel::kProxy;
-  constexpr int kPauseAt = 322, kPause = 9;
+  struct Pause {
+    int at, periods;
+  };
   // Pressed 1.5 mm into the front face's middle over 0.2 s, held 0.1 s, then lifted at 20 mm/s
-  // (the device's stroke) to 0.9 mm and held there: the push, one per period, paused or not.
-  const auto lift = [&](bool paused) {
+  // (the device's stroke) to 0.9 mm and held there: the push, one per period, held through
+  // each pause.
+  const auto lift = [&](const std::vector<Pause>& pauses) {
     AsyncRegions regions(scene);
     SlidingContact contact(ContactObject::Of(scene), scene.contact, 0.1);
     contact.Bind(contact.Prepare(regions));
@@ -270,8 +275,11 @@ TEST(SlidingTool, AfterAPauseWhileLiftingOutThePushComesBackFromTheHeldOneNotFro
     for (int n = 0; n < 400; ++n, now += 1'000'000) {
       const double depth =
           n < 200 ? 0.0015 * n / 200 : std::clamp(0.0015 - 2e-5 * (n - 300), 0.0009, 0.0015);
-      const bool step = !paused || n < kPauseAt || n >= kPauseAt + kPause;
-      if (paused && n == kPauseAt + kPause) contact.CatchUp(now, kPause * 1'000'000, false);
+      bool step = true;
+      for (const Pause& p : pauses) {
+        step = step && !(n >= p.at && n < p.at + p.periods);
+        if (n == p.at + p.periods) contact.CatchUp(now, p.periods * 1'000'000, false);
+      }
       const double z = n == 0 ? -0.001 : depth;  // touched from outside
       contact.Update({0.125, 0.125, z}, now,
                      step ? std::optional<LatticeIndex>(centre) : std::nullopt);
@@ -280,32 +288,39 @@ TEST(SlidingTool, AfterAPauseWhileLiftingOutThePushComesBackFromTheHeldOneNotFro
                                      regions.period_ticks(kPrimaryRegion));
         push = contact.StepPeriod(regions, now);
       }
-      pushes.push_back(push);  // held through the pause
+      pushes.push_back(push);
     }
     return pushes;
   };
-  const auto plain = lift(false), paused = lift(true);
   const auto step = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
     return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
   };
-  const std::array<double, 3> held = paused[kPauseAt + kPause - 1];
-  // Lifted further than the spring was compressed (k = 1000 N/m): off the paused tissue.
-  ASSERT_LT(held[2] / scene.contact.stiffness_n_per_m, 2e-5 * kPause);
-  ASSERT_GT(held[2], 0.02);
-  double largest_step = 0;
-  for (int n = kPauseAt + kPause; n < kPauseAt + 40; ++n) {
-    largest_step = std::max(largest_step, step(paused[n], paused[n - 1]));
+  const auto plain = lift({});
+  for (const std::vector<Pause>& pauses :
+       {std::vector<Pause>{{322, 9}}, std::vector<Pause>{{318, 9}, {331, 5}}}) {
+    const auto paused = lift(pauses);
+    const std::array<double, 3> held = paused[pauses[0].at + pauses[0].periods - 1];
+    // Lifted further than the spring was compressed (k = 1000 N/m): off the paused tissue.
+    ASSERT_LT(held[2] / scene.contact.stiffness_n_per_m, 2e-5 * pauses[0].periods);
+    ASSERT_GT(held[2], 0.02);
+    for (const Pause& p : pauses) {
+      EXPECT_NEAR(paused[p.at + p.periods][2], paused[p.at + p.periods - 1][2], 1e-9)
+          << "the first push after the pause at " << p.at << " is not the held one";
+    }
+    const int last = pauses.back().at + pauses.back().periods;
+    double largest_step = 0;
+    for (int n = pauses[0].at + pauses[0].periods; n < last + 30; ++n) {
+      largest_step = std::max(largest_step, step(paused[n], paused[n - 1]));
+    }
+    EXPECT_LT(largest_step, 0.02) << pauses.size() << " pause(s)";
+    // Caught up, the push is the one without the pause.
+    EXPECT_LT(step(paused[last + 31], plain[last + 31]), 0.01) << pauses.size() << " pause(s)";
+    std::printf(
+        "%zu pause(s) lifting out: held %.4f N (%.4f N without), first push the same, largest "
+        "step after %.4f N; 31 ms after the last %.4f N (%.4f N without)\n",
+        pauses.size(), held[2], plain[pauses[0].at + pauses[0].periods - 1][2], largest_step,
+        paused[last + 31][2], plain[last + 31][2]);
   }
-  const std::array<double, 3> first = paused[kPauseAt + kPause];
-  EXPECT_NEAR(first[2], held[2], 1e-9) << "the first push after the pause is not the held one";
-  EXPECT_LT(largest_step, 0.02);
-  // Caught up (18 ms), the push is the one without the pause.
-  EXPECT_LT(step(paused[kPauseAt + 40], plain[kPauseAt + 40]), 0.01);
-  std::printf(
-      "a 9 ms pause lifting out: held %.4f N (%.4f N without the pause), first push %.4f N, "
-      "largest step after %.4f N; 31 ms after it %.4f N (%.4f N without)\n",
-      held[2], plain[kPauseAt + kPause - 1][2], first[2], largest_step, paused[kPauseAt + 40][2],
-      plain[kPauseAt + 40][2]);
 }
 
 // Regions restarted from rest under a sliding tool (a runaway's demotion, a move the check refused

@@ -196,7 +196,8 @@ std::string ReportText(const device::SessionReport& r) {
         r.error_percent_lowest, r.error_percent_highest,
         static_cast<long long>(r.contact_answers_error_unknown));
   } else if (r.contact_answers > 0) {
-    text << "  error reported in contact  none (the daemon has no error map)\n";
+    text
+        << "  error reported in contact  none (no error map, or none for where the regions were)\n";
   }
   text << "  flags seen                 " << FlagNames(r.flags_seen) << "\n";
   if (r.status) {
