@@ -106,9 +106,10 @@ def start_daemon(hapticsimd, scene, out, socket, error_map):
 
 
 def slides(trace):
-    """(x mm, normal N, lateral N, the error reported %) of every answer in contact in the middle
-    of a slide (a phase of 0.25 to 0.65 of its stroke: the press is done, the lift not begun), from
-    the second stroke on; and the largest force step between answers in contact from there."""
+    """(x mm, normal N, lateral N, the error reported %, its flags) of every answer in contact in
+    the middle of a slide (a phase of 0.25 to 0.65 of its stroke: the press is done, the lift not
+    begun), from the second stroke on; and the largest force step between answers in contact from
+    there."""
     points, largest_step, last = [], 0.0, None
     with open(trace) as f:
         for row in csv.DictReader(f):
@@ -123,7 +124,7 @@ def slides(trace):
             phase = (t * FREQUENCY_HZ) % 1
             if contact and 0.25 < phase < 0.65:
                 points.append((float(row["x_m"]) * 1e3, -force[2], math.hypot(force[0], force[1]),
-                               float(row["error_percent"])))
+                               float(row["error_percent"]), int(row["flags"])))
     return points, largest_step
 
 
@@ -154,11 +155,11 @@ def main():
     csv_path = os.path.join(args.out, "stroke-daemon.csv")
     with open(csv_path, "w") as f:
         f.write("x_mm,normal_force_N,lateral_force_N\n")
-        for x, normal, lateral, _ in points:
+        for x, normal, lateral, _, _ in points:
             f.write("%.6g,%.9g,%.9g\n" % (x, normal, lateral))
     plot = os.path.join(args.out, "stroke-daemon.svg")
     bins = {}  # the strokes' answers averaged per 0.5 mm of the tool's way: one curve
-    for x, normal, _, _ in points:
+    for x, normal, _, _, _ in points:
         bins.setdefault(round(x * 2) / 2, []).append(normal)
     curve = [(x, sum(v) / len(v)) for x, v in sorted(bins.items())]
     svg(curve, plot, (32.5, 47.5),
@@ -166,7 +167,7 @@ def main():
         % (STROKES - 1))
 
     def at(x_mm):
-        near = [normal for x, normal, _, _ in points if abs(x - x_mm) <= 2.5]
+        near = [normal for x, normal, _, _, _ in points if abs(x - x_mm) <= 2.5]
         return sum(near) / len(near)
 
     with open(log) as f:
@@ -179,7 +180,10 @@ def main():
         if not rates or rates[-1] != int(rate):  # a switch of the primary's size alone
             rates.append(int(rate))
     plain = (at(15.0) + at(65.0)) / 2
-    known = [error for _, _, _, error in points if error >= 0]
+    known = [error for _, _, _, error, _ in points if error >= 0]
+    # An answer without an error says why in its flags: no map (32), or none for where the regions
+    # are, the supervisor choosing again (2, error target exceeded).
+    unexplained = [1 for _, _, _, error, flags in points if error < 0 and not flags & (2 | 32)]
     print(json.dumps({"answers_in_slides": len(points), "regions_moved": moves,
                       "force_over_inclusion_N": at(40.0), "force_over_plain_tissue_N": plain,
                       "ratio": at(40.0) / plain,
@@ -190,6 +194,7 @@ def main():
                       # worst force-magnitude error where the regions were, % of the peak).
                       "error_percent_reported": [min(known), max(known)] if known else None,
                       "answers_error_unknown": len(points) - len(known),
+                      "answers_error_unknown_unflagged": len(unexplained),
                       "secondary_rates_hz_run": rates,
                       "csv": csv_path, "plot": plot},
                      indent=2))
