@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "daemon/smoothstep.hpp"
+
 namespace hapticsim {
 namespace {
 
@@ -181,7 +183,7 @@ ContactTracker::Contact ContactTracker::Advance(
   if (ramping_ && ramp_duration_ns_ > 0) {
     const double tau =
         std::min(1.0, static_cast<double>(now_ns - ramp_start_ns_) / ramp_duration_ns_);
-    weight = tau * tau * (3 - 2 * tau);
+    weight = Smoothstep(tau);
     since_s = static_cast<double>(now_ns - ramp_start_ns_) * 1e-9;
     if (tau >= 1) ramping_ = false;
   }

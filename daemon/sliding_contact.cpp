@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "core/regions/proxy_following.hpp"
+#include "daemon/smoothstep.hpp"
 
 namespace hapticsim {
 
@@ -153,13 +154,13 @@ SlidingContact::Contact SlidingContact::Answer() const noexcept {
 double SlidingContact::CatchUpLag(std::int64_t now_ns) const noexcept {
   if (catch_up_ns_ < 0 || now_ns - catch_up_ns_ >= catch_up_duration_ns_) return 0.0;
   const double tau = static_cast<double>(now_ns - catch_up_ns_) / catch_up_duration_ns_;
-  return 1.0 - tau * tau * (3 - 2 * tau);
+  return 1.0 - Smoothstep(tau);
 }
 
 double SlidingContact::RampScale(std::int64_t now_ns) const noexcept {
   if (ramp_start_ns_ < 0 || ramp_ns_ <= 0) return 1.0;
   const double tau = std::clamp(static_cast<double>(now_ns - ramp_start_ns_) / ramp_ns_, 0.0, 1.0);
-  return tau * tau * (3 - 2 * tau);
+  return Smoothstep(tau);
 }
 
 std::array<double, 3> SlidingContact::Rendered(const ProxyContact::Result& touch,
