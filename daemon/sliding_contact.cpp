@@ -8,6 +8,13 @@
 #include "daemon/smoothstep.hpp"
 
 namespace hapticsim {
+namespace {
+
+bool Pushes(const std::array<double, 3>& push) {
+  return push[0] != 0 || push[1] != 0 || push[2] != 0;
+}
+
+}  // namespace
 
 SlidingContact::SlidingContact(const ContactObject& object, const ContactSettings& settings,
                                double engage_ramp_s)
@@ -79,6 +86,7 @@ void SlidingContact::Bind(Binding binding) noexcept {
   if (binding.proxy && proxy_) binding.proxy->ContinueFrom(*proxy_);
   proxy_ = std::move(binding.proxy);
   bound_centre_ = binding.centre;
+  ++bindings_;
 }
 
 SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_m,
@@ -86,6 +94,10 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
                                                const std::optional<LatticeIndex>& centre) noexcept {
   last_tool_ = state_ == State::kEngaged ? tool_ : tip_m;
   tool_ = tip_m;
+  if (state_ == State::kEngaged && !object_.Inside(tip_m) && Pushes(pushed_n_)) {
+    Release(now_ns);  // out sideways, still pressed in: the push fades out
+  }
+  if (state_ == State::kReleasing) return Answer();  // wherever the tip goes (StepPeriod ends it)
   if (!object_.Inside(tip_m)) {
     state_ = State::kFree;
     following_ = out_of_region_ = false;
@@ -134,6 +146,7 @@ void SlidingContact::TryEngage(const std::optional<LatticeIndex>& centre,
   }
   proxy_->PlaceUnder(tool_);
   last_tool_ = stepped_tool_ = tool_;
+  pushed_n_ = {};
   state_ = State::kEngaged;
   out_of_region_ = following_ = false;
   catch_up_ns_ = -1;
@@ -142,8 +155,8 @@ void SlidingContact::TryEngage(const std::optional<LatticeIndex>& centre,
 
 SlidingContact::Contact SlidingContact::Answer() const noexcept {
   Contact contact;
-  if (state_ != State::kEngaged && state_ != State::kWaiting) return contact;
-  contact.engaged = state_ == State::kEngaged;
+  if (state_ == State::kFree || state_ == State::kAwaitLiftOff) return contact;
+  contact.engaged = state_ == State::kEngaged || state_ == State::kReleasing;
   contact.waiting = state_ == State::kWaiting || out_of_region_;
   contact.following = following_;
   contact.inward_normal = inward_;
@@ -217,6 +230,12 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     if (const auto node = NodeInsideFace(OnTouchedFace(tool_))) wanted_ = node;
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
+  // A release is over once its push has faded, or where the regions it pushed were replaced.
+  if (state_ == State::kReleasing &&
+      (ReleaseScale(now_ns) <= 0 || bindings_ != release_binding_ || !proxy_)) {
+    state_ = State::kAwaitLiftOff;
+    pushed_n_ = {};
+  }
   if (RampScale(now_ns) >= 1.0) ramp_start_ns_ = -1;
   if (catch_up_ns_ >= 0 && now_ns - catch_up_ns_ >= catch_up_duration_ns_) catch_up_ns_ = -1;
   for (int q = 1; q <= substeps; ++q) {
@@ -244,11 +263,23 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
                                        std::span<double> load) noexcept {
   std::fill(load.begin(), load.end(), 0.0);
   SlidingContact& c = contact_;
+  if (c.state_ == State::kReleasing) {  // the last push fading out where it pushed
+    const double scale = c.ReleaseScale(now_ns_);
+    for (int k = 0; k < 3; ++k) push_n[k] = scale * c.pushed_n_[k];
+    c.proxy_->SpreadLoads(push_n, load);
+    return;
+  }
   if (c.state_ != State::kEngaged || !c.proxy_) return;
   const ProxyContact::Result touch = c.proxy_->Update(tool_m, predicted, compliance, load);
   if (touch.left_surface) {
-    // Off the face's rim: released; a new touch only after the tip has left the object.
-    c.state_ = State::kAwaitLiftOff;
+    // Off the face's rim: let go, the push fading out; a new touch only after the tip has left
+    // the object.
+    c.Release(now_ns_);
+    if (c.state_ == State::kReleasing) {
+      push_n = c.pushed_n_;
+      c.proxy_->SpreadLoads(push_n, load);
+    }
+    return;
   } else if (touch.left_region) {
     c.out_of_region_ = true;  // nothing pushed until the regions are under it again
   } else if (c.out_of_region_ && touch.in_contact) {
@@ -258,7 +289,9 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
   if (c.state_ == State::kEngaged && touch.in_contact) {
     push_n = c.Rendered(touch, now_ns_);
     c.proxy_->SpreadLoads(push_n, load);
+    c.pushed_n_ = push_n;
   } else {
+    c.pushed_n_ = {};
     // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push would
     // be a force the object never gets back. The tool's lag goes with it, so a touch again in
     // the next substeps would start at the tool's full depth: it ramps in instead.
@@ -305,6 +338,24 @@ void SlidingContact::AfterPeriod() noexcept {
   }
 }
 
+void SlidingContact::Release(std::int64_t now_ns) noexcept {
+  following_ = out_of_region_ = false;
+  ramp_start_ns_ = catch_up_ns_ = -1;
+  if (!Pushes(pushed_n_) || !proxy_) {
+    state_ = State::kAwaitLiftOff;
+    pushed_n_ = {};
+    return;
+  }
+  state_ = State::kReleasing;
+  release_start_ns_ = now_ns;
+  release_binding_ = bindings_;
+}
+
+double SlidingContact::ReleaseScale(std::int64_t now_ns) const noexcept {
+  const double tau = static_cast<double>(now_ns - release_start_ns_) / kRelease_ns;
+  return tau >= 1 ? 0.0 : 1.0 - Smoothstep(std::max(0.0, tau));
+}
+
 void SlidingContact::RestartFromRest() noexcept {
   if (state_ != State::kFree) state_ = State::kAwaitLiftOff;
   following_ = out_of_region_ = false;
@@ -312,6 +363,7 @@ void SlidingContact::RestartFromRest() noexcept {
 }
 
 void SlidingContact::RestartKeepingContact() noexcept {
+  if (state_ == State::kReleasing) state_ = State::kAwaitLiftOff;  // what it pushed is gone
   if (state_ == State::kEngaged || state_ == State::kWaiting) {
     // The motion the proxy pressed into is gone: it touches again where the tool is, once regions
     // on its face can push there (TryEngage), its force ramped in. It wants the node under the

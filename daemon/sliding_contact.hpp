@@ -101,13 +101,26 @@ class SlidingContact {
   void CatchUp(std::int64_t now_ns, std::int64_t paused_ns, bool hold_expired) noexcept;
   /** The longest a push blends back after a pause (CatchUp), ns: the node contact's catch-up. */
   static constexpr std::int64_t kCatchUp_ns = ContactTracker::kCatchUp_ns;
+  /**
+   * A contact let go while it pushes — the tip gone out of the object sideways, still pressed
+   * in (past the rim of the face the proxy lags behind on), or the proxy slid off its face's rim
+   * — fades its last push out over this, by a smoothstep, on the nodes it pushed, rendered and
+   * flagged in contact meanwhile; then the tip must leave the object (if it has not) before it
+   * touches again. Let go in one period, the push stepped the hand by all of it: 0.13 N off the
+   * cube's rim 5 mm in, 0.14 N where a walk over the organ went off a step of its staircase (a
+   * push as deep as the tool goes, up to the port guard's 0.5 N a period). The node contact's
+   * slip-off time.
+   */
+  static constexpr std::int64_t kRelease_ns = ContactTracker::kSlipOff_ns;
 
   /** The regions restart from rest around a new centre: an engaged or waiting contact engages
    *  again under the tip, its force ramped in from zero. */
   void RestartKeepingContact() noexcept;
 
  private:
-  enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged };
+  // kReleasing: let go while pushing (the tip out of the object sideways, the proxy off its
+  // face's rim), the last push fading out (Release).
+  enum class State { kFree, kAwaitLiftOff, kWaiting, kEngaged, kReleasing };
   Contact Answer() const noexcept;
   // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
   // normal the face's, as a proxy needs; never a rim node), none on a held face.
@@ -118,6 +131,10 @@ class SlidingContact {
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
   double RampScale(std::int64_t now_ns) const noexcept;
+  // Lets go: the last push fades out from `now_ns` (kReleasing), or at once if there is none.
+  void Release(std::int64_t now_ns) noexcept;
+  // What is left of a released push: 1 → 0 by a smoothstep over kRelease_ns.
+  double ReleaseScale(std::int64_t now_ns) const noexcept;
   // How much of what a pause held back is still to be given back (CatchUp): 1 → 0 by a
   // smoothstep over the catch-up, 0 outside one.
   double CatchUpLag(std::int64_t now_ns) const noexcept;
@@ -162,6 +179,10 @@ class SlidingContact {
   std::int64_t catch_up_ns_ = -1;    // the push comes back from held_push_ from here (−1: none)
   std::array<double, 3> last_push_{};  // the last period's push (the one a pause holds)
   std::array<double, 3> held_push_{};  // the push a pause held, come back from (CatchUp)
+  std::array<double, 3> pushed_n_{};   // the last substep's push: a release fades it out
+  std::int64_t release_start_ns_ = 0;
+  // Bind counts the regions bound; a release spreads its push only on the ones it began on.
+  std::uint64_t bindings_ = 0, release_binding_ = 0;
   // Where the catching-up spring pulls from, less the tool (Rendered), once its first push is set.
   std::array<double, 3> catch_up_offset_m_{};
   // How far the tool moved while the regions stood still (CatchUp): the proxy's tool lags by it,

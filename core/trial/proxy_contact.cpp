@@ -258,6 +258,9 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           std::span<const double> compliance,
                                           std::span<double> loads) noexcept {
   std::fill(loads.begin(), loads.end(), 0.0);
+  // Off the face the spread of the last push is kept: a caller fading that push out spreads it
+  // there (SpreadLoads).
+  const int last_pushed = pushed_.count;
   pushed_.count = 0;
   Result result;
   Patch corners;
@@ -269,6 +272,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   const double h = surface_.spacing_m;
   if (!PatchAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !PatchAt(proxy_, &corners)) {
     result.left_surface = true;
+    pushed_.count = last_pushed;
     return result;
   }
   if (!Readable(corners)) {
@@ -297,6 +301,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     proxy_[1] += move * d[t2_] / h;
     if (!PatchAt(proxy_, &corners)) {
       result.left_surface = true;
+      pushed_.count = last_pushed;
       return result;
     }
     if (!Readable(corners) || !Reachable(corners)) {

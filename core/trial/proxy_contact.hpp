@@ -109,7 +109,8 @@ class ProxyContact {
                 std::span<const double> compliance, std::span<double> loads) noexcept;
   /** Writes to `loads` the push `force_on_object_n` spread as the last Update in contact spread
    *  its own (the same nodes and weights): a push blended or ramped by the caller. Zero loads if
-   *  the last Update pushed nothing. Never allocates. */
+   *  the last Update pushed nothing, unless it left the surface (Result::left_surface): then the
+   *  push before it is spread there, for a caller fading it out. Never allocates. */
   void SpreadLoads(const std::array<double, 3>& force_on_object_n,
                    std::span<double> loads) const noexcept;
   /** Whether a tool at `tool_m` could push here: over a face cell whose tip patch this surface

@@ -382,5 +382,44 @@ TEST(SlidingTool, RegionsMovedToAnotherFaceUnderTheToolPushNothingThereAndTheTou
   EXPECT_GT(-served.force_n[800][2], 0.3) << "the tool did not touch again on its face";
 }
 
+// The stroke on past the front face's rim (x = 0.25 m), still 5 mm in: the tool leaves the cube
+// sideways while pushing (0.13 N, the rim's edge giving way). Let go in one period, the push
+// stepped the hand by all of it; it fades out over SlidingContact::kRelease_ns instead, flagged in
+// contact, and then nothing is felt while the tool is outside.
+TEST(SlidingTool, AToolThatLeavesTheObjectSidewaysWhilePushingLetsGoSmoothly) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.input.stroke_length_m = 0.14;
+  const ContactTrajectory path(scene.input);
+  long out = -1;  // the first period with the tip past the rim
+  for (long n = 0; out < 0 && n < 10'000; ++n) {
+    if (0.125 + path.DisplacementAt(static_cast<double>(n) * 1e-3)[0] > 0.25) out = n;
+  }
+  ASSERT_GT(out, 0);
+  const Served served = Serve(scene);
+  ASSERT_GT(served.force_n.size(), static_cast<std::size_t>(out + 40));
+  const auto magnitude = [&](long n) {
+    const auto& f = served.force_n[static_cast<std::size_t>(n)];
+    return std::hypot(f[0], f[1], f[2]);
+  };
+  const double pushing = magnitude(out - 1);
+  EXPECT_GT(pushing, 0.1) << "the tool was not pushing as it left";
+  double largest_step = 0;
+  for (long n = out - 5; n < out + 40; ++n) {
+    const auto& a = served.force_n[static_cast<std::size_t>(n - 1)];
+    const auto& b = served.force_n[static_cast<std::size_t>(n)];
+    largest_step = std::max(largest_step, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+  }
+  const long released_ms = SlidingContact::kRelease_ns / 1'000'000;
+  EXPECT_GT(magnitude(out + released_ms / 2), 0.3 * pushing) << "let go at once";
+  for (long n = out + released_ms + 2; n < out + 40; ++n) {
+    EXPECT_EQ(magnitude(n), 0.0) << "a force outside the object, period " << n;
+  }
+  // A smoothstep over 20 periods changes the push by at most 1.5 / 20 = 7.5 % of it a period; at
+  // once it would be all of it.
+  EXPECT_LT(largest_step, 0.15 * pushing);
+  std::printf("off the rim: push %.3f N as the tool left, largest step after %.3f N\n",
+              magnitude(out - 1), largest_step);
+}
+
 }  // namespace
 }  // namespace hapticsim
