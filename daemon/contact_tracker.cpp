@@ -30,7 +30,7 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
   const bool after_gap = held_;
   held_ = false;
   if (!object_.Inside(tip_m)) {
-    if (SlipsOff(now_ns, after_gap)) return Advance(now_ns, centre);
+    if (SlipsOff(tip_m, now_ns, after_gap)) return Advance(now_ns, centre);
     state_ = State::kFree;
     slipping_off_ = false;
     fresh_tips_ = 0;
@@ -45,10 +45,10 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
       fresh_tips_ = 0;
       CatchUp(OwnPathNow(now_ns), now_ns);
     } else if (ramping_) {
-      // Back inside elsewhere (the next step of a staircase, a face away from its node): the
-      // node goes on back to rest, and the touch is a new one once it is there. Taken up, its
-      // node would be driven by the tip less an entry point millimetres away (on the organ: up
-      // to 0.38 N sideways, for 150 ms, at the port guard's ceiling).
+      // Back inside elsewhere (the next step of a staircase): the node goes on back to rest, and
+      // the touch is a new one once it is there. Taken up, its node would be driven by the tip
+      // less an entry point millimetres away (on the organ: up to 0.38 N sideways, for 150 ms,
+      // at the port guard's ceiling).
       return Advance(now_ns, centre);
     } else {
       slipping_off_ = false;
@@ -102,20 +102,22 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
   return Advance(now_ns, centre);
 }
 
-bool ContactTracker::SlipsOff(std::int64_t now_ns, bool after_gap) noexcept {
+bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                              bool after_gap) noexcept {
   if (state_ != State::kEngaged) return false;
   if (slipping_off_) {
     // Input back after a gap: the slip goes on from where the node was held, at rest.
     if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
     return ramping_;  // until the node is back at rest
   }
-  // Outside the object with its node away from rest: the tip went off a face sideways still
-  // pressed in (over a step of a curved object's staircase, past its rim), or lifted out through
-  // its face after dragging the node along it (the node contact does not slide). Let go at once,
-  // the node's push, inwards or sideways, would step the force.
-  double moved_squared = 0;
-  for (int c = 0; c < 3; ++c) moved_squared += displacement_[c] * displacement_[c];
-  if (moved_squared <= kDeepTouchDown_m * kDeepTouchDown_m) return false;
+  // Outside the object but still pressed along the entry face's normal: the tip went off a
+  // face sideways (over a step of a curved object's staircase, past its rim), not out of it.
+  double pressed = 0, node_depth = 0;
+  for (int c = 0; c < 3; ++c) {
+    pressed += (tip_m[c] - entry_[c]) * inward_[c];
+    node_depth += displacement_[c] * inward_[c];
+  }
+  if (pressed <= kDeepTouchDown_m || node_depth <= kDeepTouchDown_m) return false;
   slipping_off_ = true;
   StartRamp(OwnPathNow(now_ns), velocity_, kSlipOff_ns, now_ns);
   return true;

@@ -102,15 +102,12 @@ class ContactTracker {
   static constexpr double kCatchUpJump_m = 10e-6;
   static constexpr std::int64_t kCatchUp_ns = 20'000'000;
   /**
-   * A tip that leaves the object while its node is more than kDeepTouchDown_m from rest lets the
-   * node go back to rest over this, by the same smoothstep from its own path, its force rendered
-   * and flagged in contact meanwhile: one that left sideways still pressed in (over a step of a
-   * curved object's voxel staircase, past its rim), or one lifted out through its face after
-   * dragging the node along it (the node does not slide: its sideways push is still there).
-   * Let go in one period, the organ's node pressed 4.9 mm (0.56 N) sprang back at once: the port
-   * guard's slew ceiling stepped the hand by 0.5 N, and the released organ rang with 1.5 mJ more
-   * than it held before (docs/operations.md); a node dragged along its face and lifted out let
-   * go of its sideways push with the same 0.5 N step in 4 of 29 walks over the organ.
+   * A tip that leaves the object sideways while still pressed into it along the entry face's
+   * normal — over a step of a curved object's voxel staircase, past its rim — lets the node go
+   * back to rest over this, by the same smoothstep from its own path, its force rendered and
+   * flagged in contact meanwhile. Let go in one period, the organ's node pressed 4.9 mm (0.56 N)
+   * sprang back at once: the port guard's slew ceiling stepped the hand by 0.5 N, and the
+   * released organ rang with 1.5 mJ more than it held before (docs/operations.md).
    */
   static constexpr std::int64_t kSlipOff_ns = 20'000'000;
 
@@ -124,10 +121,9 @@ class ContactTracker {
   Contact Advance(std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   bool TipJumped(const std::array<double, 3>& tip_m) const noexcept;
   // Outside the object: true while an engaged contact slips off (kSlipOff_ns), starting it if
-  // its node was more than kDeepTouchDown_m from rest when the tip left (sideways still pressed
-  // in, through the far side of a part thinner than the press, or lifted out after dragging the
-  // node along its face).
-  bool SlipsOff(std::int64_t now_ns, bool after_gap) noexcept;
+  // the tip left sideways while still pressed in (or through the far side of a part thinner
+  // than the press: the test is the depth past the entry face's plane).
+  bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns, bool after_gap) noexcept;
   // A tip back inside while its node slips off came in nearest to the same node (through its
   // face, or back over the rim it went off): the contact goes on, instead of a new one.
   bool ReentersThroughOwnNode(const std::array<double, 3>& tip_m) const noexcept;
