@@ -48,7 +48,8 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
       // Back inside elsewhere (the next step of a staircase): the node goes on back to rest, and
       // the touch is a new one once it is there. Taken up, its node would be driven by the tip
       // less an entry point millimetres away (on the organ: up to 0.38 N sideways, for 150 ms,
-      // at the port guard's ceiling).
+      // at the port guard's ceiling). After a gap, from where the node was held, as outside.
+      if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
       return Advance(now_ns, centre);
     } else {
       slipping_off_ = false;
@@ -227,7 +228,8 @@ void ContactTracker::RestartFromRest() noexcept {
 }
 
 void ContactTracker::RestartKeepingContact() noexcept {
-  // Slipping off, the tip is outside: nothing to engage again.
+  // Slipping off, the node was let go (the tip outside, or back inside elsewhere): nothing to
+  // engage again (a tip inside touches down afresh at the next Update).
   if (slipping_off_) {
     state_ = State::kFree;
   } else if (state_ == State::kEngaged) {

@@ -124,8 +124,10 @@ class ContactTracker {
   // the tip left sideways while still pressed in (or through the far side of a part thinner
   // than the press: the test is the depth past the entry face's plane).
   bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns, bool after_gap) noexcept;
-  // A tip back inside while its node slips off came in nearest to the same node (through its
-  // face, or back over the rim it went off): the contact goes on, instead of a new one.
+  // A tip back inside while its node slips off came in nearest to the node it touched: the
+  // contact goes on, instead of a new one. (Back over the rim it went off is such a touch on the
+  // cube's 20.8 mm lattice; on finer ones a tip pressed in deeper than half a voxel comes back
+  // through the side face nearest the next node: a new touch, once the old node is at rest.)
   bool ReentersThroughOwnNode(const std::array<double, 3>& tip_m) const noexcept;
   // Where the node's own path has taken it by now: on from the last period at its velocity.
   std::array<double, 3> OwnPathNow(std::int64_t now_ns) const noexcept;

@@ -162,7 +162,11 @@ std::array<double, 3> HapticLoop::PeriodReaction(bool usable, bool holding,
                                                  std::int64_t release_ns,
                                                  std::int32_t* flags) noexcept {
   watched_this_period_ = false;  // until WatchEnergyBalance runs on these regions below
-  if (!usable) return holding ? held_reaction_ : std::array<double, 3>{};
+  if (!usable) {
+    // Paused under a push let go, its fade goes on (SlidingContact::ReleasingPush), not held.
+    if (holding && sliding_ && sliding_->releasing()) return sliding_->ReleasingPush(release_ns);
+    return holding ? held_reaction_ : std::array<double, 3>{};
+  }
   std::array<double, 3> reaction{};
   // Asleep, the regions are exactly at rest at time 0: a touch steps on from there in this very
   // period, with the secondaries restarted on this release.

@@ -94,7 +94,7 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
                                                const std::optional<LatticeIndex>& centre) noexcept {
   last_tool_ = state_ == State::kEngaged ? tool_ : tip_m;
   tool_ = tip_m;
-  if (state_ == State::kEngaged && !object_.Inside(tip_m) && Pushes(pushed_n_)) {
+  if (state_ == State::kEngaged && !object_.Inside(tip_m) && PressedIn(tip_m)) {
     Release(now_ns);  // out sideways, still pressed in: the push fades out
   }
   if (state_ == State::kReleasing) return Answer();  // wherever the tip goes (StepPeriod ends it)
@@ -231,8 +231,7 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
   // A release is over once its push has faded, or where the regions it pushed were replaced.
-  if (state_ == State::kReleasing &&
-      (ReleaseScale(now_ns) <= 0 || bindings_ != release_binding_ || !proxy_)) {
+  if (state_ == State::kReleasing && ReleaseScale(now_ns) <= 0) {
     state_ = State::kAwaitLiftOff;
     pushed_n_ = {};
   }
@@ -263,10 +262,13 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
                                        std::span<double> load) noexcept {
   std::fill(load.begin(), load.end(), 0.0);
   SlidingContact& c = contact_;
-  if (c.state_ == State::kReleasing) {  // the last push fading out where it pushed
-    const double scale = c.ReleaseScale(now_ns_);
-    for (int k = 0; k < 3; ++k) push_n[k] = scale * c.pushed_n_[k];
-    c.proxy_->SpreadLoads(push_n, load);
+  if (c.state_ == State::kReleasing) {
+    // The last push fading out where it pushed, on the regions it pushed; on regions bound since
+    // (a move's pause under the release) the user's fade goes on, the object free meanwhile: its
+    // push was held through the pause already (HapticLoop), and ending the fade there would drop
+    // what is left of it at once.
+    push_n = c.ReleasingPush(now_ns_);
+    if (c.proxy_ && c.bindings_ == c.pushed_binding_) c.proxy_->SpreadLoads(push_n, load);
     return;
   }
   if (c.state_ != State::kEngaged || !c.proxy_) return;
@@ -290,6 +292,7 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
     push_n = c.Rendered(touch, now_ns_);
     c.proxy_->SpreadLoads(push_n, load);
     c.pushed_n_ = push_n;
+    c.pushed_binding_ = c.bindings_;
   } else {
     c.pushed_n_ = {};
     // Nothing pushed (Update left the loads zero), nothing felt: a blend from a held push would
@@ -339,16 +342,31 @@ void SlidingContact::AfterPeriod() noexcept {
 }
 
 void SlidingContact::Release(std::int64_t now_ns) noexcept {
+  // Only what the primary thread owns: Update calls this while Bind may be writing proxy_.
   following_ = out_of_region_ = false;
   ramp_start_ns_ = catch_up_ns_ = -1;
-  if (!Pushes(pushed_n_) || !proxy_) {
+  if (!Pushes(pushed_n_)) {
     state_ = State::kAwaitLiftOff;
-    pushed_n_ = {};
     return;
   }
   state_ = State::kReleasing;
   release_start_ns_ = now_ns;
-  release_binding_ = bindings_;
+}
+
+std::array<double, 3> SlidingContact::ReleasingPush(std::int64_t now_ns) const noexcept {
+  if (state_ != State::kReleasing) return {};
+  const double scale = ReleaseScale(now_ns);
+  return {scale * pushed_n_[0], scale * pushed_n_[1], scale * pushed_n_[2]};
+}
+
+bool SlidingContact::PressedIn(const std::array<double, 3>& tip_m) const noexcept {
+  // The tip's depth past the touched face's plane, as ContactTracker::SlipsOff tests it: a tip
+  // lifted straight out is not (its push is the spring's last, near nothing).
+  double depth = 0;
+  for (int c = 0; c < 3; ++c) {
+    if (inward_[c] != 0) depth = (tip_m[c] - face_m_) * inward_[c];
+  }
+  return depth > ContactTracker::kDeepTouchDown_m;
 }
 
 double SlidingContact::ReleaseScale(std::int64_t now_ns) const noexcept {

@@ -31,7 +31,9 @@ namespace hapticsim {
  *
  * A proxy that slides out of the primary (the regions did not follow in time) pushes nothing
  * (zero force, "waiting") and asks for the regions at once; one that slides off the face's rim
- * releases the contact, and the tip must leave the object before it touches again.
+ * releases the contact, and the tip must leave the object before it touches again. Released
+ * while it pushes — off the rim, or the tip out of the object sideways still pressed in — its last
+ * push fades out over kRelease_ns first (kReleasing, engaged meanwhile).
  *
  * Threads: Prepare is any thread's; Bind is the supervisor's, while the primary leaves the
  * regions alone (HapticLoop::Install); everything else is the primary thread's, never allocates,
@@ -84,6 +86,10 @@ class SlidingContact {
   std::optional<LatticeIndex> wanted_node() const { return wanted_; }
   /** True while the tip is outside the object (or before the first input). */
   bool outside() const { return state_ == State::kFree; }
+  /** While a push let go fades out (kRelease_ns): what is left of it at `now_ns`, N; zero
+   *  otherwise. What a pause of the regions renders then, instead of the push held. */
+  std::array<double, 3> ReleasingPush(std::int64_t now_ns) const noexcept;
+  bool releasing() const { return state_ == State::kReleasing; }
 
   /** The regions restart from rest: any contact is released and must lift off first. */
   void RestartFromRest() noexcept;
@@ -102,8 +108,9 @@ class SlidingContact {
   /** The longest a push blends back after a pause (CatchUp), ns: the node contact's catch-up. */
   static constexpr std::int64_t kCatchUp_ns = ContactTracker::kCatchUp_ns;
   /**
-   * A contact let go while it pushes — the tip gone out of the object sideways, still pressed
-   * in (past the rim of the face the proxy lags behind on), or the proxy slid off its face's rim
+   * A contact let go while it pushes — the tip gone out of the object sideways, still more than
+   * ContactTracker::kDeepTouchDown_m past the face's plane (past the rim of the face the proxy
+   * lags behind on), or the proxy slid off its face's rim
    * — fades its last push out over this, by a smoothstep, on the nodes it pushed, rendered and
    * flagged in contact meanwhile; then the tip must leave the object (if it has not) before it
    * touches again. Let go in one period, the push stepped the hand by all of it: 0.13 N off the
@@ -133,6 +140,8 @@ class SlidingContact {
   double RampScale(std::int64_t now_ns) const noexcept;
   // Lets go: the last push fades out from `now_ns` (kReleasing), or at once if there is none.
   void Release(std::int64_t now_ns) noexcept;
+  // The tip more than ContactTracker::kDeepTouchDown_m past the touched face's plane.
+  bool PressedIn(const std::array<double, 3>& tip_m) const noexcept;
   // What is left of a released push: 1 → 0 by a smoothstep over kRelease_ns.
   double ReleaseScale(std::int64_t now_ns) const noexcept;
   // How much of what a pause held back is still to be given back (CatchUp): 1 → 0 by a
@@ -181,8 +190,9 @@ class SlidingContact {
   std::array<double, 3> held_push_{};  // the push a pause held, come back from (CatchUp)
   std::array<double, 3> pushed_n_{};   // the last substep's push: a release fades it out
   std::int64_t release_start_ns_ = 0;
-  // Bind counts the regions bound; a release spreads its push only on the ones it began on.
-  std::uint64_t bindings_ = 0, release_binding_ = 0;
+  // Bind counts the regions bound (the primary reads the count only on regions that are its
+  // own); a release spreads its push only on the ones that push was pushed on.
+  std::uint64_t bindings_ = 0, pushed_binding_ = 0;  // that pushed_n_ was pushed on
   // Where the catching-up spring pulls from, less the tool (Rendered), once its first push is set.
   std::array<double, 3> catch_up_offset_m_{};
   // How far the tool moved while the regions stood still (CatchUp): the proxy's tool lags by it,

@@ -211,6 +211,34 @@ TEST(ProxyContact, ATipsLoadsSumToItsForceSymmetricallyAndANarrowTipIsTheCells) 
   EXPECT_EQ(loads_of(0.9 * h, off), loads_of(0.0, off));
 }
 
+// A tool that goes past the face's rim leaves the surface the proxy can render: nothing is pushed
+// in that update, but the last push's nodes and weights are kept, so that a caller fading that
+// push out (SlidingContact's release) spreads it where it was pushed, summing to the push.
+TEST(ProxyContact, OffTheFaceTheLastPushsSpreadIsKeptForAPushFadingOut) {
+  Scene scene = Stroke(0.5, 0.4);
+  scene.mesh.nodes = 9;
+  const SceneModel object(scene);
+  const ElasticModel& model = object.model();
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(model.grid().num_dofs());
+  ProxyContact proxy(model, object.contact_node(), object.contact_normal(), scene.contact);
+  std::vector<double> loads(proxy.loaded_dofs().size(), 0.0), pushed(loads.size(), 0.0);
+  const std::vector<double> compliance(loads.size(), 1e-6);
+  const std::array<double, 3> start = proxy.start_m();
+  ASSERT_TRUE(
+      proxy.Update({start[0], start[1], start[2] + 0.002}, u, compliance, pushed).in_contact);
+  const ProxyContact::Result off =
+      proxy.Update({start[0] + 1.0, start[1], start[2] + 0.002}, u, compliance, loads);
+  ASSERT_TRUE(off.left_surface);
+  EXPECT_TRUE(std::all_of(loads.begin(), loads.end(), [](double l) { return l == 0; }));
+  proxy.SpreadLoads({0.0, 0.0, 0.5}, loads);
+  double sum = 0;
+  for (std::size_t i = 2; i < loads.size(); i += 3) {
+    sum += loads[i];
+    EXPECT_EQ(loads[i] > 0, pushed[i] > 0) << "another node than the last push's, DOF " << i;
+  }
+  EXPECT_NEAR(sum, 0.5, 1e-12);
+}
+
 TEST(StrokeTrial, KineticFrictionAboveStaticIsRefused) {
   Scene scene = Stroke(0.3, 0.4);
   EXPECT_THROW(ValidateScene(scene), Error);

@@ -42,16 +42,18 @@ Scene Stroke(double static_mu, double kinetic_mu) {
 
 struct Served {
   std::vector<std::array<double, 3>> force_n;  // sent to the device, one per period
+  std::vector<std::int32_t> flags;             // of each
   int moves = 0;                               // the regions followed the proxy
   double largest_step_n = 0;
 };
 
-// The stroke's path played as device input, one period each, the regions moved (motion carried)
-// before any period the loop asks them to follow; `before(n, loop)` runs first (another
-// supervisor's act).
+// The stroke's path (or `tip_at(n)`'s) played as device input, one period each, the regions moved
+// (motion carried) before any period the loop asks them to follow; `before(n, loop)` runs first
+// (another supervisor's act).
 Served Serve(
     const Scene& scene,
-    const std::function<void(long, HapticLoop&)>& before = [](long, HapticLoop&) {}) {
+    const std::function<void(long, HapticLoop&)>& before = [](long, HapticLoop&) {},
+    const std::function<std::array<double, 3>(long)>& tip_at = {}) {
   HapticLoop loop(scene, HapticLoop::Options{});
   const ContactTrajectory path(scene.input);
   const long periods = std::lround(scene.duration_s() / scene.solver.dt_s);
@@ -70,6 +72,7 @@ Served Serve(
     std::array<double, 3> tip = {0.125, 0.125, 0.0};
     const std::array<double, 3> moved = path.DisplacementAt(static_cast<double>(n) * 1e-3);
     for (int c = 0; c < 3; ++c) tip[c] += moved[c];
+    if (tip_at) tip = tip_at(n);
     testing::PlayPeriodInVirtualTime(loop, release, DeviceSample{n, release, tip, false});
     ForceRecord record;
     while (loop.forces().Pop(&record)) {
@@ -80,6 +83,7 @@ Served Serve(
             std::max(served.largest_step_n, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
       }
       served.force_n.push_back(record.force_n);
+      served.flags.push_back(record.flags);
     }
   }
   return served;
@@ -411,6 +415,10 @@ TEST(SlidingTool, AToolThatLeavesTheObjectSidewaysWhilePushingLetsGoSmoothly) {
   }
   const long released_ms = SlidingContact::kRelease_ns / 1'000'000;
   EXPECT_GT(magnitude(out + released_ms / 2), 0.3 * pushing) << "let go at once";
+  for (long n = out; n < out + released_ms - 1; ++n) {
+    EXPECT_TRUE(served.flags[static_cast<std::size_t>(n)] & force_flags::kInContact)
+        << "a fading push not flagged in contact, period " << n;
+  }
   for (long n = out + released_ms + 2; n < out + 40; ++n) {
     EXPECT_EQ(magnitude(n), 0.0) << "a force outside the object, period " << n;
   }
@@ -419,6 +427,38 @@ TEST(SlidingTool, AToolThatLeavesTheObjectSidewaysWhilePushingLetsGoSmoothly) {
   EXPECT_LT(largest_step, 0.15 * pushing);
   std::printf("off the rim: push %.3f N as the tool left, largest step after %.3f N\n",
               magnitude(out - 1), largest_step);
+}
+
+// A tool lifted straight out lets go at once, with no fade: the tissue is pressed in behind the
+// face's plane, so the spring has let go before the tip leaves the object, and only a tip still
+// more than 0.5 mm past the plane releases by a fade (SlidingContact::PressedIn). Back in 3 ms
+// later it touches again at once. A lift-off that faded would have left a tip back inside within
+// the fade waiting, pushing nothing, for a lift-off it had already made.
+TEST(SlidingTool, AToolLiftedStraightOutAndBackInAtOnceTouchesAgain) {
+  Scene scene = Stroke(0.5, 0.4);
+  const auto tip_at = [](long n) -> std::array<double, 3> {
+    double z = 0;
+    if (n < 100)
+      z = -0.001 + 4e-5 * n;  // in to 3 mm at 40 mm/s
+    else if (n < 200)
+      z = 0.003;  // held
+    else if (n < 235)
+      z = 0.003 - 1e-4 * (n - 200);  // out at 0.1 m/s, to −0.5 mm
+    else if (n < 238)
+      z = -0.0005;  // 3 ms out
+    else
+      z = std::min(0.002, -0.0005 + 1e-4 * (n - 238));  // back in, to 2 mm
+    return {0.125, 0.125, z};
+  };
+  const Served served = Serve(
+      scene, [](long, HapticLoop&) {}, tip_at);
+  ASSERT_GT(served.force_n.size(), 400u);
+  for (long n = 232; n < 238; ++n) {  // the tip out from 230 on: nothing rendered out there
+    const auto& f = served.force_n[static_cast<std::size_t>(n)];
+    if (tip_at(n)[2] < 0) EXPECT_LT(std::hypot(f[0], f[1], f[2]), 0.02) << "period " << n;
+  }
+  EXPECT_GT(-served.force_n[400][2], 0.2) << "the tool back in did not touch again";
+  EXPECT_TRUE(served.flags[400] & force_flags::kInContact);
 }
 
 }  // namespace
