@@ -230,7 +230,7 @@ std::array<double, 3> SlidingContact::StepPeriod(AsyncRegions& regions,
     if (const auto node = NodeInsideFace(OnTouchedFace(tool_))) wanted_ = node;
   }
   if (state_ == State::kWaiting) TryEngage(bound_centre_, now_ns);
-  // A release is over once its push has faded, or where the regions it pushed were replaced.
+  // A release is over once its push has faded.
   if (state_ == State::kReleasing && ReleaseScale(now_ns) <= 0) {
     state_ = State::kAwaitLiftOff;
     pushed_n_ = {};
@@ -264,9 +264,9 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
   SlidingContact& c = contact_;
   if (c.state_ == State::kReleasing) {
     // The last push fading out where it pushed, on the regions it pushed; on regions bound since
-    // (a move's pause under the release) the user's fade goes on, the object free meanwhile: its
-    // push was held through the pause already (HapticLoop), and ending the fade there would drop
-    // what is left of it at once.
+    // (a move's pause under the release, through which HapticLoop rendered the fade too) the
+    // user's fade goes on, the object free meanwhile: ending it there would drop what is left of
+    // it at once.
     push_n = c.ReleasingPush(now_ns_);
     if (c.proxy_ && c.bindings_ == c.pushed_binding_) c.proxy_->SpreadLoads(push_n, load);
     return;
@@ -361,7 +361,8 @@ std::array<double, 3> SlidingContact::ReleasingPush(std::int64_t now_ns) const n
 
 bool SlidingContact::PressedIn(const std::array<double, 3>& tip_m) const noexcept {
   // The tip's depth past the touched face's plane, as ContactTracker::SlipsOff tests it: a tip
-  // lifted straight out is not (its push is the spring's last, near nothing).
+  // lifted straight out is not (the tissue pressed in behind the plane, its spring let go before
+  // the tip left).
   double depth = 0;
   for (int c = 0; c < 3; ++c) {
     if (inward_[c] != 0) depth = (tip_m[c] - face_m_) * inward_[c];
