@@ -417,10 +417,14 @@ TEST(HapticLoopReconfigure, ASlidingToolsRegionsFollowItWithTheForceHeldAndBlend
   supervisor.join();
   loop.Stop();
   EXPECT_GE(moves, 2) << "the regions did not follow the proxy across the face";
-  int held = 0;
-  double largest = 0;
+  int held = 0, late = 0;
+  double largest = 0, largest_late = 0;
   const ForceRecord* last = nullptr;
+  bool last_late = false;
   for (const ForceRecord& f : forces) {
+    // A period that woke late took more than one input, or came more than 1.5 periods after the
+    // last: the tool moved two periods' worth in it (and back to one in the next).
+    const bool woke_late = last && (f.seq > f.first_seq || f.utime_us - last->utime_us > 1500);
     ASSERT_TRUE(std::isfinite(f.force_n[0] + f.force_n[1] + f.force_n[2]));
     const bool in_contact = f.flags & force_flags::kInContact;
     if (in_contact && (f.flags & force_flags::kReconfiguring)) {
@@ -430,19 +434,30 @@ TEST(HapticLoopReconfigure, ASlidingToolsRegionsFollowItWithTheForceHeldAndBlend
       }
     }
     if (last && in_contact && (last->flags & force_flags::kInContact)) {
-      largest = std::max(
-          largest, std::hypot(f.force_n[0] - last->force_n[0], f.force_n[1] - last->force_n[1],
-                              f.force_n[2] - last->force_n[2]));
+      const double step =
+          std::hypot(f.force_n[0] - last->force_n[0], f.force_n[1] - last->force_n[1],
+                     f.force_n[2] - last->force_n[2]);
+      if (woke_late || last_late) {
+        ++late;
+        largest_late = std::max(largest_late, step);
+      } else {
+        largest = std::max(largest, step);
+      }
     }
     last = &f;
+    last_late = woke_late;
   }
-  std::printf("sliding on threads: %d moves, %d periods held, largest step %.4f N\n", moves.load(),
-              held, largest);
+  std::printf(
+      "sliding on threads: %d moves, %d periods held, largest step %.4f N (%.4f N in %d steps "
+      "about a late wake)\n",
+      moves.load(), held, largest, largest_late, late);
   if (kSanitized) return;
   EXPECT_GT(held, 0) << "no period was answered while the regions moved";
-  // Late wakes step a sliding force too (the tool moved two periods' worth): the soak's 0.2 N is
-  // the bound beside load; here, on a quiet machine, the smoothness checks' 0.1 N.
+  // Periods on time, across the moves' holds and blends: the smoothness checks' 0.1 N. Late wakes
+  // step a sliding force too (the tool moved two periods' worth): the soak's 0.2 N, its bound
+  // beside load. (Once in a full suite, 0.164 N, where the test did not yet tell them apart.)
   EXPECT_LE(largest, 0.1);
+  EXPECT_LE(largest_late, 0.2);
 }
 
 }  // namespace
