@@ -44,12 +44,11 @@ ContactTracker::Contact ContactTracker::Update(const std::array<double, 3>& tip_
       slipping_off_ = false;
       fresh_tips_ = 0;
       CatchUp(OwnPathNow(now_ns), now_ns);
-    } else if (ramping_) {
+    } else if (GoesOnSlipping(now_ns, after_gap)) {
       // Back inside elsewhere (the next step of a staircase): the node goes on back to rest, and
       // the touch is a new one once it is there. Taken up, its node would be driven by the tip
       // less an entry point millimetres away (on the organ: up to 0.38 N sideways, for 150 ms,
-      // at the port guard's ceiling). After a gap, from where the node was held, as outside.
-      if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
+      // at the port guard's ceiling).
       return Advance(now_ns, centre);
     } else {
       slipping_off_ = false;
@@ -106,11 +105,7 @@ ContactTracker::Contact ContactTracker::Hold(std::int64_t now_ns,
 bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns,
                               bool after_gap) noexcept {
   if (state_ != State::kEngaged) return false;
-  if (slipping_off_) {
-    // Input back after a gap: the slip goes on from where the node was held, at rest.
-    if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
-    return ramping_;  // until the node is back at rest
-  }
+  if (slipping_off_) return GoesOnSlipping(now_ns, after_gap);
   // Outside the object but still pressed along the entry face's normal: the tip went off a
   // face sideways (over a step of a curved object's staircase, past its rim), not out of it.
   double pressed = 0, node_depth = 0;
@@ -122,6 +117,12 @@ bool ContactTracker::SlipsOff(const std::array<double, 3>& tip_m, std::int64_t n
   slipping_off_ = true;
   StartRamp(OwnPathNow(now_ns), velocity_, kSlipOff_ns, now_ns);
   return true;
+}
+
+bool ContactTracker::GoesOnSlipping(std::int64_t now_ns, bool after_gap) noexcept {
+  // Input back after a gap: the slip goes on from where the node was held, at rest.
+  if (after_gap) StartRamp(displacement_, {0, 0, 0}, kSlipOff_ns, now_ns);
+  return ramping_;  // until the node is back at rest
 }
 
 bool ContactTracker::ReentersThroughOwnNode(const std::array<double, 3>& tip_m) const noexcept {

@@ -124,6 +124,9 @@ class ContactTracker {
   // the tip left sideways while still pressed in (or through the far side of a part thinner
   // than the press: the test is the depth past the entry face's plane).
   bool SlipsOff(const std::array<double, 3>& tip_m, std::int64_t now_ns, bool after_gap) noexcept;
+  // A slip under way goes on (after an input gap, from where the node was held): true until the
+  // node is back at rest.
+  bool GoesOnSlipping(std::int64_t now_ns, bool after_gap) noexcept;
   // A tip back inside while its node slips off came in nearest to the node it touched: the
   // contact goes on, instead of a new one. (Back over the rim it went off is such a touch on the
   // cube's 20.8 mm lattice; on finer ones a tip pressed in deeper than half a voxel comes back

@@ -234,6 +234,15 @@ TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
   EXPECT_NEAR(tracker.Update(tip, 101 * kMs, middle).displacement_m[2], 0.01, 1e-15);
 }
 
+// A touch at x (by the cube's side edge, y = 0.125) on `node`, 3 mm in over 30 periods and held
+// for 30; the time of the last period.
+std::int64_t PressThreeMillimetresIn(ContactTracker& tracker, double x, const LatticeIndex& node) {
+  tracker.Update({x, 0.125, -0.001}, 0, node);
+  std::int64_t t = 0;
+  for (int n = 1; n <= 60; ++n) tracker.Update({x, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, node);
+  return t;
+}
+
 // A tip that goes off the object sideways while pressed in (here past the cube's side edge, 3 mm
 // deep; on a curved object over a step of its voxel staircase) lets the node go back to rest over
 // kSlipOff_ns, in contact meanwhile, instead of dropping it in one period; one going straight out
@@ -241,11 +250,7 @@ TEST(ContactTracker, ADeepTouchDownRampsInFromZero) {
 TEST(ContactTracker, ATipThatGoesOffSidewaysPressedInLetsTheNodeGoBackToRestSmoothly) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex edge{12, 6, 0};  // on the side edge x = 0.25
-  tracker.Update({0.2495, 0.125, -0.001}, 0, edge);
-  std::int64_t t = 0;
-  for (int n = 1; n <= 60; ++n) {  // 3 mm in, then held
-    tracker.Update({0.2495, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
-  }
+  std::int64_t t = PressThreeMillimetresIn(tracker, 0.2495, edge);
   // Sideways at 5 mm/s (a step of 5 µm a period: no jump to catch up with), 3 mm deep: out of
   // the cube after 100 periods.
   double previous = 0.003, previous_step = 0, largest_change = 0;
@@ -281,11 +286,7 @@ TEST(ContactTracker, ATipThatGoesOffSidewaysPressedInLetsTheNodeGoBackToRestSmoo
 TEST(ContactTracker, BackInsideElsewhereWhileSlippingOffIsANewTouchOnceTheNodeIsAtRest) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex edge{12, 6, 0};  // on the side edge x = 0.25
-  tracker.Update({0.2495, 0.125, -0.001}, 0, edge);
-  std::int64_t t = 0;
-  for (int n = 1; n <= 60; ++n) {  // 3 mm in, then held
-    tracker.Update({0.2495, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
-  }
+  std::int64_t t = PressThreeMillimetresIn(tracker, 0.2495, edge);
   std::vector<double> depth;        // the node's, from the last period inside on
   for (int n = 1; n <= 102; ++n) {  // sideways at 5 mm/s, out over the edge: the node slips off
     const auto c = tracker.Update({0.2495 + 5e-6 * n, 0.125, 0.003}, t += kMs, edge);
@@ -318,11 +319,7 @@ TEST(ContactTracker, BackInsideElsewhereWhileSlippingOffIsANewTouchOnceTheNodeIs
 TEST(ContactTracker, BackInsideWhileSlippingOffTheNodeCatchesUpWithTheTipAgain) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex edge{12, 6, 0};
-  tracker.Update({0.2497, 0.125, -0.001}, 0, edge);
-  std::int64_t t = 0;
-  for (int n = 1; n <= 60; ++n) {  // 3 mm in, then held
-    tracker.Update({0.2497, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
-  }
+  std::int64_t t = PressThreeMillimetresIn(tracker, 0.2497, edge);
   // Sideways at 5 mm/s, out over the edge for 9 periods, then back in along the same line.
   double previous = 0.003, previous_step = 0, largest_change = 0, d = 0;
   double shallowest = 0.003;
@@ -354,11 +351,7 @@ TEST(ContactTracker, BackInsideWhileSlippingOffTheNodeCatchesUpWithTheTipAgain) 
 TEST(ContactTracker, AGapWhileSlippingOffGoesOnFromWhereTheNodeWasHeld) {
   ContactTracker tracker(CubeBox(), 0.1);
   const LatticeIndex edge{12, 6, 0};
-  tracker.Update({0.2495, 0.125, -0.001}, 0, edge);
-  std::int64_t t = 0;
-  for (int n = 1; n <= 60; ++n) {
-    tracker.Update({0.2495, 0.125, 1e-4 * std::min(n, 30)}, t += kMs, edge);
-  }
+  std::int64_t t = PressThreeMillimetresIn(tracker, 0.2495, edge);
   std::array<double, 3> tip{};
   double d = 0.003;
   for (int n = 1; n <= 105; ++n) {  // out of the cube from the 101st period: 5 periods slipping
