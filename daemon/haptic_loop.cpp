@@ -133,6 +133,7 @@ void HapticLoop::PrimaryPeriod(std::int64_t release_ns, std::int64_t now_ns) noe
     flags |= force_flags::kInContact;
     counters_.last_contact_ns.Set(now_ns);
   }
+  counters_.in_contact.Set(in_contact);
   PublishPeriod(now_ns, sent.force_n, simulated_n, flags);
 }
 

@@ -159,7 +159,7 @@ class HapticLoop {
     std::int64_t configuration_id = -1;
     AdaptivitySettings configuration;    ///< the regions' (primary_size, secondary_lod, rates)
     LatticeIndex centre{};               ///< the node the regions are centred on
-    bool in_contact = false;             ///< the tool engaged within the last 5 primary periods
+    bool in_contact = false;             ///< the newest period, or one of the last 5, engaged
     /// The surface nodes on the wire's lattice (ContactObject::ToWireIds of
     /// AsyncRegions::surface_ids, the same for every configuration): id = (ix · n + iy) · n + iz, n
     /// = nodes_per_axis.

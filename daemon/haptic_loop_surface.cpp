@@ -44,8 +44,12 @@ bool HapticLoop::TakeSurface(std::int64_t max_wait_ns, SurfaceFrame* frame) {
     }
     std::this_thread::sleep_for(kPoll);
   }
+  // In contact as the newest period answered, whenever that was: a primary woken late beside a
+  // busy neighbour has not let go. The five periods bridge a reconfiguration's pause that was not
+  // held, where one period answers out of contact.
   const double primary_period_ns = primary_period_ns_;
   frame->in_contact =
+      counters_.in_contact.value() ||
       NowNs() - last_contact_ns() <= static_cast<std::int64_t>(5 * primary_period_ns);
   return true;
 }

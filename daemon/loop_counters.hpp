@@ -52,6 +52,7 @@ struct LoopCounters {
   RelaxedCount limited_periods;      ///< the port guard limited the force (kForceLimited)
   RelaxedCount dissipating_periods;  ///< the port guard dissipated energy (kPortDissipating)
   Relaxed<std::int64_t> last_contact_ns;  ///< CLOCK_MONOTONIC of the last in contact (0: never)
+  Relaxed<bool> in_contact;               ///< the newest period answered in contact
 
   // The port guard.
   RelaxedCount force_faults;  ///< faults latched

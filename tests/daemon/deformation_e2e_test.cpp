@@ -191,7 +191,8 @@ TEST(HapticsimdDeformation, ThePressedSurfaceComesOutAtItsRateWithTheToolsDepthA
       const auto support = NodeDisplacement(d, ids, kSupport);
       const auto corner = NodeDisplacement(d, ids, kFrontCorner);
       ASSERT_TRUE(touched && support && corner);
-      EXPECT_TRUE(d.in_contact);
+      EXPECT_TRUE(d.in_contact) << "frame " << d.frame << ", " << since_press
+                                << " s into the press";
       // The touched node is where the tool is (the daemon follows the tip within a few periods).
       EXPECT_NEAR((*touched)[2], kDepth, 5e-4) << "frame " << d.frame;
       EXPECT_LT(std::abs((*touched)[0]) + std::abs((*touched)[1]), 1e-4);
