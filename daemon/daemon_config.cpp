@@ -77,6 +77,7 @@ void AddDeviceAndRealtimeKeys(SetterMap& s) {
   port("device.max_force_n", &PortGuardSettings::max_force_n);
   port("device.max_force_rate_n_per_ms", &PortGuardSettings::max_force_rate_n_per_ms);
   port("device.engage_rate_n_per_ms", &PortGuardSettings::engage_rate_n_per_ms);
+  port("device.lift_off_rate_n_per_ms", &PortGuardSettings::lift_off_rate_n_per_ms);
   port("device.fault_force_n", &PortGuardSettings::fault_force_n);
   port("device.watchdog_s", &PortGuardSettings::watchdog_s);
   port("device.max_damping_n_s_per_m", &PortGuardSettings::max_damping_n_s_per_m);
@@ -177,6 +178,12 @@ void ValidatePortGuard(const PortGuardSettings& p) {
           "device.engage_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
               FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
               FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" + value(p.engage_rate_n_per_ms));
+  require(
+      std::isfinite(p.lift_off_rate_n_per_ms) && p.lift_off_rate_n_per_ms >= p.max_force_n / 1000 &&
+          p.lift_off_rate_n_per_ms <= p.max_force_rate_n_per_ms,
+      "device.lift_off_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
+          FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
+          FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" + value(p.lift_off_rate_n_per_ms));
   require(
       std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n && p.fault_force_n <= 1000,
       "device.fault_force_n must be from device.max_force_n (" + FormatReal(p.max_force_n) +
@@ -451,6 +458,8 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "max_force_n = " << real(c.port.max_force_n) << "\n"
       << "max_force_rate_n_per_ms = " << real(c.port.max_force_rate_n_per_ms) << "\n"
       << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"
+      << "lift_off_rate_n_per_ms = " << real(c.port.lift_off_rate_n_per_ms)
+      << "  # a lift-off's release (the engage ramp's if that is faster)\n"
       << "fault_force_n = " << real(c.port.fault_force_n) << "\n"
       << "watchdog_s = " << real(c.port.watchdog_s) << "\n"
       << "passivity = " << (c.port.passivity ? "true" : "false") << "\n"

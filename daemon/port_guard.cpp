@@ -147,9 +147,14 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
     }
   } else if (Norm(sent_) > 0) {
     engaging_ = true;  // releasing: to zero
-    // Lift-off (the tool left the object) releases as fast as the slew allows; a fault, stale
-    // input or paused regions at the engage rate, since the tool may still be pressing.
-    if (!in.engaged && !latched_) release_step = settings_.max_force_rate_n_per_ms * elapsed_ms;
+    // Lift-off (the tool left the object) releases faster than the engage ramp, but not at the
+    // slew ceiling: a node dragged along its face and lifted out still pulls sideways (0.5 N on
+    // the organ's walk), and dropping that at once is a step the hand feels. A fault, stale input
+    // or paused regions release at the engage rate, since the tool may still be pressing.
+    if (!in.engaged && !latched_) {
+      release_step =
+          std::max(settings_.lift_off_rate_n_per_ms, settings_.engage_rate_n_per_ms) * elapsed_ms;
+    }
   }
   rendering_before_ = rendering;
 

@@ -13,6 +13,7 @@ struct PortGuardSettings {
   double max_force_n = 8.0;              ///< magnitude ceiling: larger forces are saturated
   double max_force_rate_n_per_ms = 0.5;  ///< slew ceiling between consecutive periods, N per ms
   double engage_rate_n_per_ms = 0.05;    ///< engaging and releasing ramp (from and to zero)
+  double lift_off_rate_n_per_ms = 0.1;   ///< a lift-off's release (or the engage ramp's if faster)
   double fault_force_n = 50.0;           ///< a simulated force above this is a divergence: fault
   double watchdog_s = 0.2;               ///< a primary gap this long while sending force: fault
   bool passivity = true;                 ///< time-domain passivity observer and controller
@@ -39,8 +40,10 @@ struct PortGuardSettings {
  *     (Reengage), the output moves to the new target (the simulated force, or zero) at
  *     engage_rate_n_per_ms at most, so every engagement (start-up, a new session, input back
  *     after a gap, a re-arm, a reconfiguration) ramps from zero and every release ramps to zero;
- *     a lift-off releases at the slew rate (the tool has left). A touch-down whose force is still
- *     within one ramp step needs no ramp: a normal touch renders unchanged.
+ *     a lift-off releases faster, at lift_off_rate_n_per_ms (the tool has left; what it still
+ *     had is mostly the sideways pull of a node dragged along, which no step should drop at the
+ *     slew ceiling). A touch-down whose force is still within one ramp step needs no ramp: a
+ *     normal touch renders unchanged.
  *  5. Passivity (Hannaford and Ryu's time-domain passivity observer and controller, in
  *     impedance form). The observer sums the energy the port has absorbed since the touch-down,
  *     E = −Σ F_sent(k−1) · (p(k) − p(k−1)), the exact work a force held over each period does on

@@ -317,11 +317,13 @@ TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
   const std::string path = ::testing::TempDir() + "hapticsimd_config_device.toml";
   std::ofstream(path) << "[shm]\nenabled = true\n[device]\nmax_force_n = 3.0\n"
                          "max_force_rate_n_per_ms = 0.2\nengage_rate_n_per_ms = 0.03\n"
+                         "lift_off_rate_n_per_ms = 0.08\n"
                          "fault_force_n = 20.0\nwatchdog_s = 0.05\npassivity = false\n";
   const DaemonConfig config = LoadDaemonConfig(path);
   EXPECT_EQ(config.port.max_force_n, 3.0);
   EXPECT_EQ(config.port.max_force_rate_n_per_ms, 0.2);
   EXPECT_EQ(config.port.engage_rate_n_per_ms, 0.03);
+  EXPECT_EQ(config.port.lift_off_rate_n_per_ms, 0.08);
   EXPECT_EQ(config.port.fault_force_n, 20.0);
   EXPECT_EQ(config.port.watchdog_s, 0.05);
   EXPECT_FALSE(config.port.passivity);
@@ -339,6 +341,8 @@ TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
       {"[device]\nengage_rate_n_per_ms = 1.0\n", "to device.max_force_rate_n_per_ms (0.5)"},
       {"[device]\nwatchdog_s = 0.0\n", "device.watchdog_s must be from 0.05 to 10 s"},
       {"[device]\nengage_rate_n_per_ms = 1e-9\n", "device.engage_rate_n_per_ms must be from"},
+      {"[device]\nlift_off_rate_n_per_ms = 0.6\n", "to device.max_force_rate_n_per_ms (0.5)"},
+      {"[device]\nlift_off_rate_n_per_ms = nan\n", "device.lift_off_rate_n_per_ms must be from"},
       {"[device]\ninput = \"usb\"\n", "device.input must be \"lcm\" or \"shm\" (it is \"usb\")"},
       {"[device]\ninput = \"shm\"\n", "device.input = \"shm\" needs shm.enabled = true"},
       {"[lcm]\nenabled = false\n[device]\ninput = \"lcm\"\n",

@@ -210,14 +210,32 @@ TEST(PortGuard, EngagingRampsFromZeroAndReleasingRampsToZero) {
   while (last < 0 && periods < 1000) period(false);
   EXPECT_LE(largest_step, 0.05 + 1e-12);
   // Pressing again (a new ramp in), then the tool leaves the object: it is gone, so the release
-  // runs at the slew ceiling, 0.5 N per ms.
+  // runs faster, at the lift-off rate, 0.1 N per ms (not the slew ceiling's 0.5: no step a hand
+  // feels).
   while (last > -1.5 && periods < 1000) period(true);
   in.engaged = false;
-  period(false);
-  EXPECT_NEAR(last, -1.0, 1e-12);
-  period(false);
-  period(false);
+  largest_step = 0;
+  const int lifted_at = periods;
+  while (last < 0 && periods < 1000) period(false);
   EXPECT_EQ(last, 0.0);
+  EXPECT_NEAR(largest_step, 0.1, 1e-12);
+  EXPECT_EQ(periods - lifted_at, 15);  // 1.5 N at 0.1 N per ms
+  // A profile whose engage ramp is faster than its lift-off rate releases a lift-off at the ramp.
+  PortGuardSettings quick;
+  quick.engage_rate_n_per_ms = 0.3;
+  PortGuard quick_guard(quick, kPeriod_s);
+  PortGuard::Input press = in;
+  press.engaged = true;
+  press.render = true;
+  double sent = 0;
+  for (int k = 0; k < 10; ++k, now += kPeriodNs) {
+    press.now_ns = now;
+    sent = quick_guard.Period(press).force_n[2];
+  }
+  ASSERT_EQ(sent, -1.5);
+  press.engaged = press.render = false;
+  press.now_ns = now;
+  EXPECT_NEAR(quick_guard.Period(press).force_n[2], -1.2, 1e-12);
   // A normal touch-down starts from almost nothing: no ramp, the simulated force is sent as is.
   in.simulated_n = {0, 0, -0.01};
   period(true);
