@@ -393,27 +393,33 @@ DaemonConfig ParseDaemonConfigText(const std::string& text, const std::string& o
   return ParseDaemonConfig(origin, text, read_scene_file);
 }
 
+namespace {
+
+// A TOML basic string: backslashes, quotes and control characters escaped, so that what is
+// printed reads back as the same text (found by fuzzing a URL with backslashes in it).
+std::string TomlString(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (ch == '\\' || ch == '"') {
+      out += '\\';
+      out += ch;
+    } else if (byte < 0x20 || byte == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04X", byte);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
 std::string FormatDaemonConfig(const DaemonConfig& c) {
   std::ostringstream out;
-  // A TOML basic string: backslashes, quotes and control characters escaped, so that what is
-  // printed reads back as the same text (found by fuzzing a URL with backslashes in it).
-  auto quote = [](const std::string& s) {
-    std::string out = "\"";
-    for (const char ch : s) {
-      const auto byte = static_cast<unsigned char>(ch);
-      if (ch == '\\' || ch == '"') {
-        out += '\\';
-        out += ch;
-      } else if (byte < 0x20 || byte == 0x7f) {
-        char escaped[8];
-        std::snprintf(escaped, sizeof escaped, "\\u%04X", byte);
-        out += escaped;
-      } else {
-        out += ch;
-      }
-    }
-    return out + "\"";
-  };
+  const auto quote = TomlString;
   auto real = [](double v) { return FormatReal(v); };
   out << "# hapticsimd configuration (every key optional; these are the values in effect)\n"
       << "[scene]\nfile = " << quote(c.scene_file) << "\n\n"

@@ -455,7 +455,9 @@ TEST(SlidingTool, AToolLiftedStraightOutAndBackInAtOnceTouchesAgain) {
   ASSERT_GT(served.force_n.size(), 400u);
   for (long n = 232; n < 238; ++n) {  // the tip out from 230 on: nothing rendered out there
     const auto& f = served.force_n[static_cast<std::size_t>(n)];
-    if (tip_at(n)[2] < 0) EXPECT_LT(std::hypot(f[0], f[1], f[2]), 0.02) << "period " << n;
+    if (tip_at(n)[2] < 0) {
+      EXPECT_LT(std::hypot(f[0], f[1], f[2]), 0.02) << "period " << n;
+    }
   }
   EXPECT_GT(-served.force_n[400][2], 0.2) << "the tool back in did not touch again";
   EXPECT_TRUE(served.flags[400] & force_flags::kInContact);
