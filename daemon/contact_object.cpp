@@ -123,10 +123,12 @@ bool ContactObject::Inside(const std::array<double, 3>& tip_m) const noexcept {
   return Occupied(v[0], v[1], v[2]);
 }
 
-ContactObject::Entry ContactObject::EntryFrom(const std::array<double, 3>& point_m,
-                                              const std::array<int, 3>& voxel) const noexcept {
+std::array<ContactObject::Entry, 6> ContactObject::WaysOutFrom(
+    const std::array<double, 3>& point_m, const std::array<int, 3>& voxel) const noexcept {
   // Along each axis the row of occupied voxels through `voxel` ends, on either side, at a face
-  // of the surface: the nearest of those six faces is the way in (the front, −z, first on a tie).
+  // of the surface: those six faces, the front (−z) first, then −x, +x, −y, +y, each with the
+  // point projected onto it, sorted by depth keeping that order on a tie (by hand: six entries,
+  // and the primary thread asks).
   const auto face_beyond_row = [&](int c, int step) {
     std::array<int, 3> at = voxel;
     do {
@@ -134,23 +136,36 @@ ContactObject::Entry ContactObject::EntryFrom(const std::array<double, 3>& point
     } while (Occupied(at[0], at[1], at[2]));
     return (step < 0 ? at[c] + 1 : at[c]) * spacing_m_;
   };
-  int axis = 2;
-  double face = 0, depth = std::numeric_limits<double>::infinity(), inward = 1;
+  std::array<Entry, 6> ways{};
+  int count = 0;
   for (int c : {2, 0, 1}) {
-    const double low = face_beyond_row(c, -1), high = face_beyond_row(c, +1);
-    if (point_m[c] - low < depth) depth = point_m[c] - low, axis = c, face = low, inward = 1;
-    if (high - point_m[c] < depth) depth = high - point_m[c], axis = c, face = high, inward = -1;
+    for (int step : {-1, +1}) {
+      Entry way;
+      const double face = face_beyond_row(c, step);
+      way.point_m = point_m;
+      way.point_m[c] = face;
+      way.inward_normal[c] = -step;
+      way.depth_m = step < 0 ? point_m[c] - face : face - point_m[c];
+      int at = count++;
+      for (; at > 0 && ways[at - 1].depth_m > way.depth_m; --at) ways[at] = ways[at - 1];
+      ways[at] = way;
+    }
   }
-  Entry entry;
-  entry.point_m = point_m;
-  entry.point_m[axis] = face;
-  entry.inward_normal[axis] = inward;
-  entry.depth_m = depth;
-  return entry;
+  return ways;
+}
+
+ContactObject::Entry ContactObject::EntryFrom(const std::array<double, 3>& point_m,
+                                              const std::array<int, 3>& voxel) const noexcept {
+  return WaysOutFrom(point_m, voxel)[0];  // the nearest of the six faces is the way in
 }
 
 ContactObject::Entry ContactObject::EntryOf(const std::array<double, 3>& tip_m) const noexcept {
   return EntryFrom(tip_m, VoxelOf(tip_m));
+}
+
+std::array<ContactObject::Entry, 6> ContactObject::WaysOut(
+    const std::array<double, 3>& tip_m) const noexcept {
+  return WaysOutFrom(tip_m, VoxelOf(tip_m));
 }
 
 std::array<int, 3> ContactObject::NearestVoxel(

@@ -50,6 +50,9 @@ class ContactObject {
     double depth_m = 0;
   };
   Entry EntryOf(const std::array<double, 3>& tip_m) const noexcept;
+  /** All six ways out of a tip inside the object, along ±x, ±y, ±z, least deep first (EntryOf's
+   *  is the first): where the face the tip is least deep behind cannot be touched, the next. */
+  std::array<Entry, 6> WaysOut(const std::array<double, 3>& tip_m) const noexcept;
   /** Where a tip outside the object would come down: the point of a voxel near it nearest to
    *  the tip (NearestPoint), with that voxel's way out as EntryOf gives it (depth 0 on a face
    *  of the surface where the voxel is the nearest). */
@@ -102,7 +105,9 @@ class ContactObject {
   // Voxels by index (ix, iy, iz) of their lowest node, x fastest; false outside the lattice.
   bool Occupied(int vx, int vy, int vz) const noexcept;
   std::array<int, 3> VoxelOf(const std::array<double, 3>& point_m) const noexcept;
-  // EntryOf for a point in (or on) voxel `voxel`.
+  // WaysOut and EntryOf for a point in (or on) voxel `voxel`.
+  std::array<Entry, 6> WaysOutFrom(const std::array<double, 3>& point_m,
+                                   const std::array<int, 3>& voxel) const noexcept;
   Entry EntryFrom(const std::array<double, 3>& point_m,
                   const std::array<int, 3>& voxel) const noexcept;
   // 0, or ±(axis + 1) of the inward normal of the flat face `node` lies inside of.

@@ -19,8 +19,10 @@ namespace hapticsim {
  * it sticks and slides by Coulomb friction, and the primary region follows it across the face
  * (ProxyWantsPrimaryAt: the supervisor moves the regions with the object's motion carried).
  *
- * Touch-down is ContactTracker's — the face the tip is least deep behind — and the node it wants
- * is the one nearest the entry point inside that face (a rim node's normal is not the face's). The
+ * Touch-down is through the face the tip is least deep behind, as ContactTracker's, or where that
+ * face has no node inside it (a riser of a voxel staircase one voxel high), the next way out that
+ * has one, up to a voxel deeper (ContactObject::WaysOut); the node it wants is the one nearest
+ * the entry point inside that face (a rim node's normal is not the face's). The
  * proxy engages wherever the regions it is bound to, on that face, can push under the tip (then
  * they follow it from there); otherwise it waits (zero force, "waiting") until the supervisor has
  * moved them onto the node it wants. Its force ramps in over
@@ -134,6 +136,10 @@ class SlidingContact {
   std::optional<LatticeIndex> NodeInsideFace(const ContactObject::Entry& entry) const noexcept;
   // `point_m` (the tip, under the face; the proxy) projected onto the touched face's plane.
   ContactObject::Entry OnTouchedFace(const std::array<double, 3>& point_m) const noexcept;
+  // A touch of the tip, inside the object: waiting for regions on its face, or engaged at once
+  // where the bound ones reach.
+  void TouchDown(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                 const std::optional<LatticeIndex>& centre) noexcept;
   // Engages a waiting touch when the regions, this period's (`centre`), can push under the tip on
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;

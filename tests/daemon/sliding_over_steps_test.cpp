@@ -1,0 +1,124 @@
+// A sliding tool (contact.model = "proxy") over a voxel staircase, through hapticsimd's primary
+// period in virtual time, the regions moved wherever the loop asks (as the supervisor does): a tip
+// that comes in through a step's riser one voxel high — a face with rim nodes only, nothing a
+// proxy can slide on — touches the face above it instead, its force ramped in, with no step over
+// 0.1 N. It pushed nothing until the tool had left the object again: on a walk over the organ
+// (examples/organ/), a staircase of such risers, the tool was in contact for 1,038–1,611 of
+// 15,000 answers, and is for 6,145–6,548 since.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <vector>
+
+#include "daemon/contact_object.hpp"
+#include "daemon/haptic_loop.hpp"
+#include "daemon/supervisor.hpp"
+#include "tests/support/play_device.hpp"
+#include "tests/support/voxel_scene.hpp"
+
+namespace hapticsim {
+namespace {
+
+constexpr double kH = 0.01;  // voxel edge, m
+using Point = std::array<double, 3>;
+
+// 10 × 6 × 4 voxels of 1 cm, the back face (z = 4 cm) held, the voxels x < 4 cm, z < `step` cm
+// cut out of its front: a step whose floor is at z = `step` cm and whose wall, facing −x, is at
+// x = 4 cm.
+Scene SteppedBlock(int step) {
+  Scene scene = testing::VoxelScene(
+      10, 6, 4, kH, [step](int x, int, int z) { return x < 4 && z < step ? 0 : 1; });
+  testing::HoldPlaneZ(&scene, 0.04);
+  scene.materials = {{1, Material{}}};  // 10 kPa, ν 0.45, 1000 kg/m³, d 10/s
+  scene.contact.model = ContactModel::kProxy;
+  scene.contact.static_friction = 0.5;
+  scene.contact.kinetic_friction = 0.4;
+  scene.adaptivity.primary_size = 3;
+  scene.adaptivity.secondary_lod = 1;
+  scene.adaptivity.secondary_rate_hz = 1000;
+  return scene;
+}
+
+struct Played {
+  std::vector<Point> force_n;
+  std::vector<std::int32_t> flags;
+  double largest_step_n = 0;
+  int moves = 0;
+};
+
+// `tip_at(n)` for `periods` periods, the regions moved onto the node the loop wants whenever it
+// follows the proxy (motion carried) or a touch waits for them (from rest, ramped in).
+Played Play(const Scene& scene, int periods, const std::function<Point(int)>& tip_at) {
+  HapticLoop loop(scene, HapticLoop::Options{});
+  const RegionConfiguration configuration{3, 1, 1000};
+  std::int64_t release = 1'000'000'000;
+  Played played;
+  for (int n = 0; n < periods; ++n, release += 1'000'000) {
+    const bool following = loop.contact_following();
+    if ((following || loop.contact_waiting()) && loop.wanted_contact_node() &&
+        loop.wanted_contact_node() != loop.centre_node()) {
+      loop.Reconfigure(
+          SceneWith(scene, configuration, *loop.wanted_contact_node()),
+          following ? HapticLoop::Handover::kCarryMotion : HapticLoop::Handover::kRampIn);
+      ++played.moves;
+    }
+    testing::PlayPeriodInVirtualTime(loop, release, DeviceSample{n, release, tip_at(n), false});
+    ForceRecord record;
+    while (loop.forces().Pop(&record)) {
+      const Point& f = record.force_n;
+      if (!played.force_n.empty()) {
+        const Point& a = played.force_n.back();
+        played.largest_step_n =
+            std::max(played.largest_step_n, std::hypot(f[0] - a[0], f[1] - a[1], f[2] - a[2]));
+      }
+      played.force_n.push_back(f);
+      played.flags.push_back(record.flags);
+    }
+  }
+  return played;
+}
+
+bool InContact(const Played& played, int n) {
+  return played.flags[static_cast<std::size_t>(n)] & force_flags::kInContact;
+}
+
+// A step one voxel high (1 cm): its wall has rim nodes only. The tool comes in sideways through it,
+// 5 mm behind the front face's plane, to 3 mm past the wall, and stays: the wall is the face it
+// is least deep behind (3 mm), but it has no node to slide on, so the touch is through the front
+// face above it (5 mm), pushed back out of that face, its force ramped in.
+TEST(SlidingOverSteps, AToolInThroughARiserWithNoNodeInsideTouchesTheFaceAboveIt) {
+  const Scene scene = SteppedBlock(1);
+  const ContactObject object = ContactObject::Of(scene);
+  const Point held{0.043, 0.03, 0.005};
+  ASSERT_TRUE(object.Inside(held));
+  // Its ways out, least deep first: the wall 3 mm, the front 5 mm, the back 35 mm, …
+  const std::array<ContactObject::Entry, 6> ways = object.WaysOut(held);
+  EXPECT_EQ(ways[0].inward_normal, (Point{1, 0, 0}));
+  EXPECT_NEAR(ways[0].depth_m, 0.003, 1e-12);
+  EXPECT_EQ(ways[1].inward_normal, (Point{0, 0, 1}));
+  EXPECT_NEAR(ways[1].depth_m, 0.005, 1e-12);
+  EXPECT_NEAR(ways[1].point_m[2], 0.0, 1e-12);
+  for (int k = 1; k < 6; ++k) EXPECT_LE(ways[k - 1].depth_m, ways[k].depth_m) << k;
+  EXPECT_EQ(object.EntryOf(held).inward_normal, ways[0].inward_normal) << "EntryOf is the first";
+  const auto tip_at = [](int n) {
+    return Point{0.03 + 0.013 * std::min(1.0, n / 200.0), 0.03, 0.005};
+  };
+  const Played played = Play(scene, 700, tip_at);
+  ASSERT_EQ(played.force_n.size(), 700u);
+  const Point& end = played.force_n.back();
+  std::printf(
+      "in through a one-voxel riser: force (%.4f, %.4f, %.4f) N after 0.5 s, %d moves, "
+      "largest step %.4f N\n",
+      end[0], end[1], end[2], played.moves, played.largest_step_n);
+  EXPECT_TRUE(InContact(played, 699)) << "the tool inside pushes nothing";
+  EXPECT_LT(end[2], -0.05) << "not pushed back out of the front face";
+  EXPECT_LT(std::abs(end[0]), 0.5 * std::abs(end[2])) << "(within the friction cone)";
+  EXPECT_LE(played.largest_step_n, 0.1);
+}
+
+}  // namespace
+}  // namespace hapticsim
