@@ -117,7 +117,9 @@ TEST(ContactTracker, ATouchElsewhereWaitsThenRampsItsDepthInFromZero) {
     z += 1e-5;
     const auto c = tracker.Update({2 * kH, 3 * kH, z}, t, side);
     ASSERT_TRUE(c.engaged);
-    if (n == 0) EXPECT_NEAR(c.displacement_m[2], 0.0, 1e-15);
+    if (n == 0) {
+      EXPECT_NEAR(c.displacement_m[2], 0.0, 1e-15);
+    }
     largest_step = std::max(largest_step, c.displacement_m[2] - previous);
     previous = c.displacement_m[2];
   }
@@ -213,7 +215,9 @@ TEST(ContactTracker, AFastTouchDownAndATouchAgainFollowTheTipWithoutACatchUp) {
     for (int n = -2; n <= 4; ++n) {
       const double z = 1e-4 * n + 0.5e-4;  // first inside at 50 µm
       const auto c = tracker.Update({0.125, 0.125, z}, t += kMs, middle);
-      if (z > 0) EXPECT_NEAR(c.displacement_m[2], z, 1e-15) << touch << " " << n;
+      if (z > 0) {
+        EXPECT_NEAR(c.displacement_m[2], z, 1e-15) << touch << " " << n;
+      }
     }
     for (int n = 4; n >= -2; --n)
       tracker.Update({0.125, 0.125, 1e-4 * n - 0.5e-4}, t += kMs, middle);
