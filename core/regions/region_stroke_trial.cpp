@@ -49,8 +49,11 @@ void Accumulate(AsyncRegions& regions, RegionStrokeResult* out) {
 // One stroke in progress: the regions it runs on now, the proxy and the periods' bookkeeping.
 class StrokeRun {
  public:
-  explicit StrokeRun(const Scene& scene)
+  StrokeRun(const Scene& scene, const TrialFrames& frames,
+            const std::function<void(const AsyncRegions&)>& regions_now)
       : scene_(scene),
+        frames_(frames),
+        regions_now_(regions_now),
         regions_(std::make_unique<AsyncRegions>(scene)),
         normal_(regions_->partition().contact_normal()),
         centre_(regions_->partition().contact_node()),
@@ -69,6 +72,7 @@ class StrokeRun {
     out_.stroke.trial.stability = regions_->schedule(kPrimaryRegion).alone;
     out_.stroke.proxy.reserve(static_cast<std::size_t>(steps_) + 1);
     budget_j_ = regions_->Energy();
+    if (regions_now_) regions_now_(*regions_);
   }
 
   RegionStrokeResult Run() && {
@@ -91,6 +95,7 @@ class StrokeRun {
   // at each substep's start and the spring taken at the step's end (ProxyPush). The period's
   // sample is its first substep's force. False when the trial ends in it.
   bool StepPeriod(long n) {
+    if (frames_.Due(n)) frames_.observe(n * dt_, regions_->CaptureState());
     const int substeps = regions_->schedule(kPrimaryRegion).substeps;
     for (int q = 0; q < substeps; ++q) {
       std::array<double, 3> tool = proxy_.start_m();
@@ -144,6 +149,7 @@ class StrokeRun {
     CheckAgree(proxy_, *regions_);
     runaway_periods_ = 0;
     centre_ = next;
+    if (regions_now_) regions_now_(*regions_);
     out_.moves.push_back({n, centre_});
     StabilityEstimate& stability = out_.stroke.trial.stability;
     const StabilityEstimate& primary = regions_->schedule(kPrimaryRegion).alone;
@@ -151,6 +157,8 @@ class StrokeRun {
   }
 
   const Scene& scene_;
+  const TrialFrames& frames_;
+  const std::function<void(const AsyncRegions&)>& regions_now_;
   RegionStrokeResult out_;
   std::unique_ptr<AsyncRegions> regions_;
   std::array<double, 3> normal_;
@@ -167,10 +175,11 @@ class StrokeRun {
 
 }  // namespace
 
-RegionStrokeResult RunRegionStroke(const Scene& scene) {
+RegionStrokeResult RunRegionStroke(const Scene& scene, const TrialFrames& frames,
+                                   const std::function<void(const AsyncRegions&)>& regions_now) {
   HAPTICSIM_THROW_UNLESS(scene.input.waveform == Waveform::kStroke,
                          "internal: RunRegionStroke runs input.waveform = \"stroke\"");
-  return StrokeRun(scene).Run();
+  return StrokeRun(scene, frames, regions_now).Run();
 }
 
 }  // namespace hapticsim

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/regions/async_regions.hpp"
@@ -39,10 +40,16 @@ struct RegionStrokeResult {
  * Ends as the reference does (TrialOutcome): the proxy at the face's edge (kLeftSurface), a state
  * that is not finite, energy beyond the passivity budget or the runaway watch (kDivergedEnergy);
  * and a proxy that slid out of the primary within one period, inside the face (kDivergedContact).
+ * `frames`: the whole object (AsyncRegions::CaptureState) at the start of the periods they ask for;
+ * `regions_now`, if given, is called with the regions the stroke runs on, first at the start,
+ * then after each move, before any frame of theirs (hapticsim simulate --vtk draws them).
+ *
  * @throws Error for a scene whose regions cannot be made (ValidateScene; adaptivity off), or
  * whose adaptivity.primary_size cannot reach the tip's nodes (⌈contact.radius / h⌉ + 1, at least
  * 2).
  */
-RegionStrokeResult RunRegionStroke(const Scene& scene);
+RegionStrokeResult RunRegionStroke(
+    const Scene& scene, const TrialFrames& frames = {},
+    const std::function<void(const AsyncRegions&)>& regions_now = {});
 
 }  // namespace hapticsim

@@ -9,15 +9,12 @@
 #include "core/trial/trial_recorder.hpp"
 
 namespace hapticsim {
-namespace {
 
-// The integrator's displacement in the lattice's order (the grid's nodes are its points).
-ObjectState LatticeState(const ElasticModel& model, const CentralDifferenceIntegrator& integrator) {
+ObjectState LatticeState(const ElasticModel& model, const Eigen::VectorXd& u) {
   const HexGrid& grid = model.grid();
   ObjectState state;
   state.lattice_nodes = {grid.nx(), grid.ny(), grid.nz()};
   state.displacement_m.resize(3 * state.num_points());
-  const Eigen::VectorXd& u = integrator.displacement();
   for (int ix = 0; ix < grid.nx(); ++ix) {
     for (int iy = 0; iy < grid.ny(); ++iy) {
       for (int iz = 0; iz < grid.nz(); ++iz) {
@@ -29,8 +26,6 @@ ObjectState LatticeState(const ElasticModel& model, const CentralDifferenceInteg
   }
   return state;
 }
-
-}  // namespace
 
 std::string_view TrialOutcomeName(TrialOutcome outcome) {
   switch (outcome) {
@@ -53,7 +48,7 @@ std::string_view TrialOutcomeName(TrialOutcome outcome) {
 TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& options) {
   const Scene& scene = cube.scene();
   if (scene.input.waveform == Waveform::kStroke) {
-    return RunStrokeTrial(cube, options.substep_to_stability).trial;
+    return RunStrokeTrial(cube, options.substep_to_stability, options.frames).trial;
   }
   const ElasticModel& model = cube.model();
   TrialResult result;
@@ -76,7 +71,8 @@ TrialResult RunReferenceTrial(const SceneModel& cube, const TrialOptions& option
   std::array<double, 3> reaction_at_start{};
   for (long n = 0; n <= steps; ++n) {
     const double t = n * dt;
-    if (options.frames.Due(n)) options.frames.observe(t, LatticeState(model, integrator));
+    if (options.frames.Due(n))
+      options.frames.observe(t, LatticeState(model, integrator.displacement()));
     StepStatus status = StepStatus::kOk;
     for (int q = 1; q <= result.substeps && status == StepStatus::kOk; ++q) {
       status = integrator.Step(trajectory.DisplacementAt(t + q * h));

@@ -1,13 +1,15 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <functional>
 #include <string_view>
 #include <vector>
 
-#include "core/scene/scene_model.hpp"
+#include "core/fem/elastic_model.hpp"
 #include "core/fem/object_state.hpp"
 #include "core/fem/stability_estimate.hpp"
+#include "core/scene/scene_model.hpp"
 
 namespace hapticsim {
 
@@ -61,6 +63,10 @@ struct TrialFrames {
   std::function<void(double t_s, const ObjectState& state)> observe;
   bool Due(long period) const { return every_periods > 0 && period % every_periods == 0; }
 };
+
+/** A full-resolution displacement `u` (the model's DOFs) in the lattice's order, as frames take
+ *  it (the grid's nodes are its points). */
+ObjectState LatticeState(const ElasticModel& model, const Eigen::VectorXd& u);
 
 struct TrialOptions {
   /** Run even when the prediction says dt is past the stability limit (to watch detection). */

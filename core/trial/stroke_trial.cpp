@@ -25,7 +25,8 @@ std::vector<int> OwnedDofs(const ElasticModel& model) {
 
 }  // namespace
 
-StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability) {
+StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability,
+                                 const TrialFrames& frames) {
   const Scene& scene = object.scene();
   const ElasticModel& model = object.model();
   StrokeTrialResult out;
@@ -65,6 +66,7 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stabi
   // spring taken there: ProxyPush); the period's sample is its first substep's force. False when
   // the trial ends.
   const auto step_period = [&](long n) {
+    if (frames.Due(n)) frames.observe(n * dt, LatticeState(model, integrator.u()));
     for (int q = 0; q < result.substeps; ++q) {
       std::array<double, 3> tool = contact.start_m();
       const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt + q * h);

@@ -30,8 +30,10 @@ struct StrokeTrialResult {
  * which TrialResult::stability.critical_dt_s then reports — unless `substep_to_stability`, as
  * TrialOptions asks of a reference: then each period takes the substeps that keep within 95 % of
  * that limit, the proxy touching at each (the tool on its path), as the regions' primary does.
- * A proxy that reaches the edge of the face ends the trial (kLeftSurface).
+ * A proxy that reaches the edge of the face ends the trial (kLeftSurface). `frames`: the whole
+ * object at the start of the periods they ask for (hapticsim simulate --vtk).
  */
-StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability = false);
+StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stability = false,
+                                 const TrialFrames& frames = {});
 
 }  // namespace hapticsim

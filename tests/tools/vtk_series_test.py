@@ -12,6 +12,11 @@ adaptive shape against the full-resolution reference's at the same times.
 Then the same on examples/palpation's phantom (a NIfTI volume, two materials): its cells against
 the voxels VTK's own NIfTI reader counts in the file, label by label, the held back face at zero,
 the contact on the press, von Mises of each cell's own material.
+
+And a stroke on the regions, whose primary follows the tool's proxy: frames of both runs at the
+same times, the supports at zero, von Mises as recomputed, the dimple under the proxy within a
+node spacing of the tool's own trajectory and inside the primary region, whose cells move along
+with it, and the adaptive shape against the reference's.
 """
 import json
 import math
@@ -212,6 +217,71 @@ def check_phantom(cli, work):
           "their materials, the back face held, the contact on the press, von Mises per material")
 
 
+def check_stroke(cli, work):
+    """A stroke on the regions (the primary follows the proxy): 5 mm in, 60 mm along x."""
+    out = work / "stroke-vtk"
+    length, spacing = 0.06, EDGE / (N - 1)
+    run = subprocess.run([cli, "simulate", "--set", "input.waveform=stroke", "--set",
+                          "input.amplitude=0.005", "--set", f"input.stroke_length={length}",
+                          "--set", "adaptivity.primary_size=3", "--vtk", str(out), "--vtk-rate",
+                          str(RATE)], capture_output=True, text=True)
+    if run.returncode != 0:
+        fail(f"simulate --vtk of a stroke exited {run.returncode}: {run.stderr}")
+    runs = {name: frames_of(out / f"{name}.pvd") for name in ("adaptive", "reference")}
+    front = [point(ix, iy, 0) for ix in range(N) for iy in range(N)]
+    primaries, worst_shape = [], 0.0
+    for (t, adaptive_file), (t_reference, reference_file) in zip(runs["adaptive"],
+                                                                 runs["reference"]):
+        if round(t, 9) != round(t_reference, 9):
+            fail(f"stroke: frames at {t} and {t_reference} s")
+        frames = {"adaptive": read(adaptive_file), "reference": read(reference_file)}
+        # The tool along x, by the stroke's own trajectory: in over the first quarter, then
+        # L·(τ − sin 2πτ / 2π).
+        tau = max(0.0, (t - 0.25) / 0.75)
+        tool_x = EDGE / 2 + length * (tau - math.sin(2 * math.pi * tau) / (2 * math.pi))
+        for name, frame in frames.items():
+            for s in SUPPORTS:
+                if numpy.any(frame["u"][point(*s)] != 0):
+                    fail(f"stroke {name} t={t}: support {s} moved")
+            if numpy.max(numpy.abs(von_mises(frame) - frame["von_mises"])) > \
+                    1e-9 * max(1e-9, float(numpy.max(frame["von_mises"]))):
+                fail(f"stroke {name} t={t}: von Mises differs from the recomputation")
+            if t < 0.3:
+                continue
+            # The dimple under the proxy, which lags the tool by friction (μ_k × the depth): the
+            # front face's deepest node within a spacing of the tool.
+            deepest = max(front, key=lambda p: frame["u"][p][2])
+            x = frame["points"][deepest][0]
+            if abs(x - tool_x) > spacing:
+                fail(f"stroke {name} t={t}: deepest front node at x = {x}, the tool at {tool_x}")
+            if name == "adaptive":
+                cells = [c for c, corners in enumerate(frame["cells"]) if deepest in corners]
+                if any(frame["region"][c] != 0 for c in cells):
+                    fail(f"stroke t={t}: the dimple at x = {x} is not in the primary region")
+        if numpy.any(frames["reference"]["region"] != 0):
+            fail("stroke: the reference has a region other than 0")
+        adaptive_primary = frames["adaptive"]["region"] == 0
+        primaries.append(numpy.mean([frames["adaptive"]["points"][frames["adaptive"]["cells"][c]]
+                                     [:, 0].mean() for c in numpy.flatnonzero(adaptive_primary)]))
+        if t > 0:
+            difference = numpy.max(numpy.linalg.norm(frames["adaptive"]["u"] -
+                                                     frames["reference"]["u"], axis=1))
+            largest = numpy.max(numpy.linalg.norm(frames["reference"]["u"], axis=1))
+            worst_shape = max(worst_shape, difference / largest)
+    if len(primaries) != RATE + 1:
+        fail(f"stroke: {len(primaries)} frames, not {RATE + 1}")
+    if primaries[-1] - primaries[0] < spacing:
+        fail(f"stroke: the primary region's cells stayed around x = {primaries[0]} m "
+             f"(at the end {primaries[-1]} m)")
+    if worst_shape > 0.1:
+        fail(f"stroke: the adaptive shape is {worst_shape:.1%} of the largest displacement from "
+             "the reference's")
+    print(f"vtk: a stroke on the regions, {len(primaries)} frames per run; the dimple within a "
+          f"spacing of the tool, in the primary; the primary's cells from x = {primaries[0]:.4f} "
+          f"to {primaries[-1]:.4f} m; adaptive shape within {worst_shape:.1%} of the reference's")
+
+
 if __name__ == "__main__":
     main()
     check_phantom(sys.argv[1], Path(sys.argv[2]))
+    check_stroke(sys.argv[1], Path(sys.argv[2]))

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -167,18 +168,31 @@ TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report
 }
 
 // A stroke on the regions: the primary follows the proxy across the face (RunRegionStroke), in
-// virtual time. The report's regions are those it started on.
+// virtual time, with frames into `vtk` ("adaptive", each with the regions of its time) when
+// asked. The report's regions are those it started on.
 TrialResult RunAdaptiveStroke(const Scene& scene, bool threads, AdaptiveReport* report,
-                              const VtkOutput* vtk) {
+                              VtkOutput* vtk) {
   HAPTICSIM_THROW_UNLESS(!threads,
                          "--threads: a stroke on the regions runs in virtual time only (the "
                          "primary follows the proxy by moving the regions); drop --threads");
-  HAPTICSIM_THROW_UNLESS(vtk == nullptr,
-                         "--vtk: a stroke on the regions writes no frames yet; drop --vtk, or set "
-                         "adaptivity.primary_size = 0 for the full-resolution stroke's");
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
   report->coupled = regions.EstimateCoupledStability();
-  const RegionStrokeResult run = RunRegionStroke(scene);
+  std::optional<VtkSeries> series;
+  TrialFrames frames;
+  std::function<void(const AsyncRegions&)> regions_now;
+  if (vtk) {
+    series.emplace(vtk->dir, "adaptive", VtkObjectOf(DescribeSceneObject(scene)),
+                   regions.partition().mesh().RegionPerLatticeCell());
+    frames = FramesInto(*series, scene, vtk->rate_hz);
+    regions_now = [&series](const AsyncRegions& now) {
+      series->SetRegions(now.partition().mesh().RegionPerLatticeCell());
+    };
+  }
+  const RegionStrokeResult run = RunRegionStroke(scene, frames, regions_now);
+  if (series) {
+    series->Finish();
+    vtk->written.push_back(series->collection());
+  }
   report->energy = run.energy;
   report->stroke_moves = run.moves.size();
   ReportRegions(regions, run.compute_s,

@@ -91,6 +91,12 @@ VtkSeries::VtkSeries(const fs::path& dir, const std::string& name, VtkObject obj
       !error, "cannot make the folder " + (dir_ / name_).string() + ": " + error.message());
 }
 
+void VtkSeries::SetRegions(std::vector<RegionIndex> region_per_cell) {
+  HAPTICSIM_THROW_UNLESS(region_per_cell.size() == object_.cell_material.size(),
+                         "internal: the regions are not the lattice's cells");
+  region_per_cell_ = std::move(region_per_cell);
+}
+
 void VtkSeries::Write(double t_s, const ObjectState& state) {
   HAPTICSIM_THROW_UNLESS(state.lattice_nodes == object_.lattice_nodes,
                          "internal: a frame of another lattice");

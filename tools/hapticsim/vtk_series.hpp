@@ -51,6 +51,8 @@ class VtkSeries {
             std::vector<RegionIndex> region_per_cell);
   /** @throws Error when the file cannot be written (the message names it). */
   void Write(double t_s, const ObjectState& state);
+  /** The regions of the frames written from now on (a stroke's primary follows its proxy). */
+  void SetRegions(std::vector<RegionIndex> region_per_cell);
   /** Writes the .pvd naming every frame. */
   void Finish();
   std::filesystem::path collection() const { return dir_ / (name_ + ".pvd"); }
