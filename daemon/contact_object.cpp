@@ -126,7 +126,7 @@ bool ContactObject::Inside(const std::array<double, 3>& tip_m) const noexcept {
 std::array<ContactObject::Entry, 6> ContactObject::WaysOutFrom(
     const std::array<double, 3>& point_m, const std::array<int, 3>& voxel) const noexcept {
   // Along each axis the row of occupied voxels through `voxel` ends, on either side, at a face
-  // of the surface: those six faces, the front (−z) first, then −x, +x, −y, +y, each with the
+  // of the surface: those six faces, −z (the front) first, then +z, −x, +x, −y, +y, each with the
   // point projected onto it, sorted by depth keeping that order on a tie (by hand: six entries,
   // and the primary thread asks).
   const auto face_beyond_row = [&](int c, int step) {

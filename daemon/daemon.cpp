@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 #include <sys/mman.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -163,9 +162,8 @@ void Daemon::SayDeviceEnvelope() const {
       "device input from {} only (device.input); force envelope: {} N, {} N/ms slew, engage ramp "
       "{} N/ms, lift-off release {} N/ms, fault above {} N or a {} s primary stall, passivity {}",
       DeviceInputName(config_), config_.port.max_force_n, config_.port.max_force_rate_n_per_ms,
-      config_.port.engage_rate_n_per_ms,
-      std::max(config_.port.lift_off_rate_n_per_ms, config_.port.engage_rate_n_per_ms),
-      config_.port.fault_force_n, config_.port.watchdog_s, config_.port.passivity ? "on" : "off");
+      config_.port.engage_rate_n_per_ms, config_.port.LiftOffRate(), config_.port.fault_force_n,
+      config_.port.watchdog_s, config_.port.passivity ? "on" : "off");
 }
 
 int Daemon::Run(const sigset_t& signals) {

@@ -178,12 +178,13 @@ void ValidatePortGuard(const PortGuardSettings& p) {
           "device.engage_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
               FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
               FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" + value(p.engage_rate_n_per_ms));
-  require(
-      std::isfinite(p.lift_off_rate_n_per_ms) && p.lift_off_rate_n_per_ms >= p.max_force_n / 1000 &&
-          p.lift_off_rate_n_per_ms <= p.max_force_rate_n_per_ms,
-      "device.lift_off_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
-          FormatReal(p.max_force_n / 1000) + ") to device.max_force_rate_n_per_ms (" +
-          FormatReal(p.max_force_rate_n_per_ms) + ") N per ms" + value(p.lift_off_rate_n_per_ms));
+  // (Above the slew ceiling it is that ceiling: a profile with a slew below the default 0.1 loads
+  // as it did before the key came.)
+  require(std::isfinite(p.lift_off_rate_n_per_ms) &&
+              p.lift_off_rate_n_per_ms >= p.max_force_n / 1000 && p.lift_off_rate_n_per_ms <= 100,
+          "device.lift_off_rate_n_per_ms must be from device.max_force_n / 1000 ms (" +
+              FormatReal(p.max_force_n / 1000) + ") to 100 N per ms" +
+              value(p.lift_off_rate_n_per_ms));
   require(
       std::isfinite(p.fault_force_n) && p.fault_force_n >= p.max_force_n && p.fault_force_n <= 1000,
       "device.fault_force_n must be from device.max_force_n (" + FormatReal(p.max_force_n) +
@@ -465,7 +466,7 @@ std::string FormatDaemonConfig(const DaemonConfig& c) {
       << "max_force_rate_n_per_ms = " << real(c.port.max_force_rate_n_per_ms) << "\n"
       << "engage_rate_n_per_ms = " << real(c.port.engage_rate_n_per_ms) << "\n"
       << "lift_off_rate_n_per_ms = " << real(c.port.lift_off_rate_n_per_ms)
-      << "  # a lift-off's release (the engage ramp's if that is faster)\n"
+      << "  # a lift-off's release (the engage ramp's if faster; at most the slew)\n"
       << "fault_force_n = " << real(c.port.fault_force_n) << "\n"
       << "watchdog_s = " << real(c.port.watchdog_s) << "\n"
       << "passivity = " << (c.port.passivity ? "true" : "false") << "\n"

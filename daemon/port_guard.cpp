@@ -151,10 +151,7 @@ PortGuard::Output PortGuard::Period(const Input& in) noexcept {
     // slew ceiling: a node dragged along its face and lifted out still pulls sideways (0.5 N on
     // the organ's walk), and dropping that at once is a step the hand feels. A fault, stale input
     // or paused regions release at the engage rate, since the tool may still be pressing.
-    if (!in.engaged && !latched_) {
-      release_step =
-          std::max(settings_.lift_off_rate_n_per_ms, settings_.engage_rate_n_per_ms) * elapsed_ms;
-    }
+    if (!in.engaged && !latched_) release_step = settings_.LiftOffRate() * elapsed_ms;
   }
   rendering_before_ = rendering;
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -18,6 +19,13 @@ struct PortGuardSettings {
   double watchdog_s = 0.2;               ///< a primary gap this long while sending force: fault
   bool passivity = true;                 ///< time-domain passivity observer and controller
   double max_damping_n_s_per_m = 10.0;   ///< the most damping the controller may add
+
+  /** The rate a lift-off releases at: lift_off_rate_n_per_ms, or the engage ramp's if faster,
+   *  at most the slew ceiling, N per ms. */
+  double LiftOffRate() const {
+    return std::min(max_force_rate_n_per_ms,
+                    std::max(lift_off_rate_n_per_ms, engage_rate_n_per_ms));
+  }
 };
 
 /**

@@ -33,6 +33,14 @@ ContactObject::Entry SlidingContact::OnTouchedFace(
 
 std::optional<LatticeIndex> SlidingContact::NodeInsideFace(
     const ContactObject::Entry& entry) const noexcept {
+  const std::optional<LatticeIndex> node = NearestNodeInsideFace(entry);
+  // On a held face: none (the support is not rendered).
+  if (!node || !object_.Drivable(*node)) return std::nullopt;
+  return node;
+}
+
+std::optional<LatticeIndex> SlidingContact::NearestNodeInsideFace(
+    const ContactObject::Entry& entry) const noexcept {
   // The node of the entry's face plane nearest to the point, or the nearest of its eight
   // neighbours in the plane, that lies inside a flat face with the entry's normal (off the face's
   // rim, and off any step of the surface: a proxy slides on one flat face). The point is on the
@@ -59,8 +67,6 @@ std::optional<LatticeIndex> SlidingContact::NodeInsideFace(
       if (!best || d2 < best_d2) best = node, best_d2 = d2;
     }
   }
-  // On a held face: none (the support is not rendered).
-  if (!best || !object_.Drivable(*best)) return std::nullopt;
   return best;
 }
 
@@ -119,16 +125,26 @@ void SlidingContact::TouchDown(const std::array<double, 3>& tip_m, std::int64_t 
   // Through the face the tip is least deep behind; where that face has no node inside it to
   // slide on — a riser of a voxel staircase one voxel high has rim nodes only (on the organ a
   // quarter of the tips inside came in so, and the tool pushed nothing until it left again) — the
-  // next way out that has one, up to a voxel deeper.
+  // next way out that has one, up to a voxel deeper. Never the face opposite the way in (on a
+  // feature a voxel thin it is that near): its push would go the way the tool moves, pulling the
+  // hand through the object. A held face ends the search: the support is not rendered, and a
+  // side face beside it would push the tool sideways by as much as a voxel's depth.
   const std::array<ContactObject::Entry, 6> ways = object_.WaysOut(tip_m);
   ContactObject::Entry entry = ways[0];
   wanted_ = std::nullopt;
   for (const ContactObject::Entry& way : ways) {
     if (way.depth_m > ways[0].depth_m + object_.spacing_m()) break;
-    if ((wanted_ = NodeInsideFace(way))) {
+    bool opposite = true;
+    for (int c = 0; c < 3; ++c)
+      opposite = opposite && way.inward_normal[c] == -ways[0].inward_normal[c];
+    if (opposite) continue;
+    const std::optional<LatticeIndex> node = NearestNodeInsideFace(way);
+    if (!node) continue;  // nothing inside it to slide on: the next way out
+    if (object_.Drivable(*node)) {
       entry = way;
-      break;
+      wanted_ = node;
     }
+    break;
   }
   inward_ = entry.inward_normal;
   for (int c = 0; c < 3; ++c) {

@@ -21,7 +21,8 @@ namespace hapticsim {
  *
  * Touch-down is through the face the tip is least deep behind, as ContactTracker's, or where that
  * face has no node inside it (a riser of a voxel staircase one voxel high), the next way out that
- * has one, up to a voxel deeper (ContactObject::WaysOut); the node it wants is the one nearest
+ * has one, up to a voxel deeper, never the opposite face, none past a held face
+ * (ContactObject::WaysOut); the node it wants is the one nearest
  * the entry point inside that face (a rim node's normal is not the face's). The
  * proxy engages wherever the regions it is bound to, on that face, can push under the tip (then
  * they follow it from there); otherwise it waits (zero force, "waiting") until the supervisor has
@@ -134,6 +135,9 @@ class SlidingContact {
   // The node a sliding touch through `entry` wants: the one nearest it inside its face (its
   // normal the face's, as a proxy needs; never a rim node), none on a held face.
   std::optional<LatticeIndex> NodeInsideFace(const ContactObject::Entry& entry) const noexcept;
+  // The same, held or not (a held face: its node, which no touch drives).
+  std::optional<LatticeIndex> NearestNodeInsideFace(
+      const ContactObject::Entry& entry) const noexcept;
   // `point_m` (the tip, under the face; the proxy) projected onto the touched face's plane.
   ContactObject::Entry OnTouchedFace(const std::array<double, 3>& point_m) const noexcept;
   // A touch of the tip, inside the object: waiting for regions on its face, or engaged at once

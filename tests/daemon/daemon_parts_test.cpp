@@ -168,6 +168,10 @@ TEST(DaemonConfig, MistakesAreRefusedNamingTheKeyAndLine) {
       {"[log]\nmax_lines_per_s = 1e9\n", "log.max_lines_per_s must be in (0, 1000]"},
       {"[device]\nmax_force_n = 100\nengage_rate_n_per_ms = 0.1\nfault_force_n = 100\n", ""},
       {"[device]\nmax_force_n = 1e300\n", "device.max_force_n must be in (0, 100] N"},
+      // A slew below the lift-off's default 0.1 N per ms loads as before the key came.
+      {"[device]\nmax_force_n = 3\nmax_force_rate_n_per_ms = 0.05\nengage_rate_n_per_ms = 0.03\n",
+       ""},
+      {"[device]\nlift_off_rate_n_per_ms = 100\n", ""},
       // The service socket: an absolute path a Unix socket can have (107 bytes).
       {"[shm]\nsocket = \"/run/hapticsim/hapticsimd.sock\"\n", ""},
       {"[shm]\nsocket = \"hapticsimd.sock\"\n", "shm.socket must be an absolute path"},
@@ -341,7 +345,7 @@ TEST(DaemonConfig, TheDeviceProfileIsReadCheckedAndOwnsTheInput) {
       {"[device]\nengage_rate_n_per_ms = 1.0\n", "to device.max_force_rate_n_per_ms (0.5)"},
       {"[device]\nwatchdog_s = 0.0\n", "device.watchdog_s must be from 0.05 to 10 s"},
       {"[device]\nengage_rate_n_per_ms = 1e-9\n", "device.engage_rate_n_per_ms must be from"},
-      {"[device]\nlift_off_rate_n_per_ms = 0.6\n", "to device.max_force_rate_n_per_ms (0.5)"},
+      {"[device]\nlift_off_rate_n_per_ms = 101\n", "device.lift_off_rate_n_per_ms must be from"},
       {"[device]\nlift_off_rate_n_per_ms = nan\n", "device.lift_off_rate_n_per_ms must be from"},
       {"[device]\ninput = \"usb\"\n", "device.input must be \"lcm\" or \"shm\" (it is \"usb\")"},
       {"[device]\ninput = \"shm\"\n", "device.input = \"shm\" needs shm.enabled = true"},

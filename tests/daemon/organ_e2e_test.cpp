@@ -108,7 +108,7 @@ TEST(HapticsimdOnAnOrgan, PressesAndAWalkOverItsFrontKeepTheForceRightUnderLoad)
 // The same walk with a tool that slides (contact.model = "proxy" added to the organ's scene):
 // the organ's voxel staircase has risers one voxel high with no node inside them to slide on, and
 // a tip that came in through one pushed nothing until it left again (1,038–1,611 answers in
-// contact in 15 s; it touches through the tread above since: 6,115–6,548, where the node contact
+// contact in 15 s; it touches through the tread above since: 6,115–6,731, where the node contact
 // gives about 6,800). Every answer arrives, no fault, no force out of contact, no step over
 // 0.25 N (the cube's bound under load).
 TEST(HapticsimdOnAnOrgan, AToolThatSlidesStaysInContactOverItsStaircaseUnderLoad) {
