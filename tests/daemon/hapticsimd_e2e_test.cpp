@@ -269,8 +269,14 @@ struct RecentringRun {
   int waited = 0;           // periods flagged waiting for the regions to move
   int pushing_back = 0;     // answers in the held press pushing back over 0.3 N
   int near_late = 0;        // answers from a period woken late or just after one
+  int on_time = 0;          // the others: the steps measured
+  int on_time_in_ramp = 0;  // … of them in the engage ramp (0.1 s from the first force)
   double largest_jump = 0;  // N, between answers of periods woken on time
   size_t answers = 0;
+
+  // The steps measured cover the re-centring: its ramp-in, and the press after it. (Not most of
+  // the answers: CI's machine once woke 811–1,157 of 1,600 late in three touches running alone.)
+  bool MeasuredEnough() const { return on_time_in_ramp >= 10 && on_time >= 200; }
 };
 
 // Hovers over surface node (2, 3, 0), presses 6 mm in over 600 ms and holds; checks what the
@@ -326,6 +332,8 @@ void TouchOffCentre(Client& client, testing::BackgroundProcess& daemon, Recentri
                          // (tests/support/late_wakes.hpp)
     } else {
       run->largest_jump = std::max(run->largest_jump, std::abs(f.force[2] - previous));
+      ++run->on_time;
+      if (first_force_us >= 0 && f.utime <= first_force_us + 100'000) ++run->on_time_in_ramp;
     }
     previous = f.force[2];
   }
@@ -335,18 +343,21 @@ void TouchOffCentre(Client& client, testing::BackgroundProcess& daemon, Recentri
   run->answers = forces.size();
   std::printf(
       "re-centring: %.1f ms from touch-down to the first force (%d periods flagged waiting); "
-      "largest force step %.4f N over periods woken on time; %d of %zu answers near a late "
-      "wake\n",
-      run->touch_to_force_ms, run->waited, run->largest_jump, run->near_late, run->answers);
+      "largest force step %.4f N over periods woken on time (%d of them in the ramp-in); %d of "
+      "%zu answers near a late wake\n",
+      run->touch_to_force_ms, run->waited, run->largest_jump, run->on_time_in_ramp, run->near_late,
+      run->answers);
 }
 
 // Contact anywhere: a touch on another surface node moves the regions there at once (their
 // coupling verified behind them) and pushes back with its force ramped in, within 20 ms.
 TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
-  // The force's smoothness is measured over the periods woken on time, so it needs most of them
-  // to be: where the machine woke a quarter or more of them late (measured once in CI: 657 of
-  // 1,600, against 0–5 on a quiet machine and 89–182 beside three busy threads), the touch is
-  // made again, on a fresh daemon, up to three times.
+  // The force's smoothness is measured over the periods woken on time (a late wake's step through
+  // the held boundary is the stall tests'), so it needs enough of them where the re-centring is:
+  // where the machine woke nearly all of the ramp-in late, the touch is made again, on a fresh
+  // daemon, up to three times. Late answers measured: 0–12 of 1,600 on a quiet machine, 61–339
+  // beside two to eight busy processes, 657–1,157 in CI (where the steps on time were 0.015–0.031
+  // N); the largest step over all answers was the on-time one's here, or under 0.09 N.
   RecentringRun run;
   for (int attempt = 1; attempt <= 3; ++attempt) {
     if (attempt > 1) {
@@ -359,16 +370,17 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
     if (HasFatalFailure()) return;
     daemon_->Signal(SIGTERM);
     EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
-    if (run.near_late < static_cast<int>(run.answers) / 4) break;
-    std::printf("attempt %d: %d of %zu answers came from periods woken late; touching again\n",
-                attempt, run.near_late, run.answers);
+    if (run.MeasuredEnough()) break;
+    std::printf("attempt %d: %d of %zu answers woken on time, %d in the ramp-in; touching again\n",
+                attempt, run.on_time, run.answers, run.on_time_in_ramp);
   }
   EXPECT_LE(run.touch_to_force_ms, 20.0) << "from touch-down to the first force\n"
                                          << daemon_->Log();
   EXPECT_GT(run.pushing_back, 100) << daemon_->Log();
   EXPECT_LT(run.largest_jump, 0.1) << "a force step across the re-centring";
-  EXPECT_LT(run.near_late, static_cast<int>(run.answers) / 4)
-      << "answers from periods woken late, of " << run.answers << ", in each of three touches";
+  EXPECT_TRUE(run.MeasuredEnough())
+      << "too few answers woken on time to measure the re-centring, in each of three touches: "
+      << run.on_time << " of " << run.answers << ", " << run.on_time_in_ramp << " in the ramp-in";
 }
 
 TEST_F(HapticsimdEndToEnd, APinnedConfigurationHoldsUntilReleasedAndAnOutOfRangeOneIsRefused) {

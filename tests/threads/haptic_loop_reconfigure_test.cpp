@@ -101,6 +101,11 @@ struct PressResult {
   bool moved = false;
 };
 
+// Fewer than `fraction` of the press's answers came from periods woken late or just after one.
+bool MostlyOnTime(const PressResult& press, double fraction) {
+  return press.near_late_wakes < fraction * static_cast<double>(press.forces.size());
+}
+
 // The force changes between periods (z) of a press: over the periods woken on time, and over all.
 void MeasureJumps(PressResult* result) {
   std::vector<Wake> wakes;
@@ -169,8 +174,16 @@ PressResult PressAt(const LatticeIndex& node, const LatticeIndex& centre) {
 
 TEST(HapticLoopReconfigure, ATouchOnAnotherNodeIsAnsweredAfterRecentringWithoutAForceStep) {
   const LatticeIndex side{2, 3, 0};
-  const PressResult centred = PressAt(side, side);  // the same press, no re-centring needed
-  const PressResult moved = PressAt(side, LatticeIndex{6, 6, 0});
+  // Pressed again, up to three times, where the machine woke two in five of either press's
+  // answers late (see below): the smoothness is measured over the others.
+  PressResult centred, moved;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    centred = PressAt(side, side);  // the same press, no re-centring needed
+    moved = PressAt(side, LatticeIndex{6, 6, 0});
+    if (kSanitized || (MostlyOnTime(centred, 0.4) && MostlyOnTime(moved, 0.4))) break;
+    std::printf("attempt %d: %d and %d of %zu answers near a late wake; pressing again\n", attempt,
+                centred.near_late_wakes, moved.near_late_wakes, moved.forces.size());
+  }
   EXPECT_FALSE(centred.moved);
   ASSERT_TRUE(moved.moved) << "the touch never asked for the regions";
   int waiting = 0, engaged = 0;
@@ -219,8 +232,10 @@ TEST(HapticLoopReconfigure, ATouchOnAnotherNodeIsAnsweredAfterRecentringWithoutA
   // Left out: under one per cent on a quiet machine, 1 to 14 % with two busy loops beside it;
   // on a noisier VM (2026-12-05) 2 to 21 % idle, once 37 %. Two in five, and what is left says
   // nothing about smoothness.
-  EXPECT_LT(moved.near_late_wakes, 2 * moved.forces.size() / 5);
-  EXPECT_LT(centred.near_late_wakes, 2 * centred.forces.size() / 5);
+  EXPECT_TRUE(MostlyOnTime(moved, 0.4) && MostlyOnTime(centred, 0.4))
+      << "two in five answers or more near a late wake in each of three pairs of presses: "
+      << moved.near_late_wakes << " and " << centred.near_late_wakes << " of "
+      << moved.forces.size();
   // The wait, the move and the ramp-in are all before the stop: there, no change larger than the
   // ordinary press's own. (At the stop itself the force changes by however the object happens to
   // be moving then, which differs between regions started from rest at different times: 0.036
@@ -323,8 +338,16 @@ std::vector<SwitchWindow> SwitchWindows(const std::vector<ForceRecord>& forces) 
 // force does not step by more than 0.1 N between periods — quiet, and beside two busy threads.
 TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWithoutAStep) {
   for (int busy : {0, 2}) {
-    const PressResult plain = PaperPress(false, busy);
-    const PressResult switched = PaperPress(true, busy);
+    // Pressed again, up to three times, where the machine woke half the switched press's answers
+    // late (see below): the smoothness is measured over the others.
+    PressResult plain, switched;
+    for (int attempt = 1; attempt <= 3; ++attempt) {
+      plain = PaperPress(false, busy);
+      switched = PaperPress(true, busy);
+      if (kSanitized || MostlyOnTime(switched, 0.5)) break;
+      std::printf("%d busy threads, attempt %d: %d of %zu answers near a late wake; again\n", busy,
+                  attempt, switched.near_late_wakes, switched.forces.size());
+    }
     ASSERT_TRUE(switched.moved) << "the stand-in supervisor did not switch three times";
     int held = 0;
     for (const ForceRecord& f : switched.forces) {
@@ -363,7 +386,9 @@ TEST(HapticLoopReconfigure, AConfigurationSwitchedInThePressCarriesTheForceWitho
     EXPECT_EQ(windows.size(), 3u) << "each switch in the press is a hold of its own";
     // Beside two busy threads 1–31 % of the answers were near a late wake (with or without
     // switches): half, and what is left still covers the press.
-    EXPECT_LT(switched.near_late_wakes, switched.forces.size() / 2);
+    EXPECT_TRUE(MostlyOnTime(switched, 0.5))
+        << "half the answers or more near a late wake in each of three presses: "
+        << switched.near_late_wakes << " of " << switched.forces.size();
     // Both presses are smooth between periods woken on time: under the 0.1 N of every smoothness
     // check (measured in 40 runs: up to 0.047 N switched and 0.041 N plain quiet, 0.042 N and
     // 0.051 N beside two busy threads). And at the switches (each hold and the five periods after
