@@ -132,23 +132,30 @@ TEST(IdleLoop, AfterAnIdleWaitTheAnswersAreReadOnTheGridItWentBackTo) {
     read_in_stretches.push_back({f.period, f.utime_us, input_stale});
   }
   ASSERT_GT(stale, 0) << "no answer to stale input while the device was silent";
-  auto late_after_the_wait = [&](const std::vector<Wake>& wakes) {
+  auto late_in = [&](const std::vector<Wake>& wakes, size_t begin, size_t end) {
     const std::vector<bool> near = NearALateWake(wakes);
     int late = 0;
-    for (size_t i = answers.size() - after.size(); i < answers.size(); ++i) {
-      late += !read_in_stretches[i].input_stale && near[i];
-    }
+    for (size_t i = begin; i < end; ++i) late += !read_in_stretches[i].input_stale && near[i];
     return late;
+  };
+  auto late_after_the_wait = [&](const std::vector<Wake>& wakes) {
+    return late_in(wakes, answers.size() - after.size(), answers.size());
   };
   // On one grid the whole second stretch is "late" by the ~150 periods skipped: the measure the
   // e2e re-centring test once failed on (657 of 1,600 answers). Read in stretches, only the
   // machine's own late wakes count (a quiet machine: none to a few).
   const int on_one_grid = late_after_the_wait(counted_on_one_grid);
   const int in_stretches = late_after_the_wait(read_in_stretches);
-  std::printf("after the idle wait, of %zu answers: %d late counted on one grid, %d in stretches\n",
-              after.size(), on_one_grid, in_stretches);
+  // The machine's own: the answers before the wait, as late as it woke them.
+  const int before_the_wait = late_in(read_in_stretches, 0, answers.size() - after.size());
+  std::printf(
+      "after the idle wait, of %zu answers: %d late counted on one grid, %d in stretches (%d "
+      "before the wait)\n",
+      after.size(), on_one_grid, in_stretches, before_the_wait);
   EXPECT_GT(on_one_grid, 250);
-  EXPECT_LT(in_stretches, 75);
+  // A machine that wakes many late (CI's once woke two in three) makes as many late after the
+  // wait as before it, give or take.
+  EXPECT_LT(in_stretches, 75 + before_the_wait);
 }
 
 }  // namespace
