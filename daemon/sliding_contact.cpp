@@ -233,21 +233,28 @@ std::array<double, 3> SlidingContact::Rendered(const ProxyContact::Result& touch
   }
   std::array<double, 3> push{};
   for (int c = 0; c < 3; ++c) push[c] = k * offset[c] / over;
-  return InsideFrictionCone(push);
+  return InsideFrictionCone(push, touch.wall_holds);
 }
 
 std::array<double, 3> SlidingContact::InsideFrictionCone(
-    const std::array<double, 3>& push) const noexcept {
+    const std::array<double, 3>& push, const std::array<bool, 3>& wall_holds) const noexcept {
   double normal = 0;
   for (int c = 0; c < 3; ++c) normal += push[c] * inward_[c];
   if (!(normal > 0)) return {};  // a push never pulls the tool in
+  // What a wall holds (the proxy at its foot, the tool past it) is the wall's push, kept whole.
   std::array<double, 3> tangential{};
-  for (int c = 0; c < 3; ++c) tangential[c] = push[c] - normal * inward_[c];
+  for (int c = 0; c < 3; ++c) {
+    tangential[c] = wall_holds[static_cast<std::size_t>(c)] ? 0.0 : push[c] - normal * inward_[c];
+  }
   const double along = std::hypot(tangential[0], tangential[1], tangential[2]);
   const double most = settings_.static_friction * normal;
   if (along <= most) return push;
-  std::array<double, 3> inside{};
-  for (int c = 0; c < 3; ++c) inside[c] = normal * inward_[c] + tangential[c] * (most / along);
+  std::array<double, 3> inside = push;
+  for (int c = 0; c < 3; ++c) {
+    if (!wall_holds[static_cast<std::size_t>(c)]) {
+      inside[c] = normal * inward_[c] + tangential[c] * (most / along);
+    }
+  }
   return inside;
 }
 

@@ -161,8 +161,10 @@ class SlidingContact {
   // end: ramped in, or brought back from the push held over a pause (CatchUp: the spring anchored
   // where it gave that push, the anchor returning to the tool).
   std::array<double, 3> Rendered(const ProxyContact::Result& touch, std::int64_t now_ns) noexcept;
-  // `push` with its tangential part at most μ_s times its normal part, and none if it would pull.
-  std::array<double, 3> InsideFrictionCone(const std::array<double, 3>& push) const noexcept;
+  // `push` with its tangential part at most μ_s times its normal part, and none if it would pull;
+  // what a wall holds (the proxy at its foot, ProxyContact::Result::wall_holds) is kept whole.
+  std::array<double, 3> InsideFrictionCone(const std::array<double, 3>& push,
+                                           const std::array<bool, 3>& wall_holds) const noexcept;
   // One primary substep's push, from the state at its end (EndOfStepLoad): the proxy moved for
   // the tool at `tool_m`, the push rendered and spread over the face (zero unless engaged).
   class SubstepPush final : public EndOfStepLoad {

@@ -91,35 +91,81 @@ void ProxyContact::Rebind(ProxySurface surface) {
   }
 }
 
-bool ProxyContact::ExposedFace(int i1, int i2) const {
+bool ProxyContact::Occupied(int along, int i1, int i2) const {
   const std::array<int, 3>& n = surface_.lattice_nodes;
   const std::array<int, 3> counts = {n[0] - 1, n[1] - 1, n[2] - 1};
   if (i1 < 0 || i2 < 0 || i1 >= counts[t1_] || i2 >= counts[t2_]) return false;
-  // The voxel inside the face must be the object's, the one outside it not.
-  auto occupied = [&](int along) {
-    if (along < 0 || along >= counts[axis_]) return false;
-    std::array<int, 3> e{};
-    e[axis_] = along;
-    e[t1_] = i1;
-    e[t2_] = i2;
-    return surface_
-               .occupied[static_cast<std::size_t>(e[0] + counts[0] * (e[1] + counts[1] * e[2]))] !=
-           0;
-  };
-  const int inside = sign_ > 0 ? plane_ : plane_ - 1;
-  const int outside = sign_ > 0 ? plane_ - 1 : plane_;
-  return occupied(inside) && !occupied(outside);
+  if (along < 0 || along >= counts[axis_]) return false;
+  std::array<int, 3> e{};
+  e[axis_] = along;
+  e[t1_] = i1;
+  e[t2_] = i2;
+  return surface_
+             .occupied[static_cast<std::size_t>(e[0] + counts[0] * (e[1] + counts[1] * e[2]))] != 0;
 }
 
-bool ProxyContact::PatchAt(const std::array<double, 2>& proxy, Patch* corners) const {
+bool ProxyContact::ExposedFace(int i1, int i2) const {
+  // The voxel inside the face must be the object's, the one outside it not.
+  const int inside = sign_ > 0 ? plane_ : plane_ - 1;
+  const int outside = sign_ > 0 ? plane_ - 1 : plane_;
+  return Occupied(inside, i1, i2) && !Occupied(outside, i1, i2);
+}
+
+bool ProxyContact::WallCell(int i1, int i2) const {
+  return Occupied(sign_ > 0 ? plane_ - 1 : plane_, i1, i2);
+}
+
+std::array<int, 2> ProxyContact::CellOf(const std::array<double, 2>& proxy) const {
   const std::array<int, 3>& n = surface_.lattice_nodes;
-  const std::array<int, 3> counts = {n[0] - 1, n[1] - 1, n[2] - 1};
   // A proxy exactly on the lattice's last node line belongs to the cell below it.
   const auto cell = [](double at, int count) {
     const int i = static_cast<int>(std::floor(at));
     return i == count && at == count ? count - 1 : i;
   };
-  const int i1 = cell(proxy[0], counts[t1_]), i2 = cell(proxy[1], counts[t2_]);
+  return {cell(proxy[0], n[t1_] - 1), cell(proxy[1], n[t2_] - 1)};
+}
+
+bool ProxyContact::OverFaceOrWall(const std::array<double, 2>& proxy) const {
+  if (!std::isfinite(proxy[0] + proxy[1])) return false;
+  const std::array<int, 2> cell = CellOf(proxy);
+  return ExposedFace(cell[0], cell[1]) || WallCell(cell[0], cell[1]);
+}
+
+bool ProxyContact::AgainstWall(int tangent, double direction) const {
+  if (direction == 0) return false;
+  const std::array<int, 2> cell = CellOf(proxy_);
+  const double within = proxy_[tangent] - std::floor(proxy_[tangent]);
+  // Clamped, the proxy sits kWallGap short of the boundary ahead, or on the one behind.
+  const bool at_boundary = direction > 0 ? within >= 1 - 2 * kWallGap : within <= kWallGap;
+  std::array<int, 2> beyond = cell;
+  beyond[tangent] += direction > 0 ? 1 : -1;
+  return at_boundary && WallCell(beyond[0], beyond[1]);
+}
+
+void ProxyContact::SlideTowards(const std::array<double, 2>& target) noexcept {
+  // In steps of at most half a cell, one tangent at a time: a step onto a wall's cell stops at
+  // the boundary, the other tangent goes on (the proxy slides along the wall's foot).
+  const double span = std::max(std::abs(target[0] - proxy_[0]), std::abs(target[1] - proxy_[1]));
+  const int steps = std::clamp(static_cast<int>(std::ceil(2 * span)), 1, 64);
+  const std::array<double, 2> from = proxy_;
+  for (int s = 1; s <= steps; ++s) {
+    for (int t = 0; t < 2; ++t) {
+      const double next = from[t] + (target[t] - from[t]) * s / steps;
+      std::array<double, 2> moved = proxy_;
+      moved[t] = next;
+      const std::array<int, 2> cell = CellOf(moved), now = CellOf(proxy_);
+      if (cell[t] != now[t] && WallCell(cell[0], cell[1])) {
+        proxy_[t] = next > proxy_[t] ? now[t] + 1 - kWallGap : now[t];
+      } else {
+        proxy_[t] = next;
+      }
+    }
+  }
+}
+
+bool ProxyContact::PatchAt(const std::array<double, 2>& proxy, Patch* corners) const {
+  const std::array<int, 2> cell = CellOf(proxy);
+  const int i1 = cell[0], i2 = cell[1];
   if (!std::isfinite(proxy[0] + proxy[1]) || !ExposedFace(i1, i2)) return false;
   if (reach_ > 1.0) return TentPatch(proxy, corners);
   const double a = proxy[0] - i1, b = proxy[1] - i2;
@@ -253,6 +299,25 @@ double ProxyContact::Compliance(const Patch& patch,
   return sum;
 }
 
+bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth) noexcept {
+  // The pull into a wall the proxy is against is the wall's to hold, not friction's: only the
+  // rest of the tangential pull may slide it.
+  std::array<double, 2> pull = {d[t1_], d[t2_]};
+  for (int t = 0; t < 2; ++t) {
+    if (AgainstWall(t, pull[static_cast<std::size_t>(t)])) pull[static_cast<std::size_t>(t)] = 0;
+  }
+  const double tangential = std::hypot(pull[0], pull[1]);
+  const double mu = sliding_ ? contact_.kinetic_friction : contact_.static_friction;
+  sliding_ = tangential > mu * depth;
+  if (sliding_) {
+    // Slide towards the tool until the pull is μ_k times the push, or a wall stops it.
+    const double move = (tangential - contact_.kinetic_friction * depth) / tangential;
+    const double h = surface_.spacing_m;
+    SlideTowards({proxy_[0] + move * pull[0] / h, proxy_[1] + move * pull[1] / h});
+  }
+  return sliding_;
+}
+
 ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           const Eigen::VectorXd& u,
                                           std::span<const double> compliance,
@@ -263,14 +328,15 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   const int last_pushed = pushed_.count;
   pushed_.count = 0;
   Result result;
-  Patch corners;
+  Patch corners, tool_patch;
   const auto offset_to_tool = [&] {
     const std::array<double, 3> s = SurfacePoint(corners, u);
     return std::array<double, 3>{tool_m[0] - s[0], tool_m[1] - s[1], tool_m[2] - s[2]};
   };
-  // Over no face of the object, the tool has left the surface this contact can render.
+  // Over no face of the object, the tool has left the surface this contact can render. Over a
+  // wall rising from the face (a concave corner) it has not: the wall holds the proxy at its foot.
   const double h = surface_.spacing_m;
-  if (!PatchAt({tool_m[t1_] / h, tool_m[t2_] / h}, &corners) || !PatchAt(proxy_, &corners)) {
+  if (!OverFaceOrWall({tool_m[t1_] / h, tool_m[t2_] / h}) || !PatchAt(proxy_, &corners)) {
     result.left_surface = true;
     pushed_.count = last_pushed;
     return result;
@@ -281,6 +347,13 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   }
   std::array<double, 3> d = offset_to_tool();
   const double depth = sign_ * d[axis_];
+  if (depth <= 0 && !PatchAt({tool_m[t1_] / h, tool_m[t2_] / h}, &tool_patch)) {
+    // Above the face's plane past a wall's foot: the tool is in the wall, which this face cannot
+    // render (it renders the wall's push at the foot only while the tool is below the face too).
+    result.left_surface = true;
+    pushed_.count = last_pushed;
+    return result;
+  }
   if (depth <= 0) {  // out of contact: the proxy waits under the tool
     proxy_ = {tool_m[t1_] / h, tool_m[t2_] / h};
     sliding_ = false;
@@ -291,14 +364,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     return result;
   }
   const double k = contact_.stiffness_n_per_m;
-  const double tangential = std::hypot(d[t1_], d[t2_]);
-  const double mu = sliding_ ? contact_.kinetic_friction : contact_.static_friction;
-  sliding_ = tangential > mu * depth;
-  if (sliding_) {
-    // Slide towards the tool until the pull is μ_k times the push.
-    const double move = (tangential - contact_.kinetic_friction * depth) / tangential;
-    proxy_[0] += move * d[t1_] / h;
-    proxy_[1] += move * d[t2_] / h;
+  if (SlideByFriction(d, depth)) {
     if (!PatchAt(proxy_, &corners)) {
       result.left_surface = true;
       pushed_.count = last_pushed;
@@ -313,6 +379,8 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   result.in_contact = true;
   result.sliding = sliding_;
   result.offset_m = d;
+  result.wall_holds[static_cast<std::size_t>(t1_)] = AgainstWall(0, d[t1_]);
+  result.wall_holds[static_cast<std::size_t>(t2_)] = AgainstWall(1, d[t2_]);
   // The spring taken at the step's end: the push f moves the surface under the proxy by C·f, so
   // f = k·(d − C·f).
   result.compliance_m_per_n = Compliance(corners, compliance);

@@ -55,8 +55,12 @@ ProxySurface ProxySurfaceOf(const ElasticModel& model);
  * above μ_k·k·g. Out of contact (g ≤ 0) the proxy sits under the tool and no force is felt.
  *
  * The face is the plane of the contact node, normal to its inward normal's axis; the proxy moves
- * over its cells that are faces of occupied voxels with nothing outside them. Update() never
- * allocates.
+ * over its cells that are faces of occupied voxels with nothing outside them. A cell of the plane
+ * with the object outside it is a wall rising from the face (a concave corner): the proxy stops at
+ * its foot, and while the tool is past it, below the face, the spring's pull into the wall is the
+ * wall's push, not friction's (Result::wall_holds); along the foot the proxy slides as anywhere.
+ * The proxy does not climb the wall: the tool risen out of the face into it has left the surface
+ * this contact renders. Update() never allocates.
  */
 class ProxyContact {
  public:
@@ -98,6 +102,9 @@ class ProxyContact {
     /// The proxy's face cell has a node this surface can neither push nor leave to a support
     /// (another region steps it): nothing was loaded. The regions must move under the proxy.
     bool left_region = false;
+    /// Per axis (grid frame): the push along it is a wall's, not friction's. The proxy stands at
+    /// the foot of a wall rising from its face (a concave corner) and the tool is past it.
+    std::array<bool, 3> wall_holds{};
   };
   /**
    * One step: the proxy moved for the tool at `tool_m` (grid frame, m) over `u`, the state at
@@ -140,6 +147,8 @@ class ProxyContact {
   // The widest tip, in lattice spacings, and the most nodes it can touch.
   static constexpr int kMaxReach = 8;
   static constexpr int kMaxPatch = (2 * kMaxReach + 1) * (2 * kMaxReach + 1);
+  // How far short of a wall's foot a stopped proxy stays, in node spacings: on its own cell.
+  static constexpr double kWallGap = 1e-6;
   // The face nodes the spring pushes and reads, with their weights (summing to 1).
   struct Patch {
     int count = 0;
@@ -152,7 +161,24 @@ class ProxyContact {
   bool TentPatch(const std::array<double, 2>& proxy, Patch* patch) const;
   // The deformed surface point at the proxy: the patch's weighted displacement.
   std::array<double, 3> SurfacePoint(const Patch& patch, const Eigen::VectorXd& u) const;
+  // Whether the object fills the voxel at `along` (the face's axis) under plane cell (i1, i2).
+  bool Occupied(int along, int i1, int i2) const;
   bool ExposedFace(int i1, int i2) const;
+  // Whether the face's plane at cell (i1, i2) has the object outside it: a wall rising from the
+  // face (a concave corner's other face, or the object going on past the face's plane). The proxy
+  // does not slide onto it.
+  bool WallCell(int i1, int i2) const;
+  // The plane's cell under a proxy at `proxy` (node spacings along t1, t2).
+  std::array<int, 2> CellOf(const std::array<double, 2>& proxy) const;
+  bool OverFaceOrWall(const std::array<double, 2>& proxy) const;
+  // Whether the proxy sits against a wall's foot along tangent `tangent` (0: t1, 1: t2), the way
+  // `direction`'s sign says.
+  bool AgainstWall(int tangent, double direction) const;
+  // Moves the proxy towards `target`, stopping at the foot of any wall on the way.
+  void SlideTowards(const std::array<double, 2>& target) noexcept;
+  // Coulomb friction on the tangential pull of the offset `d` (tool − surface, m) at `depth`:
+  // sticks, or slides the proxy towards the tool (SlideTowards). Returns whether it slid.
+  bool SlideByFriction(const std::array<double, 3>& d, double depth) noexcept;
   // Σ w²·c over the patch's pushed nodes: how far a push moves the surface point, m/N.
   double Compliance(const Patch& patch, std::span<const double> compliance) const noexcept;
   // Whether every node of the patch has its displacement in the state vector (ProxySurface::dof),

@@ -5,8 +5,8 @@
 // 0.1 N. It pushed nothing until the tool had left the object again: on a walk over the organ
 // (examples/organ/), a staircase of such risers, the tool was in contact for 1,038–1,611 of
 // 15,000 answers, and is for 6,115–6,731 since. A tip in through a held face touches no other face
-// instead. And a proxy that slides off its face's rim with the tip still inside the object lets
-// go smoothly.
+// instead. And a tool past a concave corner is held there by both faces, and lets go smoothly
+// where it rises out of the floor into the wall.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -150,49 +150,108 @@ TEST(SlidingOverSteps, AToolInThroughAHeldFaceTouchesNoOtherFace) {
 }
 
 // A step two voxels high: the tool 3 mm into the step's floor, stroked along +x to 6 mm past the
-// wall's foot (a concave corner). The proxy slides along the floor to its rim there and lets go
-// with the tip still inside the object, under the wall: its push fades out over
-// SlidingContact::kRelease_ns, flagged in contact meanwhile, with no step over 0.1 N, and nothing
-// is pushed after it. (What it should do there — stay in the corner, held by both faces — it does
-// not: docs/operations.md, *A tool that slides*.)
-TEST(SlidingOverSteps, AProxyOffItsFacesRimWithTheTipInsideLetsGoSmoothly) {
+// wall's foot (a concave corner), held there, and stroked back. The proxy slides along the floor
+// to the wall's foot and stays there, held by both faces: the floor pushes the tool back out of
+// itself and the wall pushes it back out of the wall, harder than friction could (the proxy does
+// not slide up the wall, nor let go). Stroked back, the proxy leaves the wall and slides on at
+// kinetic friction. No step over 0.1 N, in contact throughout. (It let go there, fading, with the
+// tip still inside, before the wall held it.)
+TEST(SlidingOverSteps, AToolPastAConcaveCornerIsHeldThereByBothFaces) {
+  Scene scene = SteppedBlock(2);
+  scene.input.contact_node = LatticeIndex{2, 3, 2};
+  const auto smooth = [](double t) { return t <= 0 ? 0.0 : t >= 1 ? 1.0 : t * t * (3 - 2 * t); };
+  const auto x_at = [&](double t) {
+    return 0.02 + 0.026 * smooth((t - 0.3) / 0.8) - 0.026 * smooth((t - 1.4) / 0.8);
+  };
+  const auto tip_at = [&](int n) {
+    const double t = n * 1e-3;
+    return Point{x_at(t), 0.03, 0.018 + 0.005 * smooth(t / 0.2)};
+  };
+  const ContactObject object = ContactObject::Of(scene);
+  const int periods = 2400;
+  const Played played = Play(scene, periods, tip_at);
+  ASSERT_EQ(played.force_n.size(), static_cast<std::size_t>(periods));
+  int first_contact = -1, out_after = 0;
+  for (int n = 0; n < periods; ++n) {
+    if (InContact(played, n) && first_contact < 0) first_contact = n;
+    if (first_contact >= 0 && !InContact(played, n)) ++out_after;
+  }
+  ASSERT_GE(first_contact, 0) << "the stroke never touched";
+  EXPECT_EQ(out_after, 0) << "periods out of contact after the touch, the tip inside throughout";
+  // At the wall's foot (x = 4 cm) and 6 mm past it, held: the wall's push grows with the depth into
+  // the wall, and is more than μ_s times the floor's.
+  const auto force = [&](int n) { return played.force_n[static_cast<std::size_t>(n)]; };
+  int at_foot = 0;
+  while (tip_at(at_foot)[0] < 0.04) ++at_foot;
+  const Point foot = force(at_foot), held = force(1390);
+  ASSERT_TRUE(object.Inside(tip_at(1390)));
+  std::printf(
+      "concave corner: force (%.4f, %.4f, %.4f) N at the wall's foot, (%.4f, %.4f, %.4f) N held "
+      "6 mm past it; largest step %.4f N\n",
+      foot[0], foot[1], foot[2], held[0], held[1], held[2], played.largest_step_n);
+  EXPECT_LT(held[2], -0.1) << "the floor does not push back";
+  EXPECT_LT(held[0], -0.5 * std::abs(held[2])) << "the wall does not push back beyond friction";
+  EXPECT_LT(held[0], foot[0] - 0.1) << "the wall's push does not grow with the depth into it";
+  EXPECT_LE(played.largest_step_n, 0.1);
+  // Stroked back (−x), once sliding: the lateral force is μ_k times the normal (within 5 %),
+  // opposing the motion.
+  int sliding_back = 0;
+  for (int n = 1800; n < 2150; ++n) {
+    const Point f = force(n);
+    if (f[2] > -0.05) continue;
+    ++sliding_back;
+    EXPECT_NEAR(f[0] / -f[2], 0.4, 0.4 * 0.05) << "period " << n;
+  }
+  EXPECT_GT(sliding_back, 300);
+}
+
+// Held past the corner as above, the tool then rises 8 mm, out of the floor and on into the wall:
+// the floor can no longer hold the proxy at the wall's foot, and the proxy cannot climb the wall
+// (it slides on one face). The contact lets go there, the tip inside the wall: the push, 0.66 N,
+// fades out over SlidingContact::kRelease_ns, flagged in contact meanwhile, with no step over 0.1
+// N, and nothing is pushed after it. (Let go at once, it stepped by the port guard's 0.5 N.)
+TEST(SlidingOverSteps, AToolThatRisesOutOfTheFloorIntoTheWallLetsGoSmoothly) {
   Scene scene = SteppedBlock(2);
   scene.input.contact_node = LatticeIndex{2, 3, 2};
   const auto smooth = [](double t) { return t <= 0 ? 0.0 : t >= 1 ? 1.0 : t * t * (3 - 2 * t); };
   const auto tip_at = [&](int n) {
     const double t = n * 1e-3;
-    return Point{0.02 + 0.026 * smooth((t - 0.3) / 0.8), 0.03, 0.018 + 0.005 * smooth(t / 0.2)};
+    return Point{0.02 + 0.026 * smooth((t - 0.3) / 0.8), 0.03,
+                 0.018 + 0.005 * smooth(t / 0.2) - 0.008 * smooth((t - 1.3) / 0.3)};
   };
   const ContactObject object = ContactObject::Of(scene);
-  const Played played = Play(scene, 1200, tip_at);
-  ASSERT_EQ(played.force_n.size(), 1200u);
+  const int periods = 1800;
+  const Played played = Play(scene, periods, tip_at);
+  ASSERT_EQ(played.force_n.size(), static_cast<std::size_t>(periods));
   const auto magnitude = [&](int n) {
     const Point& f = played.force_n[static_cast<std::size_t>(n)];
     return std::hypot(f[0], f[1], f[2]);
   };
-  // The last period pushing in full, then the fade.
   int last_in_contact = -1;
-  for (int n = 0; n < 1200; ++n) {
+  for (int n = 0; n < periods; ++n) {
     if (InContact(played, n)) last_in_contact = n;
   }
-  ASSERT_GT(last_in_contact, 400) << "the stroke never touched";
+  ASSERT_GT(last_in_contact, 1300) << "let go before the rise";
+  ASSERT_LT(last_in_contact, periods - 100) << "never let go";
   const long fade = SlidingContact::kRelease_ns / 1'000'000;
   const int let_go = last_in_contact - static_cast<int>(fade) + 1;
-  ASSERT_TRUE(object.Inside(tip_at(let_go))) << "the tip had left the object: not this case";
-  EXPECT_GT(tip_at(let_go)[0], 0.0395) << "let go before the floor's rim";
+  for (int n = let_go; n < periods; ++n) {
+    ASSERT_TRUE(object.Inside(tip_at(n))) << "the tip left the object: not this case";
+  }
+  EXPECT_LT(tip_at(let_go)[2], 0.0205) << "let go before the tip rose out of the floor";
   const double pushing = magnitude(let_go - 1);
-  EXPECT_GT(pushing, 0.2) << "not pushing as it let go";
+  EXPECT_GT(pushing, 0.4) << "the wall was not pushing as it let go";
   double largest_step = 0;
   for (int n = let_go; n <= last_in_contact + 1; ++n) {
     const Point& a = played.force_n[static_cast<std::size_t>(n - 1)];
     const Point& b = played.force_n[static_cast<std::size_t>(n)];
     largest_step = std::max(largest_step, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
   }
-  for (int n = last_in_contact + 1; n < 1200; ++n) EXPECT_EQ(magnitude(n), 0.0) << n;
+  for (int n = last_in_contact + 1; n < periods; ++n) EXPECT_EQ(magnitude(n), 0.0) << n;
   std::printf(
-      "off the floor's rim at the wall's foot (x = %.4f m): %.3f N let go, largest step "
-      "in the fade %.4f N\n",
-      tip_at(let_go)[0], pushing, largest_step);
+      "risen out of the floor into the wall (z = %.4f m): %.3f N let go, largest step in the "
+      "fade %.4f N\n",
+      tip_at(let_go)[2], pushing, largest_step);
   EXPECT_LE(largest_step, 0.15 * pushing);
   EXPECT_LE(played.largest_step_n, 0.1);
 }

@@ -209,7 +209,8 @@ TEST(DaemonPrimaryPeriod, NeverAllocatesWithASlidingTool) {
 // An object that leaves voxels empty (ContactObject on voxels): the block of 10 × 6 × 4 voxels of
 // 1 cm with a step cut out of its front (x < 4 cm, z < 2 cm empty), its back held. The tool hovers
 // in the step and in front of the object (the hovered face, the nearest voxel), presses into the
-// step's floor (the way in through the voxels), drags 2 cm along it to the wall, lifts off and
+// step's floor (the way in through the voxels), drags along it 6 mm past the wall (the proxy held
+// at its foot), lifts off and
 // presses the front face beside the step: with the node contact, then with a sliding tool (the
 // flat faces, the node inside the face, the proxy on the floor).
 TEST(DaemonPrimaryPeriod, NeverAllocatesOnAnObjectWithEmptyVoxels) {
@@ -235,7 +236,7 @@ TEST(DaemonPrimaryPeriod, NeverAllocatesOnAnObjectWithEmptyVoxels) {
       } else if (n < 400) {
         tip[2] = 0.018 + 0.007 * std::min(1.0, (n - 100) / 200.0);  // into the floor
       } else if (n < 500) {
-        tip = {0.02 + 0.02 * (n - 400) / 100.0, 0.03, 0.025};  // along it to the wall
+        tip = {0.02 + 0.026 * (n - 400) / 100.0, 0.03, 0.025};  // along it, 6 mm past the wall
       } else if (n < 700) {
         tip = {0.06, 0.03, -0.002};  // lifted, over the front face
       } else {
