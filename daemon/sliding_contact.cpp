@@ -106,12 +106,16 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
   if (state_ == State::kReleasing) return Answer();  // wherever the tip goes (StepPeriod ends it)
   if (!object_.Inside(tip_m)) {
     state_ = State::kFree;
+    wall_within_m_ = 0;
     following_ = out_of_region_ = false;
     ramp_start_ns_ = catch_up_ns_ = -1;
     wanted_ = NodeInsideFace(object_.HoverEntry(tip_m));
     return {};
   }
-  if (state_ == State::kAwaitLiftOff) return {};
+  if (state_ == State::kAwaitLiftOff) {
+    TouchTheWall(tip_m, now_ns, centre);
+    return Answer();
+  }
   if (state_ == State::kFree) {
     TouchDown(tip_m, now_ns, centre);
   } else if (state_ == State::kWaiting) {
@@ -160,6 +164,19 @@ void SlidingContact::TouchDown(const std::array<double, 3>& tip_m, std::int64_t 
   if (state_ == State::kEngaged && entry.depth_m <= ContactTracker::kDeepTouchDown_m) {
     ramp_start_ns_ = -1;
   }
+}
+
+void SlidingContact::TouchTheWall(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                                  const std::optional<LatticeIndex>& centre) noexcept {
+  // Let go where the tool rose out of its face into a wall (the proxy slides on one face), the
+  // tip inside the wall touches it again, as from outside, if its way out is at most twice as
+  // deep as the tip was past the wall's foot then: its force ramps in to about the push let go
+  // (the same spring as deep in the same wall), or what the hand pushed in since. Deeper, a
+  // touch through whatever face is nearest could push far harder than anything felt before (at a
+  // concave corner's pocket the nearest was 23 mm away: 2.2 N): it waits for the tip to leave.
+  if (wall_within_m_ <= 0 || object_.WaysOut(tip_m)[0].depth_m > wall_within_m_) return;
+  wall_within_m_ = 0;
+  TouchDown(tip_m, now_ns, centre);
 }
 
 SlidingContact::Contact SlidingContact::Hold(std::int64_t now_ns,
@@ -315,8 +332,9 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
   const ProxyContact::Result touch = c.proxy_->Update(tool_m, predicted, compliance, load);
   if (touch.left_surface) {
     // Off the face's rim: let go, the push fading out; a new touch only after the tip has left
-    // the object.
+    // the object, or risen into a wall, through it (TouchTheWall).
     c.Release(now_ns_);
+    c.wall_within_m_ = 2 * touch.into_wall_m;
     if (c.state_ == State::kReleasing) {
       push_n = c.pushed_n_;
       c.proxy_->SpreadLoads(push_n, load);
@@ -417,6 +435,7 @@ double SlidingContact::ReleaseScale(std::int64_t now_ns) const noexcept {
 
 void SlidingContact::RestartFromRest() noexcept {
   if (state_ != State::kFree) state_ = State::kAwaitLiftOff;
+  wall_within_m_ = 0;
   following_ = out_of_region_ = false;
   ramp_start_ns_ = catch_up_ns_ = -1;
 }

@@ -34,7 +34,11 @@ namespace hapticsim {
  *
  * A proxy that slides out of the primary (the regions did not follow in time) pushes nothing
  * (zero force, "waiting") and asks for the regions at once; one that slides off the face's rim
- * releases the contact, and the tip must leave the object before it touches again. Released
+ * releases the contact, and the tip must leave the object before it touches again — unless the
+ * tool rose out of its face into a wall rising from it (ProxyContact::Result::into_wall_m): then
+ * it touches the wall, as from outside, where the wall's way out is at most twice as deep as the
+ * tip was past the wall's foot (TouchTheWall). At a wall's foot with the tool past it, below the
+ * face, the wall's push is kept whole by the friction cone (a concave corner). Released
  * while it pushes — off the rim, or the tip out of the object sideways still pressed in — its last
  * push fades out over kRelease_ns first (kReleasing, engaged meanwhile).
  *
@@ -144,6 +148,10 @@ class SlidingContact {
   // where the bound ones reach.
   void TouchDown(const std::array<double, 3>& tip_m, std::int64_t now_ns,
                  const std::optional<LatticeIndex>& centre) noexcept;
+  // Let go into a wall (ProxyContact::Result::into_wall_m), awaiting lift-off: touches it, as
+  // TouchDown, where the tip's way out is within wall_within_m_.
+  void TouchTheWall(const std::array<double, 3>& tip_m, std::int64_t now_ns,
+                    const std::optional<LatticeIndex>& centre) noexcept;
   // Engages a waiting touch when the regions, this period's (`centre`), can push under the tip on
   // its face.
   void TryEngage(const std::optional<LatticeIndex>& centre, std::int64_t now_ns) noexcept;
@@ -201,6 +209,8 @@ class SlidingContact {
   std::array<double, 3> last_push_{};  // the last period's push (the one a pause holds)
   std::array<double, 3> held_push_{};  // the push a pause held, come back from (CatchUp)
   std::array<double, 3> pushed_n_{};   // the last substep's push: a release fades it out
+  // Let go into a wall: how deep a way out through it may be to touch it again (0: none).
+  double wall_within_m_ = 0;
   std::int64_t release_start_ns_ = 0;
   // Bind counts the regions bound (the primary reads the count only on regions that are its
   // own); a release spreads its push only on the ones that push was pushed on.

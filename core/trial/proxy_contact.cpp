@@ -351,6 +351,11 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     // Above the face's plane past a wall's foot: the tool is in the wall, which this face cannot
     // render (it renders the wall's push at the foot only while the tool is below the face too).
     result.left_surface = true;
+    const std::array<double, 3> rest = proxy_rest_m();
+    for (int t = 0; t < 2; ++t) {
+      const double past = tool_m[t == 0 ? t1_ : t2_] - rest[t == 0 ? t1_ : t2_];
+      if (AgainstWall(t, past)) result.into_wall_m = std::max(result.into_wall_m, std::abs(past));
+    }
     pushed_.count = last_pushed;
     return result;
   }

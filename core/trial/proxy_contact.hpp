@@ -99,6 +99,9 @@ class ProxyContact {
     bool in_contact = false;
     bool sliding = false;       ///< the proxy slid this period
     bool left_surface = false;  ///< the proxy reached the face's edge: no surface under it
+    /// … because the tool has risen out of the face into a wall rising from it, this far past
+    /// the wall's foot (m; 0: not). The wall's face is another contact's to render.
+    double into_wall_m = 0;
     /// The proxy's face cell has a node this surface can neither push nor leave to a support
     /// (another region steps it): nothing was loaded. The regions must move under the proxy.
     bool left_region = false;

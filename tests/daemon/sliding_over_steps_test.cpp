@@ -5,8 +5,8 @@
 // 0.1 N. It pushed nothing until the tool had left the object again: on a walk over the organ
 // (examples/organ/), a staircase of such risers, the tool was in contact for 1,038–1,611 of
 // 15,000 answers, and is for 6,115–6,731 since. A tip in through a held face touches no other face
-// instead. And a tool past a concave corner is held there by both faces, and lets go smoothly
-// where it rises out of the floor into the wall.
+// instead. And a tool past a concave corner is held there by both faces; risen out of the floor
+// into the wall, it touches the wall.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,6 +84,8 @@ Played Play(const Scene& scene, int periods, const std::function<Point(int)>& ti
   }
   return played;
 }
+
+double Smooth(double t) { return t <= 0 ? 0.0 : t >= 1 ? 1.0 : t * t * (3 - 2 * t); }
 
 bool InContact(const Played& played, int n) {
   return played.flags[static_cast<std::size_t>(n)] & force_flags::kInContact;
@@ -205,55 +207,90 @@ TEST(SlidingOverSteps, AToolPastAConcaveCornerIsHeldThereByBothFaces) {
   EXPECT_GT(sliding_back, 300);
 }
 
-// Held past the corner as above, the tool then rises 8 mm, out of the floor and on into the wall:
-// the floor can no longer hold the proxy at the wall's foot, and the proxy cannot climb the wall
-// (it slides on one face). The contact lets go there, the tip inside the wall: the push, 0.66 N,
-// fades out over SlidingContact::kRelease_ns, flagged in contact meanwhile, with no step over 0.1
-// N, and nothing is pushed after it. (Let go at once, it stepped by the port guard's 0.5 N.)
-TEST(SlidingOverSteps, AToolThatRisesOutOfTheFloorIntoTheWallLetsGoSmoothly) {
+// A step two voxels high, the tool stroked 3 mm into its floor to 6 mm past the wall's foot
+// (held there, as above), then risen by `rise(t)` (m along −z) and moved on into the wall by
+// `on(t)` (m along +x).
+Played RiseIntoTheWall(const std::function<double(double)>& rise,
+                       const std::function<double(double)>& on, int periods) {
   Scene scene = SteppedBlock(2);
   scene.input.contact_node = LatticeIndex{2, 3, 2};
-  const auto smooth = [](double t) { return t <= 0 ? 0.0 : t >= 1 ? 1.0 : t * t * (3 - 2 * t); };
   const auto tip_at = [&](int n) {
     const double t = n * 1e-3;
-    return Point{0.02 + 0.026 * smooth((t - 0.3) / 0.8), 0.03,
-                 0.018 + 0.005 * smooth(t / 0.2) - 0.008 * smooth((t - 1.3) / 0.3)};
+    return Point{0.02 + 0.026 * Smooth((t - 0.3) / 0.8) + on(t), 0.03,
+                 0.018 + 0.005 * Smooth(t / 0.2) - rise(t)};
   };
-  const ContactObject object = ContactObject::Of(scene);
-  const int periods = 1800;
-  const Played played = Play(scene, periods, tip_at);
-  ASSERT_EQ(played.force_n.size(), static_cast<std::size_t>(periods));
-  const auto magnitude = [&](int n) {
-    const Point& f = played.force_n[static_cast<std::size_t>(n)];
-    return std::hypot(f[0], f[1], f[2]);
-  };
+  return Play(scene, periods, tip_at);
+}
+
+double Magnitude(const Point& f) { return std::hypot(f[0], f[1], f[2]); }
+
+// Held past the corner, the tool rises 8 mm, out of the floor and on into the wall: the floor can
+// no longer hold the proxy at the wall's foot, and the proxy slides on one face. It lets go there,
+// its push (0.66 N) fading out over SlidingContact::kRelease_ns, and touches the wall itself,
+// through the wall's face, as from outside: its force ramps in, the wall pushing the tool back out
+// of it with friction along it. No step over 0.1 N, and no answer out of contact meanwhile. (Let
+// go at once, it stepped by the port guard's 0.5 N, and pushed nothing until the tip left.)
+TEST(SlidingOverSteps, AToolThatRisesOutOfTheFloorIntoTheWallTouchesTheWall) {
+  const Played played = RiseIntoTheWall([](double t) { return 0.008 * Smooth((t - 1.3) / 0.3); },
+                                        [](double) { return 0.0; }, 1800);
+  ASSERT_EQ(played.force_n.size(), 1800u);
+  const double held = Magnitude(played.force_n[1400]);
+  double least = held;
+  int out = 0, waiting = 0;
+  for (int n = 1400; n < 1800; ++n) {
+    least = std::min(least, Magnitude(played.force_n[static_cast<std::size_t>(n)]));
+    if (InContact(played, n)) continue;
+    // Waiting for regions on the wall's face, as any touch does (zero force, flagged).
+    const bool waits = played.flags[static_cast<std::size_t>(n)] & force_flags::kReconfiguring;
+    (waits ? waiting : out) += 1;
+  }
+  const Point& end = played.force_n.back();
+  std::printf(
+      "risen into the wall: %.3f N held, %.3f N at the least, %d periods waiting, then (%.4f, "
+      "%.4f, %.4f) N through the wall; %d moves, largest step %.4f N\n",
+      held, least, waiting, end[0], end[1], end[2], played.moves, played.largest_step_n);
+  EXPECT_GT(held, 0.5) << "the corner did not hold the tool";
+  EXPECT_LT(least, 0.1 * held) << "the corner's push was not let go";
+  EXPECT_EQ(out, 0) << "answers out of contact with the tip inside, not waiting for regions";
+  EXPECT_LT(waiting, 50) << "it waited for the wall's regions";
+  EXPECT_LT(end[0], -0.5) << "the wall does not push the tool back out of it";
+  EXPECT_LE(std::abs(end[2]), 0.5 * 1.05 * std::abs(end[0])) << "outside the wall's friction cone";
+  EXPECT_LE(played.largest_step_n, 0.1);
+}
+
+// The same, the tool also pushed on 30 mm into the wall at 0.5 m/s as it rises: by the time the
+// corner's push has faded the tip is more than twice as deep past the wall's foot as it was when
+// let go, and a touch there could push far harder than the corner did. The push fades out
+// smoothly (at this speed the push grows by up to 0.19 N a period before: the hand's own motion
+// into a wall), and nothing is pushed after it until the tip leaves the object.
+TEST(SlidingOverSteps, AToolPushedDeepIntoTheWallAsItRisesTouchesNothing) {
+  const Played played =
+      RiseIntoTheWall([](double t) { return 0.008 * Smooth((t - 1.3) / 0.03); },
+                      [](double t) { return std::clamp(0.5 * (t - 1.31), 0.0, 0.03); }, 1800);
+  ASSERT_EQ(played.force_n.size(), 1800u);
   int last_in_contact = -1;
-  for (int n = 0; n < periods; ++n) {
+  for (int n = 0; n < 1800; ++n) {
     if (InContact(played, n)) last_in_contact = n;
   }
   ASSERT_GT(last_in_contact, 1300) << "let go before the rise";
-  ASSERT_LT(last_in_contact, periods - 100) << "never let go";
-  const long fade = SlidingContact::kRelease_ns / 1'000'000;
-  const int let_go = last_in_contact - static_cast<int>(fade) + 1;
-  for (int n = let_go; n < periods; ++n) {
-    ASSERT_TRUE(object.Inside(tip_at(n))) << "the tip left the object: not this case";
-  }
-  EXPECT_LT(tip_at(let_go)[2], 0.0205) << "let go before the tip rose out of the floor";
-  const double pushing = magnitude(let_go - 1);
-  EXPECT_GT(pushing, 0.4) << "the wall was not pushing as it let go";
-  double largest_step = 0;
-  for (int n = let_go; n <= last_in_contact + 1; ++n) {
+  ASSERT_LT(last_in_contact, 1400) << "touched again";
+  const int let_go =
+      last_in_contact - static_cast<int>(SlidingContact::kRelease_ns / 1'000'000) + 1;
+  const double pushing = Magnitude(played.force_n[static_cast<std::size_t>(let_go)]);
+  double largest_step = 0, largest_after = 0;
+  for (int n = let_go + 1; n < 1800; ++n) {
     const Point& a = played.force_n[static_cast<std::size_t>(n - 1)];
     const Point& b = played.force_n[static_cast<std::size_t>(n)];
     largest_step = std::max(largest_step, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+    if (n > last_in_contact) largest_after = std::max(largest_after, Magnitude(b));
   }
-  for (int n = last_in_contact + 1; n < periods; ++n) EXPECT_EQ(magnitude(n), 0.0) << n;
   std::printf(
-      "risen out of the floor into the wall (z = %.4f m): %.3f N let go, largest step in the "
-      "fade %.4f N\n",
-      tip_at(let_go)[2], pushing, largest_step);
+      "pushed deep into the wall as it rose: %.3f N let go, largest step in the fade %.4f N, "
+      "%.4f N after\n",
+      pushing, largest_step, largest_after);
+  EXPECT_GT(pushing, 0.5);
   EXPECT_LE(largest_step, 0.15 * pushing);
-  EXPECT_LE(played.largest_step_n, 0.1);
+  EXPECT_EQ(largest_after, 0.0) << "a touch deep inside the wall";
 }
 
 }  // namespace
