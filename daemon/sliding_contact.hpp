@@ -118,7 +118,8 @@ class SlidingContact {
    * A contact let go while it pushes — the tip gone out of the object sideways, still more than
    * ContactTracker::kDeepTouchDown_m past the face's plane (past the rim of the face the proxy
    * lags behind on), or the proxy slid off its face's rim
-   * — fades its last push out over this, by a smoothstep, on the nodes it pushed, rendered and
+   * — fades its last push out over this (longer for a large one: kReleaseRate_n_per_ns), by a
+   * smoothstep, on the nodes it pushed, rendered and
    * flagged in contact meanwhile; then the tip must leave the object (if it has not) before it
    * touches again. Let go in one period, the push stepped the hand by all of it: 0.13 N off the
    * cube's rim 5 mm in, 0.14 N where a walk over the organ went off a step of its staircase (a
@@ -126,6 +127,9 @@ class SlidingContact {
    * slip-off time.
    */
   static constexpr std::int64_t kRelease_ns = ContactTracker::kSlipOff_ns;
+  /** The fastest a let-go push fades, N/ns (0.08 N per ms): a push over 1.07 N fades over longer
+   *  than kRelease_ns. */
+  static constexpr double kReleaseRate_n_per_ns = 0.08e-6;
 
   /** The regions restart from rest around a new centre: an engaged or waiting contact engages
    *  again under the tip, its force ramped in from zero. */
@@ -160,7 +164,8 @@ class SlidingContact {
   void Release(std::int64_t now_ns) noexcept;
   // The tip more than ContactTracker::kDeepTouchDown_m past the touched face's plane.
   bool PressedIn(const std::array<double, 3>& tip_m) const noexcept;
-  // What is left of a released push: 1 → 0 by a smoothstep over kRelease_ns.
+  // What is left of a released push: 1 → 0 by a smoothstep over release_ns_ (kRelease_ns, or
+  // longer for a push too large to fade that fast: kReleaseRate_n_per_ns).
   double ReleaseScale(std::int64_t now_ns) const noexcept;
   // How much of what a pause held back is still to be given back (CatchUp): 1 → 0 by a
   // smoothstep over the catch-up, 0 outside one.
@@ -212,6 +217,7 @@ class SlidingContact {
   // Let go into a wall: how deep a way out through it may be to touch it again (0: none).
   double wall_within_m_ = 0;
   std::int64_t release_start_ns_ = 0;
+  std::int64_t release_ns_ = kRelease_ns;  // how long this release's fade takes
   // Bind counts the regions bound (the primary reads the count only on regions that are its
   // own); a release spreads its push only on the ones that push was pushed on.
   std::uint64_t bindings_ = 0, pushed_binding_ = 0;  // that pushed_n_ was pushed on

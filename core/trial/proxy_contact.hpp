@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -106,7 +107,8 @@ class ProxyContact {
     /// (another region steps it): nothing was loaded. The regions must move under the proxy.
     bool left_region = false;
     /// Per axis (grid frame): the push along it is a wall's, not friction's. The proxy stands at
-    /// the foot of a wall rising from its face (a concave corner) and the tool is past it.
+    /// the foot of a wall rising from its face (a concave corner) and the tool is past it; or the
+    /// wall has just stopped holding it (past its end) and it is catching up with the tool.
     std::array<bool, 3> wall_holds{};
   };
   /**
@@ -152,6 +154,10 @@ class ProxyContact {
   static constexpr int kMaxPatch = (2 * kMaxReach + 1) * (2 * kMaxReach + 1);
   // How far short of a wall's foot a stopped proxy stays, in node spacings: on its own cell.
   static constexpr double kWallGap = 1e-6;
+  // How much of the spring's force a proxy catching up after a wall stopped holding may shed in
+  // one Update beyond what the tool's own motion sheds, N (SlideByFriction): 0.02 N per
+  // substep, 0.04 N a period at 2 substeps.
+  static constexpr double kSlideCatchUp_n = 0.02;
   // The face nodes the spring pushes and reads, with their weights (summing to 1).
   struct Patch {
     int count = 0;
@@ -178,10 +184,16 @@ class ProxyContact {
   // `direction`'s sign says.
   bool AgainstWall(int tangent, double direction) const;
   // Moves the proxy towards `target`, stopping at the foot of any wall on the way.
-  void SlideTowards(const std::array<double, 2>& target) noexcept;
+  void SlideTowards(std::array<double, 2> target) noexcept;
   // Coulomb friction on the tangential pull of the offset `d` (tool − surface, m) at `depth`:
-  // sticks, or slides the proxy towards the tool (SlideTowards). Returns whether it slid.
-  bool SlideByFriction(const std::array<double, 3>& d, double depth) noexcept;
+  // sticks, or slides the proxy towards the tool (SlideTowards); catching up after a wall stopped
+  // holding, by at most `tool_moved_m` (how far the tool moved since the last Update) plus
+  // kSlideCatchUp_n's worth. Returns whether it slid.
+  bool SlideByFriction(const std::array<double, 3>& d, double depth, double tool_moved_m) noexcept;
+  // Out of contact (the tool above the face's plane): whether the tool is past a wall's foot the
+  // proxy is held at, or over a wall, and the contact lets go (`result`: left_surface, and
+  // into_wall_m over a wall).
+  bool LetGoAboveTheFace(const std::array<double, 3>& tool_m, Result* result) const noexcept;
   // Σ w²·c over the patch's pushed nodes: how far a push moves the surface point, m/N.
   double Compliance(const Patch& patch, std::span<const double> compliance) const noexcept;
   // Whether every node of the patch has its displacement in the state vector (ProxySurface::dof),
@@ -196,8 +208,14 @@ class ProxyContact {
   int axis_ = 2, sign_ = 1, plane_ = 0, t1_ = 0, t2_ = 1;
   std::array<double, 3> start_m_{};
   std::array<double, 2> proxy_{};  // along t1, t2 in node spacings
+  // The tool at the last Update, the same way (NaN before the first: no bound on that slide).
+  std::array<double, 2> last_tool_{std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN()};
   double reach_ = 1;               // the tip's radius in node spacings, at least one
   bool sliding_ = false;
+  bool catching_up_ = false;         // a wall stopped holding: the slide is bounded
+  std::array<bool, 2> wall_held_{};  // along t1, t2: a wall held the pull at the last slide
+  std::array<bool, 2> let_go_{};     // … and has let it go since: the proxy catches up
   Patch pushed_;  // the nodes and weights the last Update pushed (count 0: none)
   std::vector<int> loaded_dofs_;
   std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded

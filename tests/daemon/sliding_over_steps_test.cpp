@@ -29,12 +29,11 @@ namespace {
 constexpr double kH = 0.01;  // voxel edge, m
 using Point = std::array<double, 3>;
 
-// 10 × 6 × 4 voxels of 1 cm, the back face (z = 4 cm) held, the voxels x < 4 cm, z < `step` cm
-// cut out of its front: a step whose floor is at z = `step` cm and whose wall, facing −x, is at
-// x = 4 cm.
-Scene SteppedBlock(int step) {
-  Scene scene = testing::VoxelScene(
-      10, 6, 4, kH, [step](int x, int, int z) { return x < 4 && z < step ? 0 : 1; });
+// 10 × 6 × 4 voxels of 1 cm, the back face (z = 4 cm) held, the voxels `cut(x, y, z)` (voxel
+// indices) cut out of it.
+Scene CutBlock(const std::function<bool(int, int, int)>& cut) {
+  Scene scene = testing::VoxelScene(10, 6, 4, kH,
+                                    [&cut](int x, int y, int z) { return cut(x, y, z) ? 0 : 1; });
   testing::HoldPlaneZ(&scene, 0.04);
   scene.materials = {{1, Material{}}};  // 10 kPa, ν 0.45, 1000 kg/m³, d 10/s
   scene.contact.model = ContactModel::kProxy;
@@ -44,6 +43,12 @@ Scene SteppedBlock(int step) {
   scene.adaptivity.secondary_lod = 1;
   scene.adaptivity.secondary_rate_hz = 1000;
   return scene;
+}
+
+// The voxels x < 4 cm, z < `step` cm cut out of the block's front: a step whose floor is at
+// z = `step` cm and whose wall, facing −x, is at x = 4 cm.
+Scene SteppedBlock(int step) {
+  return CutBlock([step](int x, int, int z) { return x < 4 && z < step; });
 }
 
 struct Played {
@@ -291,6 +296,91 @@ TEST(SlidingOverSteps, AToolPushedDeepIntoTheWallAsItRisesTouchesNothing) {
   EXPECT_GT(pushing, 0.5);
   EXPECT_LE(largest_step, 0.15 * pushing);
   EXPECT_EQ(largest_after, 0.0) << "a touch deep inside the wall";
+}
+
+// The largest force change between periods from period `from` on, N.
+double LargestStepFrom(const Played& played, int from) {
+  double largest = 0;
+  for (std::size_t n = static_cast<std::size_t>(from) + 1; n < played.force_n.size(); ++n) {
+    const Point& a = played.force_n[n - 1];
+    const Point& b = played.force_n[n];
+    largest = std::max(largest, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+  }
+  return largest;
+}
+
+// The step's wall ends at y = 3 cm, where the floor goes on past it (an L-shaped floor). The tool,
+// 3 mm into the floor and 6 mm past the wall's foot, is stroked along the foot (+y) and past the
+// wall's end: along the foot the proxy slides at μ_k (the wall holding the rest); past the end
+// the wall no longer holds, and the proxy catches up with the tool by at most 0.02 N of its
+// spring a substep beyond what the tool's own motion sheds. (At once it stepped by 0.41 N.)
+TEST(SlidingOverSteps, AToolAlongAWallsFootAndPastItsEndSlidesOnWithoutAStep) {
+  Scene scene = CutBlock([](int x, int y, int z) { return z < 2 && (x < 4 || y >= 3); });
+  scene.input.contact_node = LatticeIndex{2, 1, 2};
+  const auto tip_at = [](int n) {
+    const double t = n * 1e-3;
+    return Point{0.02 + 0.026 * Smooth((t - 0.3) / 0.8), 0.015 + 0.03 * Smooth((t - 1.3) / 0.8),
+                 0.018 + 0.005 * Smooth(t / 0.2)};
+  };
+  const Played played = Play(scene, 2400, tip_at);
+  ASSERT_EQ(played.force_n.size(), 2400u);
+  // Along the foot (y from 1.8 to 2.5 cm, the proxy broken loose): the wall's push along x,
+  // friction along y at μ_k.
+  int along = 0;
+  for (int n = 1300; n < 2400 && tip_at(n)[1] < 0.025; ++n) {
+    const Point& f = played.force_n[static_cast<std::size_t>(n)];
+    if (tip_at(n)[1] < 0.018) continue;
+    ++along;
+    EXPECT_LT(f[0], 0.5 * f[2]) << "the wall does not hold, period " << n;
+    EXPECT_NEAR(-f[1] / -f[2], 0.4, 0.4 * 0.05) << "friction along the foot, period " << n;
+  }
+  EXPECT_GT(along, 100);
+  const Point& end = played.force_n.back();
+  std::printf(
+      "along a wall's foot and past its end: %d periods along it, (%.4f, %.4f, %.4f) N at the "
+      "end, largest step %.4f N\n",
+      along, end[0], end[1], end[2], played.largest_step_n);
+  EXPECT_LE(std::hypot(end[0], end[1]), 0.5 * 1.05 * -end[2]) << "past the end, inside the cone";
+  EXPECT_LE(played.largest_step_n, 0.1);
+}
+
+// A ridge one voxel thick (x from 4 to 5 cm) rising from the floor: the tool, 3 mm into the floor,
+// stroked 2 cm past it, then lifted out over the floor beyond it. The proxy is held at the
+// ridge's foot (a push as deep as the tool is past it: 1.9 N); lifted, the tool is out of the
+// object, and the push fades out — over 36 ms, no faster than 0.08 N a ms. (Out of contact at
+// once it stepped 1.98 N to nothing at the port guard's 0.5 N a period; faded over 20 ms, by
+// 0.164 N a period.)
+TEST(SlidingOverSteps, AToolLiftedOutPastARidgeLetsItsPushGoSmoothly) {
+  Scene scene = CutBlock([](int x, int, int z) { return z < 2 && x != 4; });
+  scene.input.contact_node = LatticeIndex{2, 3, 2};
+  const auto tip_at = [](int n) {
+    const double t = n * 1e-3;
+    return Point{0.02 + 0.04 * Smooth((t - 0.3) / 0.8), 0.03,
+                 0.018 + 0.005 * Smooth(t / 0.2) - 0.008 * Smooth((t - 1.3) / 0.3)};
+  };
+  const Played played = Play(scene, 1800, tip_at);
+  ASSERT_EQ(played.force_n.size(), 1800u);
+  const double held = Magnitude(played.force_n[1300]);
+  const double after = Magnitude(played.force_n.back());
+  std::printf("lifted out past a ridge: %.3f N held, %.4f N after; largest step %.4f N\n", held,
+              after, played.largest_step_n);
+  EXPECT_GT(held, 1.0) << "the ridge does not hold the proxy";
+  EXPECT_EQ(after, 0.0);
+  EXPECT_LE(played.largest_step_n, 0.1);
+}
+
+// Held 2 cm past the step's wall, not 6 mm, and risen into the wall: the corner's push is 1.9 N,
+// and it fades no faster than 0.08 N a ms before the wall is touched.
+TEST(SlidingOverSteps, AWallsLargePushLetGoFadesNoFasterThanALiftOff) {
+  const Played played =
+      RiseIntoTheWall([](double t) { return 0.008 * Smooth((t - 1.3) / 0.3); },
+                      [](double t) { return 0.014 * Smooth((t - 0.3) / 0.8); }, 1800);
+  ASSERT_EQ(played.force_n.size(), 1800u);
+  const double held = Magnitude(played.force_n[1300]);
+  std::printf("2 cm past the wall, risen into it: %.3f N held, largest step %.4f N\n", held,
+              played.largest_step_n);
+  EXPECT_GT(held, 1.5);
+  EXPECT_LE(LargestStepFrom(played, 1300), 0.1);
 }
 
 }  // namespace
