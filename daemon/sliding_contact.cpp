@@ -103,7 +103,10 @@ SlidingContact::Contact SlidingContact::Update(const std::array<double, 3>& tip_
   if (state_ == State::kEngaged && !object_.Inside(tip_m) && PressedIn(tip_m)) {
     Release(now_ns);  // out sideways, still pressed in: the push fades out
   }
-  if (state_ == State::kReleasing) return Answer();  // wherever the tip goes (StepPeriod ends it)
+  if (state_ == State::kReleasing) {                 // wherever the tip goes (StepPeriod ends it)
+    if (!object_.Inside(tip_m)) wall_within_m_ = 0;  // out of the wall: a touch is from outside
+    return Answer();
+  }
   if (!object_.Inside(tip_m)) {
     state_ = State::kFree;
     wall_within_m_ = 0;
@@ -150,6 +153,14 @@ void SlidingContact::TouchDown(const std::array<double, 3>& tip_m, std::int64_t 
     }
     break;
   }
+  TouchThrough(entry, wanted_, now_ns, centre);
+}
+
+void SlidingContact::TouchThrough(const ContactObject::Entry& entry,
+                                  const std::optional<LatticeIndex>& node, std::int64_t now_ns,
+                                  const std::optional<LatticeIndex>& centre) noexcept {
+  wanted_ = node;
+  wall_within_m_ = 0;
   inward_ = entry.inward_normal;
   for (int c = 0; c < 3; ++c) {
     if (inward_[c] != 0) face_m_ = entry.point_m[c];
@@ -169,14 +180,21 @@ void SlidingContact::TouchDown(const std::array<double, 3>& tip_m, std::int64_t 
 void SlidingContact::TouchTheWall(const std::array<double, 3>& tip_m, std::int64_t now_ns,
                                   const std::optional<LatticeIndex>& centre) noexcept {
   // Let go where the tool rose out of its face into a wall (the proxy slides on one face), the
-  // tip inside the wall touches it again, as from outside, if its way out is at most twice as
-  // deep as the tip was past the wall's foot then: its force ramps in to about the push let go
-  // (the same spring as deep in the same wall), or what the hand pushed in since. Deeper, a
-  // touch through whatever face is nearest could push far harder than anything felt before (at a
-  // concave corner's pocket the nearest was 23 mm away: 2.2 N): it waits for the tip to leave.
-  if (wall_within_m_ <= 0 || object_.WaysOut(tip_m)[0].depth_m > wall_within_m_) return;
-  wall_within_m_ = 0;
-  TouchDown(tip_m, now_ns, centre);
+  // tip inside the wall touches it, as from outside — through the wall's own face, never another
+  // (the nearest way out may be the far side of a ridge, pushing the hand through it) — once
+  // that way out is at most twice as deep as the tip was past the wall's foot then: its force
+  // ramps in to about the push let go (the same spring, as deep in the same wall), or what the
+  // hand pushed in since. Deeper, a touch could push far harder than the corner did: it waits,
+  // until the tip comes back within that or leaves the object.
+  if (wall_within_m_ <= 0) return;
+  for (const ContactObject::Entry& way : object_.WaysOut(tip_m)) {
+    if (way.inward_normal != wall_inward_) continue;
+    if (way.depth_m > wall_within_m_) return;
+    if (const std::optional<LatticeIndex> node = NodeInsideFace(way)) {
+      TouchThrough(way, node, now_ns, centre);
+    }
+    return;
+  }
 }
 
 SlidingContact::Contact SlidingContact::Hold(std::int64_t now_ns,
@@ -335,6 +353,7 @@ void SlidingContact::SubstepPush::Load(const Eigen::VectorXd& predicted,
     // the object, or risen into a wall, through it (TouchTheWall).
     c.Release(now_ns_);
     c.wall_within_m_ = 2 * touch.into_wall_m;
+    c.wall_inward_ = touch.into_wall_inward;
     if (c.state_ == State::kReleasing) {
       push_n = c.pushed_n_;
       c.proxy_->SpreadLoads(push_n, load);
@@ -412,9 +431,11 @@ void SlidingContact::Release(std::int64_t now_ns) noexcept {
   // A smoothstep over T sheds at most 1.5·F/T a unit of time: T long enough to keep that under
   // kReleaseRate_n_per_ns (a wall's push, not held to friction, is as deep as the tool is past
   // the wall: 1.96 N at 2 cm stepped by 0.164 N a period over 20 ms).
+  // At most kMaxRelease_ns: a pause of the regions holds a fade no longer (HapticLoop).
   const double push = std::hypot(pushed_n_[0], pushed_n_[1], pushed_n_[2]);
-  release_ns_ =
-      std::max(kRelease_ns, static_cast<std::int64_t>(1.5 * push / kReleaseRate_n_per_ns));
+  const double fade_ns = std::isfinite(push) ? 1.5 * push / kReleaseRate_n_per_ns : 0.0;
+  release_ns_ = static_cast<std::int64_t>(
+      std::clamp(fade_ns, static_cast<double>(kRelease_ns), static_cast<double>(kMaxRelease_ns)));
 }
 
 std::array<double, 3> SlidingContact::ReleasingPush(std::int64_t now_ns) const noexcept {
@@ -448,6 +469,7 @@ void SlidingContact::RestartFromRest() noexcept {
 
 void SlidingContact::RestartKeepingContact() noexcept {
   if (state_ == State::kReleasing) state_ = State::kAwaitLiftOff;  // what it pushed is gone
+  wall_within_m_ = 0;
   if (state_ == State::kEngaged || state_ == State::kWaiting) {
     // The motion the proxy pressed into is gone: it touches again where the tool is, once regions
     // on its face can push there (TryEngage), its force ramped in. It wants the node under the

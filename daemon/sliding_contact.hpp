@@ -40,7 +40,8 @@ namespace hapticsim {
  * tip was past the wall's foot (TouchTheWall). At a wall's foot with the tool past it, below the
  * face, the wall's push is kept whole by the friction cone (a concave corner). Released
  * while it pushes — off the rim, or the tip out of the object sideways still pressed in — its last
- * push fades out over kRelease_ns first (kReleasing, engaged meanwhile).
+ * push fades out first (kReleasing, engaged meanwhile; over kRelease_ns, longer for a large push:
+ * kReleaseRate_n_per_ns).
  *
  * Threads: Prepare is any thread's; Bind is the supervisor's, while the primary leaves the
  * regions alone (HapticLoop::Install); everything else is the primary thread's, never allocates,
@@ -93,7 +94,7 @@ class SlidingContact {
   std::optional<LatticeIndex> wanted_node() const { return wanted_; }
   /** True while the tip is outside the object (or before the first input). */
   bool outside() const { return state_ == State::kFree; }
-  /** While a push let go fades out (kRelease_ns): what is left of it at `now_ns`, N; zero
+  /** While a push let go fades out (release_ns_): what is left of it at `now_ns`, N; zero
    *  otherwise. What a pause of the regions renders then, instead of the push held. */
   std::array<double, 3> ReleasingPush(std::int64_t now_ns) const noexcept;
   bool releasing() const { return state_ == State::kReleasing; }
@@ -128,8 +129,11 @@ class SlidingContact {
    */
   static constexpr std::int64_t kRelease_ns = ContactTracker::kSlipOff_ns;
   /** The fastest a let-go push fades, N/ns (0.08 N per ms): a push over 1.07 N fades over longer
-   *  than kRelease_ns. */
+   *  than kRelease_ns, up to kMaxRelease_ns (a push over 2.67 N then fades faster). */
   static constexpr double kReleaseRate_n_per_ns = 0.08e-6;
+  /** The longest a let-go push fades: as long as a pause of the regions holds it
+   *  (HapticLoop::kMaxHold_s). */
+  static constexpr std::int64_t kMaxRelease_ns = 50'000'000;
 
   /** The regions restart from rest around a new centre: an engaged or waiting contact engages
    *  again under the tip, its force ramped in from zero. */
@@ -152,6 +156,9 @@ class SlidingContact {
   // where the bound ones reach.
   void TouchDown(const std::array<double, 3>& tip_m, std::int64_t now_ns,
                  const std::optional<LatticeIndex>& centre) noexcept;
+  // Touches through `entry` (`node`: the one it wants inside that face; none on a held face).
+  void TouchThrough(const ContactObject::Entry& entry, const std::optional<LatticeIndex>& node,
+                    std::int64_t now_ns, const std::optional<LatticeIndex>& centre) noexcept;
   // Let go into a wall (ProxyContact::Result::into_wall_m), awaiting lift-off: touches it, as
   // TouchDown, where the tip's way out is within wall_within_m_.
   void TouchTheWall(const std::array<double, 3>& tip_m, std::int64_t now_ns,
@@ -216,6 +223,7 @@ class SlidingContact {
   std::array<double, 3> pushed_n_{};   // the last substep's push: a release fades it out
   // Let go into a wall: how deep a way out through it may be to touch it again (0: none).
   double wall_within_m_ = 0;
+  std::array<double, 3> wall_inward_{};  // … and that wall's face's inward normal
   std::int64_t release_start_ns_ = 0;
   std::int64_t release_ns_ = kRelease_ns;  // how long this release's fade takes
   // Bind counts the regions bound (the primary reads the count only on regions that are its

@@ -111,10 +111,6 @@ bool ProxyContact::ExposedFace(int i1, int i2) const {
   return Occupied(inside, i1, i2) && !Occupied(outside, i1, i2);
 }
 
-bool ProxyContact::WallCell(int i1, int i2) const {
-  return Occupied(sign_ > 0 ? plane_ - 1 : plane_, i1, i2);
-}
-
 std::array<int, 2> ProxyContact::CellOf(const std::array<double, 2>& proxy) const {
   const std::array<int, 3>& n = surface_.lattice_nodes;
   // A proxy exactly on the lattice's last node line belongs to the cell below it.
@@ -123,55 +119,6 @@ std::array<int, 2> ProxyContact::CellOf(const std::array<double, 2>& proxy) cons
     return i == count && at == count ? count - 1 : i;
   };
   return {cell(proxy[0], n[t1_] - 1), cell(proxy[1], n[t2_] - 1)};
-}
-
-bool ProxyContact::OverFaceOrWall(const std::array<double, 2>& proxy) const {
-  if (!std::isfinite(proxy[0] + proxy[1])) return false;
-  const std::array<int, 2> cell = CellOf(proxy);
-  return ExposedFace(cell[0], cell[1]) || WallCell(cell[0], cell[1]);
-}
-
-bool ProxyContact::AgainstWall(int tangent, double direction) const {
-  if (direction == 0) return false;
-  const std::array<int, 2> cell = CellOf(proxy_);
-  const auto t = static_cast<std::size_t>(tangent);
-  const double within = proxy_[t] - cell[t];  // (1 on the lattice's last node line)
-  // Clamped, the proxy sits kWallGap short of the boundary ahead, or on the one behind.
-  const bool at_boundary = direction > 0 ? within >= 1 - 2 * kWallGap : within <= kWallGap;
-  std::array<int, 2> beyond = cell;
-  beyond[t] += direction > 0 ? 1 : -1;
-  return at_boundary && WallCell(beyond[0], beyond[1]);
-}
-
-void ProxyContact::SlideTowards(std::array<double, 2> target) noexcept {
-  // In steps of at most half a cell, one tangent at a time: a step onto a wall's cell stops that
-  // tangent at the boundary for good, the other goes on (the proxy slides along the wall's foot).
-  // A target off the lattice is taken just off it (the proxy has left the surface either way).
-  const std::array<int, 3>& n = surface_.lattice_nodes;
-  for (int t = 0; t < 2; ++t) {
-    const double last = n[t == 0 ? t1_ : t2_] - 1;
-    if (!std::isfinite(target[t])) return;
-    target[t] = std::clamp(target[t], -1.0, last + 1);
-  }
-  const double span = std::max(std::abs(target[0] - proxy_[0]), std::abs(target[1] - proxy_[1]));
-  const int steps = std::max(1, static_cast<int>(std::ceil(2 * span)));
-  const std::array<double, 2> from = proxy_;
-  std::array<bool, 2> stopped{};
-  for (int s = 1; s <= steps; ++s) {
-    for (int t = 0; t < 2; ++t) {
-      if (stopped[t]) continue;
-      const double next = from[t] + (target[t] - from[t]) * s / steps;
-      std::array<double, 2> moved = proxy_;
-      moved[t] = next;
-      const std::array<int, 2> cell = CellOf(moved), now = CellOf(proxy_);
-      if (cell[t] != now[t] && WallCell(cell[0], cell[1])) {
-        proxy_[t] = next > proxy_[t] ? now[t] + 1 - kWallGap : now[t];
-        stopped[t] = true;
-      } else {
-        proxy_[t] = next;
-      }
-    }
-  }
 }
 
 bool ProxyContact::PatchAt(const std::array<double, 2>& proxy, Patch* corners) const {
@@ -276,14 +223,15 @@ bool ProxyContact::ContinueFrom(const ProxyContact& other) noexcept {
   catching_up_ = other.catching_up_;
   wall_held_ = other.wall_held_;
   let_go_ = other.let_go_;
+  last_depth_m_ = other.last_depth_m_;
   return true;
 }
 
 void ProxyContact::PlaceUnder(const std::array<double, 3>& tool_m) noexcept {
   proxy_ = {tool_m[t1_] / surface_.spacing_m, tool_m[t2_] / surface_.spacing_m};
   last_tool_ = proxy_;
-  sliding_ = catching_up_ = false;
-  wall_held_ = let_go_ = {};
+  sliding_ = false;
+  ForgetWalls();
 }
 
 std::array<double, 3> ProxyContact::proxy_rest_m() const {
@@ -316,71 +264,6 @@ double ProxyContact::Compliance(const Patch& patch,
   return sum;
 }
 
-bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth,
-                                   double tool_moved_m) noexcept {
-  // The pull into a wall the proxy is against is the wall's to hold, not friction's: only the
-  // rest of the tangential pull may slide it.
-  std::array<double, 2> pull = {d[t1_], d[t2_]};
-  for (int t = 0; t < 2; ++t) {
-    const bool held = AgainstWall(t, pull[static_cast<std::size_t>(t)]);
-    // A wall that stops holding (the proxy slid along its foot past its end) gives the pull it
-    // held back to friction: the proxy catches up (below).
-    if (wall_held_[static_cast<std::size_t>(t)] && !held) {
-      catching_up_ = true;
-      let_go_[static_cast<std::size_t>(t)] = true;
-    }
-    wall_held_[static_cast<std::size_t>(t)] = held;
-    if (held) pull[static_cast<std::size_t>(t)] = 0;
-  }
-  const double tangential = std::hypot(pull[0], pull[1]);
-  const double mu = sliding_ ? contact_.kinetic_friction : contact_.static_friction;
-  sliding_ = tangential > mu * depth;
-  if (!sliding_) {
-    catching_up_ = false;
-    let_go_ = {};
-    return false;
-  }
-  // Slide towards the tool until the pull is μ_k times the push, or a wall stops it. Catching up,
-  // by at most as far as the tool moved plus kSlideCatchUp_n's worth of spring: at once, it
-  // stepped the force by 0.41 N where a wall 6 mm deep ended.
-  const double h = surface_.spacing_m;
-  double move = (tangential - contact_.kinetic_friction * depth) / tangential;
-  if (catching_up_) {
-    const double most_m = tool_moved_m + kSlideCatchUp_n / contact_.stiffness_n_per_m;
-    if (!(move * tangential > most_m)) {
-      catching_up_ = false;  // caught up
-      let_go_ = {};
-    } else if (std::isfinite(most_m)) {
-      move = most_m / tangential;
-    }
-  }
-  SlideTowards({proxy_[0] + move * pull[0] / h, proxy_[1] + move * pull[1] / h});
-  return true;
-}
-
-bool ProxyContact::LetGoAboveTheFace(const std::array<double, 3>& tool_m,
-                                     Result* result) const noexcept {
-  // Above the face's plane (out of contact) past a wall's foot the proxy is held at, or over a
-  // wall: the tool is in the wall, or past it over the face beyond (a ridge), which this face
-  // cannot render (it renders the wall's push at the foot only while the tool is below the face
-  // too). Out of contact at once, a push as deep as the tool is past the wall stepped to nothing
-  // (1.98 N, 2 cm past a ridge): it is let go, fading.
-  const double h = surface_.spacing_m;
-  const std::array<double, 3> rest = proxy_rest_m();
-  double past_held_wall_m = 0;
-  for (int t = 0; t < 2; ++t) {
-    const int axis = t == 0 ? t1_ : t2_;
-    const double past = tool_m[axis] - rest[axis];
-    if (AgainstWall(t, past)) past_held_wall_m = std::max(past_held_wall_m, std::abs(past));
-  }
-  const std::array<int, 2> cell = CellOf({tool_m[t1_] / h, tool_m[t2_] / h});
-  const bool over_wall = WallCell(cell[0], cell[1]);
-  if (past_held_wall_m == 0 && !over_wall) return false;
-  result->left_surface = true;
-  if (over_wall) result->into_wall_m = past_held_wall_m;
-  return true;
-}
-
 ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
                                           const Eigen::VectorXd& u,
                                           std::span<const double> compliance,
@@ -409,6 +292,7 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   }
   if (!Readable(corners)) {
     result.left_region = true;
+    ForgetWalls();
     return result;
   }
   std::array<double, 3> d = offset_to_tool();
@@ -419,16 +303,19 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   }
   if (depth <= 0) {  // out of contact: the proxy waits under the tool
     proxy_ = tool;
-    sliding_ = catching_up_ = false;
-    wall_held_ = let_go_ = {};
+    sliding_ = false;
+    ForgetWalls();
     return result;
   }
   if (!Reachable(corners)) {  // in contact where this surface cannot push
     result.left_region = true;
+    ForgetWalls();
     return result;
   }
-  const double k = contact_.stiffness_n_per_m;
-  if (SlideByFriction(d, depth, tool_moved_m)) {
+  const double shed_m = std::max(0.0, last_depth_m_ - depth);  // (NaN before: none)
+  last_depth_m_ = depth;
+  if (SlideByFriction(d, depth, tool_moved_m + contact_.kinetic_friction * shed_m,
+                      Compliance(corners, compliance))) {
     if (!PatchAt(proxy_, &corners)) {
       result.left_surface = true;
       pushed_.count = last_pushed;
@@ -436,30 +323,38 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
     }
     if (!Readable(corners) || !Reachable(corners)) {
       result.left_region = true;
+      ForgetWalls();
       return result;
     }
     d = offset_to_tool();
   }
   result.in_contact = true;
   result.sliding = sliding_;
-  result.offset_m = d;
+  Push(corners, d, compliance, loads, &result);
+  return result;
+}
+
+void ProxyContact::Push(const Patch& corners, const std::array<double, 3>& d,
+                        std::span<const double> compliance, std::span<double> loads,
+                        Result* result) noexcept {
+  result->offset_m = d;
   // What a wall held as this slide began is still the wall's, and what it let go of while the
   // proxy catches up (SlideByFriction): the proxy sliding past a wall's end has left it by now.
   for (int t = 0; t < 2; ++t) {
     const auto j = static_cast<std::size_t>(t);
-    result.wall_holds[static_cast<std::size_t>(t == 0 ? t1_ : t2_)] =
+    result->wall_holds[static_cast<std::size_t>(t == 0 ? t1_ : t2_)] =
         AgainstWall(t, d[t == 0 ? t1_ : t2_]) || wall_held_[j] || let_go_[j];
   }
   // The spring taken at the step's end: the push f moves the surface under the proxy by C·f, so
   // f = k·(d − C·f).
-  result.compliance_m_per_n = Compliance(corners, compliance);
+  const double k = contact_.stiffness_n_per_m;
+  result->compliance_m_per_n = Compliance(corners, compliance);
   for (int c = 0; c < 3; ++c)
-    result.force_on_object_n[c] = k * d[c] / (1.0 + k * result.compliance_m_per_n);
+    result->force_on_object_n[c] = k * d[c] / (1.0 + k * result->compliance_m_per_n);
   pushed_.count = corners.count;  // (only the entries in use: a patch holds up to 289)
   std::copy_n(corners.nodes.begin(), corners.count, pushed_.nodes.begin());
   std::copy_n(corners.weights.begin(), corners.count, pushed_.weights.begin());
-  SpreadLoads(result.force_on_object_n, loads);
-  return result;
+  SpreadLoads(result->force_on_object_n, loads);
 }
 
 void ProxyContact::SpreadLoads(const std::array<double, 3>& force_on_object_n,

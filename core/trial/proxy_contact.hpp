@@ -103,6 +103,7 @@ class ProxyContact {
     /// … because the tool has risen out of the face into a wall rising from it, this far past
     /// the wall's foot (m; 0: not). The wall's face is another contact's to render.
     double into_wall_m = 0;
+    std::array<double, 3> into_wall_inward{};  ///< … that wall's face's inward normal
     /// The proxy's face cell has a node this surface can neither push nor leave to a support
     /// (another region steps it): nothing was loaded. The regions must move under the proxy.
     bool left_region = false;
@@ -154,7 +155,7 @@ class ProxyContact {
   static constexpr int kMaxPatch = (2 * kMaxReach + 1) * (2 * kMaxReach + 1);
   // How far short of a wall's foot a stopped proxy stays, in node spacings: on its own cell.
   static constexpr double kWallGap = 1e-6;
-  // How much of the spring's force a proxy catching up after a wall stopped holding may shed in
+  // How much of the force rendered a proxy catching up after a wall stopped holding may shed in
   // one Update beyond what the tool's own motion sheds, N (SlideByFriction): 0.02 N per
   // substep, 0.04 N a period at 2 substeps.
   static constexpr double kSlideCatchUp_n = 0.02;
@@ -187,9 +188,17 @@ class ProxyContact {
   void SlideTowards(std::array<double, 2> target) noexcept;
   // Coulomb friction on the tangential pull of the offset `d` (tool − surface, m) at `depth`:
   // sticks, or slides the proxy towards the tool (SlideTowards); catching up after a wall stopped
-  // holding, by at most `tool_moved_m` (how far the tool moved since the last Update) plus
-  // kSlideCatchUp_n's worth. Returns whether it slid.
-  bool SlideByFriction(const std::array<double, 3>& d, double depth, double tool_moved_m) noexcept;
+  // holding, by at most `tool_shed_m` (what the tool's motion since the last Update sheds: how
+  // far it moved, and μ_k times how far it rose) plus kSlideCatchUp_n of the force rendered at
+  // the surface's compliance `compliance_m_per_n`. Returns whether it slid.
+  bool SlideByFriction(const std::array<double, 3>& d, double depth, double tool_shed_m,
+                       double compliance_m_per_n) noexcept;
+  // No wall holds the proxy, none let go of it (it left the region, or the face).
+  void ForgetWalls() noexcept;
+  // In contact: the spring's push at offset `d` (tool − surface, m) over `corners`, taken at the
+  // step's end, written to `loads` and `result` (what walls hold of it too).
+  void Push(const Patch& corners, const std::array<double, 3>& d,
+            std::span<const double> compliance, std::span<double> loads, Result* result) noexcept;
   // Out of contact (the tool above the face's plane): whether the tool is past a wall's foot the
   // proxy is held at, or over a wall, and the contact lets go (`result`: left_surface, and
   // into_wall_m over a wall).
@@ -216,6 +225,7 @@ class ProxyContact {
   bool catching_up_ = false;         // a wall stopped holding: the slide is bounded
   std::array<bool, 2> wall_held_{};  // along t1, t2: a wall held the pull at the last slide
   std::array<bool, 2> let_go_{};     // … and has let it go since: the proxy catches up
+  double last_depth_m_ = std::numeric_limits<double>::quiet_NaN();  // the tool's, last in contact
   Patch pushed_;  // the nodes and weights the last Update pushed (count 0: none)
   std::vector<int> loaded_dofs_;
   std::vector<int> slot_of_node_;  // index into the loaded nodes, −1 if not loaded

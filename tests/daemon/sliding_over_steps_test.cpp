@@ -309,20 +309,29 @@ double LargestStepFrom(const Played& played, int from) {
   return largest;
 }
 
+// The step two voxels high whose wall ends at y = 3 cm, where the floor goes on past it (an
+// L-shaped floor), the regions first on the floor at (2, 1, 2).
+Scene LFloor() {
+  Scene scene = CutBlock([](int x, int y, int z) { return z < 2 && (x < 4 || y >= 3); });
+  scene.input.contact_node = LatticeIndex{2, 1, 2};
+  return scene;
+}
+
+// The tip at `t` s on LFloor: 3 mm into the floor, on to 6 mm past the wall's foot, then along the
+// foot (+y) 3 cm, past the wall's end; risen by `rise` (m along −z).
+Point AlongTheFoot(double t, double rise) {
+  return Point{0.02 + 0.026 * Smooth((t - 0.3) / 0.8), 0.015 + 0.03 * Smooth((t - 1.3) / 0.8),
+               0.018 + 0.005 * Smooth(t / 0.2) - rise};
+}
+
 // The step's wall ends at y = 3 cm, where the floor goes on past it (an L-shaped floor). The tool,
 // 3 mm into the floor and 6 mm past the wall's foot, is stroked along the foot (+y) and past the
 // wall's end: along the foot the proxy slides at μ_k (the wall holding the rest); past the end
 // the wall no longer holds, and the proxy catches up with the tool by at most 0.02 N of its
 // spring a substep beyond what the tool's own motion sheds. (At once it stepped by 0.41 N.)
 TEST(SlidingOverSteps, AToolAlongAWallsFootAndPastItsEndSlidesOnWithoutAStep) {
-  Scene scene = CutBlock([](int x, int y, int z) { return z < 2 && (x < 4 || y >= 3); });
-  scene.input.contact_node = LatticeIndex{2, 1, 2};
-  const auto tip_at = [](int n) {
-    const double t = n * 1e-3;
-    return Point{0.02 + 0.026 * Smooth((t - 0.3) / 0.8), 0.015 + 0.03 * Smooth((t - 1.3) / 0.8),
-                 0.018 + 0.005 * Smooth(t / 0.2)};
-  };
-  const Played played = Play(scene, 2400, tip_at);
+  const auto tip_at = [](int n) { return AlongTheFoot(n * 1e-3, 0); };
+  const Played played = Play(LFloor(), 2400, tip_at);
   ASSERT_EQ(played.force_n.size(), 2400u);
   // Along the foot (y from 1.8 to 2.5 cm, the proxy broken loose): the wall's push along x,
   // friction along y at μ_k.
@@ -340,8 +349,36 @@ TEST(SlidingOverSteps, AToolAlongAWallsFootAndPastItsEndSlidesOnWithoutAStep) {
       "along a wall's foot and past its end: %d periods along it, (%.4f, %.4f, %.4f) N at the "
       "end, largest step %.4f N\n",
       along, end[0], end[1], end[2], played.largest_step_n);
-  EXPECT_LE(std::hypot(end[0], end[1]), 0.5 * 1.05 * -end[2]) << "past the end, inside the cone";
+  // Caught up within 80 ms of the tool passing the wall's end (y = 3 cm, plus the 0.3 mm the
+  // proxy lags it there; measured: 57 ms, the wall's push shed while the tread's grows back):
+  // back inside the friction cone, and there on.
+  int past_end = 0;
+  while (tip_at(past_end)[1] < 0.0303) ++past_end;
+  for (int n = past_end + 80; n < 2400; ++n) {
+    const Point& f = played.force_n[static_cast<std::size_t>(n)];
+    ASSERT_LE(std::hypot(f[0], f[1]), 0.5 * 1.05 * -f[2]) << "outside the cone at period " << n;
+  }
   EXPECT_LE(played.largest_step_n, 0.1);
+}
+
+// The same stroke, lifted out of the floor (8 mm in 50 ms, 0.16 m/s) just past the wall's end,
+// while the proxy still catches up: the push still the wall's is let go, fading, not dropped
+// (then only the port guard's lift-off ramp held it).
+TEST(SlidingOverSteps, AToolLiftedOutAsItsProxyCatchesUpPastAWallsEndLetsGoSmoothly) {
+  const auto tip_at = [](int n) {
+    const double t = n * 1e-3;
+    return AlongTheFoot(t, 0.008 * Smooth((t - 1.735) / 0.05));
+  };
+  const Played played = Play(LFloor(), 2000, tip_at);
+  ASSERT_EQ(played.force_n.size(), 2000u);
+  const double before = Magnitude(played.force_n[1735]);
+  std::printf("lifted out as the proxy catches up: %.3f N as it lifts, largest step %.4f N\n",
+              before, played.largest_step_n);
+  EXPECT_GT(before, 0.4) << "not lifted while the wall's push was still there";
+  EXPECT_EQ(Magnitude(played.force_n.back()), 0.0);
+  // A fade sheds at most 0.08 N a ms (SlidingContact::kReleaseRate_n_per_ns); dropped, the port
+  // guard's lift-off ramp held it to 0.1 N a ms.
+  EXPECT_LE(played.largest_step_n, 0.08);
 }
 
 // A ridge one voxel thick (x from 4 to 5 cm) rising from the floor: the tool, 3 mm into the floor,
@@ -369,18 +406,25 @@ TEST(SlidingOverSteps, AToolLiftedOutPastARidgeLetsItsPushGoSmoothly) {
   EXPECT_LE(played.largest_step_n, 0.1);
 }
 
-// Held 2 cm past the step's wall, not 6 mm, and risen into the wall: the corner's push is 1.9 N,
-// and it fades no faster than 0.08 N a ms before the wall is touched.
+// Held 2 cm past the step's wall, not 6 mm, and risen into the wall: the corner's push is 2.2 N,
+// and it fades no faster than 0.08 N a ms before the wall is touched — through its own face (the
+// front face, 15 mm away, is nearer than the wall's, 20 mm).
 TEST(SlidingOverSteps, AWallsLargePushLetGoFadesNoFasterThanALiftOff) {
   const Played played =
       RiseIntoTheWall([](double t) { return 0.008 * Smooth((t - 1.3) / 0.3); },
                       [](double t) { return 0.014 * Smooth((t - 0.3) / 0.8); }, 1800);
   ASSERT_EQ(played.force_n.size(), 1800u);
   const double held = Magnitude(played.force_n[1300]);
-  std::printf("2 cm past the wall, risen into it: %.3f N held, largest step %.4f N\n", held,
-              played.largest_step_n);
+  std::printf(
+      "2 cm past the wall, risen into it: %.3f N held, largest step %.4f N, then (%.3f, "
+      "%.3f, %.3f) N\n",
+      held, played.largest_step_n, played.force_n.back()[0], played.force_n.back()[1],
+      played.force_n.back()[2]);
+  const Point& end = played.force_n.back();
   EXPECT_GT(held, 1.5);
   EXPECT_LE(LargestStepFrom(played, 1300), 0.1);
+  EXPECT_TRUE(InContact(played, 1799));
+  EXPECT_LT(end[0], -1.0) << "the wall's own face is not the one touched";
 }
 
 }  // namespace
