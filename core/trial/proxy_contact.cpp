@@ -220,7 +220,6 @@ bool ProxyContact::ContinueFrom(const ProxyContact& other) noexcept {
   proxy_ = other.proxy_;
   last_tool_ = other.last_tool_;
   sliding_ = other.sliding_;
-  catching_up_ = other.catching_up_;
   wall_held_ = other.wall_held_;
   let_go_ = other.let_go_;
   last_depth_m_ = other.last_depth_m_;
@@ -314,8 +313,8 @@ ProxyContact::Result ProxyContact::Update(const std::array<double, 3>& tool_m,
   }
   const double shed_m = std::max(0.0, last_depth_m_ - depth);  // (NaN before: none)
   last_depth_m_ = depth;
-  if (SlideByFriction(d, depth, tool_moved_m + contact_.kinetic_friction * shed_m,
-                      Compliance(corners, compliance))) {
+  if (SlideByFriction(d, depth, tool_moved_m + contact_.kinetic_friction * shed_m, corners,
+                      compliance)) {
     if (!PatchAt(proxy_, &corners)) {
       result.left_surface = true;
       pushed_.count = last_pushed;

@@ -190,9 +190,11 @@ class ProxyContact {
   // sticks, or slides the proxy towards the tool (SlideTowards); catching up after a wall stopped
   // holding, by at most `tool_shed_m` (what the tool's motion since the last Update sheds: how
   // far it moved, and μ_k times how far it rose) plus kSlideCatchUp_n of the force rendered at
-  // the surface's compliance `compliance_m_per_n`. Returns whether it slid.
+  // the surface's compliance over `corners` (Compliance). Returns whether it slid.
   bool SlideByFriction(const std::array<double, 3>& d, double depth, double tool_shed_m,
-                       double compliance_m_per_n) noexcept;
+                       const Patch& corners, std::span<const double> compliance) noexcept;
+  // A wall let go of the proxy's pull and it is still catching up with the tool.
+  bool CatchingUp() const noexcept { return let_go_[0] || let_go_[1]; }
   // No wall holds the proxy, none let go of it (it left the region, or the face).
   void ForgetWalls() noexcept;
   // In contact: the spring's push at offset `d` (tool − surface, m) over `corners`, taken at the
@@ -222,7 +224,6 @@ class ProxyContact {
                                    std::numeric_limits<double>::quiet_NaN()};
   double reach_ = 1;               // the tip's radius in node spacings, at least one
   bool sliding_ = false;
-  bool catching_up_ = false;         // a wall stopped holding: the slide is bounded
   std::array<bool, 2> wall_held_{};  // along t1, t2: a wall held the pull at the last slide
   std::array<bool, 2> let_go_{};     // … and has let it go since: the proxy catches up
   double last_depth_m_ = std::numeric_limits<double>::quiet_NaN();  // the tool's, last in contact

@@ -64,12 +64,12 @@ void ProxyContact::SlideTowards(std::array<double, 2> target) noexcept {
 
 void ProxyContact::ForgetWalls() noexcept {
   wall_held_ = let_go_ = {};
-  catching_up_ = false;
   last_depth_m_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth, double tool_shed_m,
-                                   double compliance_m_per_n) noexcept {
+                                   const Patch& corners,
+                                   std::span<const double> compliance) noexcept {
   // The pull into a wall the proxy is against is the wall's to hold, not friction's: only the
   // rest of the tangential pull may slide it.
   std::array<double, 2> pull = {d[t1_], d[t2_]};
@@ -77,10 +77,8 @@ bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth,
     const bool held = AgainstWall(t, pull[static_cast<std::size_t>(t)]);
     // A wall that stops holding (the proxy slid along its foot past its end) gives the pull it
     // held back to friction: the proxy catches up (below).
-    if (wall_held_[static_cast<std::size_t>(t)] && !held) {
-      catching_up_ = true;
+    if (wall_held_[static_cast<std::size_t>(t)] && !held)
       let_go_[static_cast<std::size_t>(t)] = true;
-    }
     wall_held_[static_cast<std::size_t>(t)] = held;
     if (held) pull[static_cast<std::size_t>(t)] = 0;
   }
@@ -88,7 +86,6 @@ bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth,
   const double mu = sliding_ ? contact_.kinetic_friction : contact_.static_friction;
   sliding_ = tangential > mu * depth;
   if (!sliding_) {
-    catching_up_ = false;
     let_go_ = {};
     return false;
   }
@@ -98,12 +95,12 @@ bool ProxyContact::SlideByFriction(const std::array<double, 3>& d, double depth,
   // where a wall 6 mm deep ended.
   const double h = surface_.spacing_m;
   double move = (tangential - contact_.kinetic_friction * depth) / tangential;
-  if (catching_up_) {
+  if (CatchingUp()) {
     const double k = contact_.stiffness_n_per_m;
-    const double most_m = tool_shed_m + kSlideCatchUp_n * (1.0 + k * compliance_m_per_n) / k;
+    const double most_m =
+        tool_shed_m + kSlideCatchUp_n * (1.0 + k * Compliance(corners, compliance)) / k;
     if (!(move * tangential > most_m)) {
-      catching_up_ = false;  // caught up
-      let_go_ = {};
+      let_go_ = {};  // caught up
     } else if (std::isfinite(most_m)) {
       move = most_m / tangential;
     }
@@ -135,7 +132,7 @@ bool ProxyContact::LetGoAboveTheFace(const std::array<double, 3>& tool_m,
   const std::array<int, 2> cell = CellOf({tool_m[t1_] / h, tool_m[t2_] / h});
   const bool over_wall = WallCell(cell[0], cell[1]);
   // Catching up with a wall's push it let go of (SlideByFriction), the same.
-  if (past_held_wall_m == 0 && !over_wall && !catching_up_) return false;
+  if (past_held_wall_m == 0 && !over_wall && !CatchingUp()) return false;
   result->left_surface = true;
   if (over_wall) {
     result->into_wall_m = past_held_wall_m;
