@@ -63,7 +63,7 @@ class RegionsMover {
     double elapsed_ms = 0;             ///< from the request to this outcome
     std::string why_not;               ///< kMoveBack: why the node was refused
     bool runaway = false;              ///< kDemote for the runaway watch (OnRunaway)
-    RunawayEnergies runaway_energies;  ///< what the watch measured, for the log
+    RunawayEnergies runaway_energies{};  ///< what the watch measured, for the log
     bool moves() const { return kind != Kind::kConfirmed; }
     /**
      * Whether the new regions start from the object's motion (HapticLoop::Handover::

@@ -91,16 +91,16 @@ class StrokeRun {
     return ProxyWantsPrimaryAt(proxy_, centre_, regions_->partition().mesh().options().spacing_m);
   }
 
-  // Period n: the primary stepped once per substep, the proxy touching with the tool on its path
-  // at each substep's start and the spring taken at the step's end (ProxyPush). The period's
-  // sample is its first substep's force. False when the trial ends in it.
+  // Period n: the primary stepped once per substep, the proxy touching with the tool where
+  // hapticsimd has it (ContactTrajectory::SubstepToolAt) and the spring taken at the step's end
+  // (ProxyPush). The period's sample is its first substep's force. False when the trial ends in
+  // it.
   bool StepPeriod(long n) {
     if (frames_.Due(n)) frames_.observe(n * dt_, regions_->CaptureState());
     const int substeps = regions_->schedule(kPrimaryRegion).substeps;
     for (int q = 0; q < substeps; ++q) {
       std::array<double, 3> tool = proxy_.start_m();
-      const std::array<double, 3> moved =
-          trajectory_.DisplacementAt((n + double(q) / substeps) * dt_);
+      const std::array<double, 3> moved = trajectory_.SubstepToolAt(n, q, substeps, dt_);
       for (int c = 0; c < 3; ++c) tool[c] += moved[c];
       regions_->AdvanceSecondariesTo(regions_->state_ticks(kPrimaryRegion) +
                                      regions_->period_ticks(kPrimaryRegion));

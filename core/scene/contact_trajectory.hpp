@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <array>
 
 #include "core/scene/scene.hpp"
@@ -30,6 +31,16 @@ class ContactTrajectory {
    *  LateralAt(t) along its direction, m. */
   std::array<double, 3> DisplacementAt(double t_s) const;
   const std::array<double, 3>& inward_normal() const { return normal_; }
+
+  /**
+   * Where a stroke's tool is in substep q (0 … substeps − 1) of period n (period dt_s): as
+   * hapticsimd moves it, which has one device sample a period (SlidingContact::StepPeriod), from
+   * the last period's tip to this one's in equal parts, the last substep exactly at n · dt.
+   */
+  std::array<double, 3> SubstepToolAt(long n, int q, int substeps, double dt_s) const {
+    const double behind = 1.0 - static_cast<double>(q + 1) / substeps;
+    return DisplacementAt(std::max(0.0, (static_cast<double>(n) - behind) * dt_s));
+  }
 
  private:
   // The share of a stroke's trial gone at time t (s): 0 … 1.

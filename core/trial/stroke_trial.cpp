@@ -62,14 +62,14 @@ StrokeTrialResult RunStrokeTrial(const SceneModel& object, bool substep_to_stabi
   const long steps = scene.num_steps();
   TrialRecorder recorder(trajectory, dt, steps, &result);
   out.proxy.reserve(static_cast<std::size_t>(steps) + 1);
-  // Each substep: one step, the proxy touching with the tool on its path at the step's end (the
-  // spring taken there: ProxyPush); the period's sample is its first substep's force. False when
-  // the trial ends.
+  // Each substep: one step, the proxy touching with the tool where hapticsimd has it
+  // (ContactTrajectory::SubstepToolAt), the spring taken at the step's end (ProxyPush); the
+  // period's sample is its first substep's force. False when the trial ends.
   const auto step_period = [&](long n) {
     if (frames.Due(n)) frames.observe(n * dt, LatticeState(model, integrator.u()));
     for (int q = 0; q < result.substeps; ++q) {
       std::array<double, 3> tool = contact.start_m();
-      const std::array<double, 3> moved = trajectory.DisplacementAt(n * dt + q * h);
+      const std::array<double, 3> moved = trajectory.SubstepToolAt(n, q, result.substeps, dt);
       for (int c = 0; c < 3; ++c) tool[c] += moved[c];
       ProxyPush push(contact, tool);
       integrator.Step(held_at_rest, push);

@@ -76,7 +76,9 @@ void ExpectThreadedWithin(const Scene& scene, const std::string& label, double b
   const std::optional<double> l2 = ThreadedAgainstVirtual(scene, &misses, periods, clean);
   EXPECT_TRUE(l2) << label << ": every attempt missed a deadline (misses per region:" << misses
                   << ")";
-  if (l2) EXPECT_LT(*l2, bound_percent) << label;
+  if (l2) {
+    EXPECT_LT(*l2, bound_percent) << label;
+  }
   std::printf("%s: %.6f %% from the virtual-time run; misses per region in each attempt:%s\n",
               label.c_str(), l2.value_or(-1), misses.c_str());
 }
