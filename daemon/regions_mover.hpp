@@ -59,10 +59,10 @@ class RegionsMover {
     };
     Kind kind = Kind::kMoveVerified;
     Request request;
-    Placement to;                      ///< where the regions go (or stay, kConfirmed)
-    double elapsed_ms = 0;             ///< from the request to this outcome
-    std::string why_not;               ///< kMoveBack: why the node was refused
-    bool runaway = false;              ///< kDemote for the runaway watch (OnRunaway)
+    Placement to;                        ///< where the regions go (or stay, kConfirmed)
+    double elapsed_ms = 0;               ///< from the request to this outcome
+    std::string why_not;                 ///< kMoveBack: why the node was refused
+    bool runaway = false;                ///< kDemote for the runaway watch (OnRunaway)
     RunawayEnergies runaway_energies{};  ///< what the watch measured, for the log
     bool moves() const { return kind != Kind::kConfirmed; }
     /**
