@@ -37,33 +37,60 @@ Scene Adaptive(int primary_size, int lod, double rate_hz) {
 // (2026-12-05: 1 to 9 misses an attempt), and a quarter of it is a quarter as likely to.
 // Under a sanitizer (kSanitized) every step is slowed down many times: deadlines are not the point.
 
-// `periods` of the press on threads at a third of real time against the virtual-time run: the
-// smallest relative L2 over the first `clean` attempts that missed no deadline (of up to 20: a VM
-// loses the CPU now and then for milliseconds), or none; `misses` lists each attempt's misses per
-// region.
-std::optional<double> ThreadedAgainstVirtual(Scene scene, std::string* misses,
-                                             double periods = 0.25, int clean = 1) {
-  scene.input.periods = periods;
+// How an attempt on threads must have run for its forces to be compared: `periods` of the press,
+// `clean` attempts to compare (the smallest L2 of them is taken), and the largest share of its
+// period any thread may take from a release to its step's end (its wake-up lateness plus its
+// longest step, the worst of each, so an upper bound). 1 asks only that no deadline is missed.
+struct Attempts {
+  double periods = 0.25;
+  int clean = 1;
+  double finished_within_periods = 1.0;
+  double wall_seconds_per_second = 3.0;  // the clocks' stretch (RealTimeSchedule)
+};
+
+// Whether every region's thread of `dut` ran on time as `attempts` asks; appends to `log` each
+// region's misses and, in brackets, its worst wake-up lateness + longest step, in its periods.
+bool RanOnTime(const RealTimeSchedule& dut, int regions, const Attempts& attempts,
+               std::string* log) {
+  bool on_time = true;
+  char text[64];
+  for (int r = 0; r < regions; ++r) {
+    const DeadlineStats& stats = dut.stats(r);
+    const double finished = (stats.worst_lateness_s + stats.execution_max_s) / stats.period_s;
+    std::snprintf(text, sizeof text, " %lld (%.2f + %.2f)", static_cast<long long>(stats.misses),
+                  stats.worst_lateness_s / stats.period_s, stats.execution_max_s / stats.period_s);
+    *log += text;
+    on_time = on_time && stats.misses == 0 && finished < attempts.finished_within_periods;
+  }
+  *log += ";";
+  return on_time;
+}
+
+// The press on threads at a third of real time against the virtual-time run: the smallest
+// relative L2 over the first `attempts.clean` attempts that ran on time (of up to 20: a VM loses
+// the CPU now and then for milliseconds), or none; `log` lists each attempt as RanOnTime does,
+// and the L2 of those compared.
+std::optional<double> ThreadedAgainstVirtual(Scene scene, std::string* log,
+                                             const Attempts& attempts) {
+  scene.input.periods = attempts.periods;
   AsyncRegions regions(scene);
   const TrialResult virtual_time = regions.RunTrial();
   std::optional<double> smallest;
+  int clean = attempts.clean;
   for (int attempt = 0; attempt < 20 && clean > 0; ++attempt) {
-    RealTimeSchedule dut(regions, /*wall_seconds_per_second=*/3.0);
+    RealTimeSchedule dut(regions, attempts.wall_seconds_per_second);
     const TrialResult threaded = dut.RunTrial();
     EXPECT_EQ(threaded.samples.size(), virtual_time.samples.size());
     if (threaded.samples.size() != virtual_time.samples.size()) return std::nullopt;
-    bool missed = false;
-    for (int r = 0; r < regions.num_regions(); ++r) {
-      missed = missed || dut.stats(r).misses > 0;
-      *misses += ' ';
-      *misses += std::to_string(dut.stats(r).misses);
-    }
-    *misses += ";";
-    if (missed) continue;
+    if (!RanOnTime(dut, regions.num_regions(), attempts, log)) continue;
     --clean;
     EXPECT_EQ(dut.stats(kPrimaryRegion).cycles, static_cast<long>(virtual_time.samples.size()));
     for (int r = 1; r < regions.num_regions(); ++r) EXPECT_GT(dut.stats(r).cycles, 0);
     const double l2 = CompareForces(threaded.samples, virtual_time.samples).l2_percent;
+    char text[32];
+    std::snprintf(text, sizeof text, " %.6f %%;", l2);
+    log->back() = ':';
+    *log += text;
     smallest = std::min(smallest.value_or(l2), l2);
   }
   return smallest;
@@ -71,16 +98,19 @@ std::optional<double> ThreadedAgainstVirtual(Scene scene, std::string* misses,
 
 // ThreadedAgainstVirtual for `scene`, expected under `bound_percent`; prints what it measured.
 void ExpectThreadedWithin(const Scene& scene, const std::string& label, double bound_percent,
-                          double periods = 0.25, int clean = 1) {
-  std::string misses;
-  const std::optional<double> l2 = ThreadedAgainstVirtual(scene, &misses, periods, clean);
-  EXPECT_TRUE(l2) << label << ": every attempt missed a deadline (misses per region:" << misses
-                  << ")";
+                          const Attempts& attempts = {}) {
+  std::string log;
+  const std::optional<double> l2 = ThreadedAgainstVirtual(scene, &log, attempts);
+  EXPECT_TRUE(l2) << label
+                  << ": no attempt ran on time (misses per region, worst lateness + longest step:"
+                  << log << ")";
   if (l2) {
     EXPECT_LT(*l2, bound_percent) << label;
   }
-  std::printf("%s: %.6f %% from the virtual-time run; misses per region in each attempt:%s\n",
-              label.c_str(), l2.value_or(-1), misses.c_str());
+  std::printf(
+      "%s: %.6f %% from the virtual-time run; misses per region (worst lateness + longest step, "
+      "periods) in each attempt:%s\n",
+      label.c_str(), l2.value_or(-1), log.c_str());
 }
 
 TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
@@ -102,24 +132,32 @@ TEST(RealTimeSchedule, AgreesWithTheVirtualTimeRunWhenNoDeadlineIsMissed) {
 // (ReleaseLeadsNs): it finds the inner region at that time and publishes Γ before the inner one
 // needs it, and a later substep of its period reads the band the inner region published as its
 // next step's (AsyncRegions::ReadInnerLoads). So the threads make the virtual-time run's exchange:
-// over the first half of the press, the best of three clean attempts, measured 0.000000–0.000001 %
-// with one shell and two (0.0017 % in a single attempt once), 0.003 %
-// in 2 substeps a period (the controllers acting on a step-late view). Released 1.25 periods
-// ahead, as regions at different rates are: 0.0023 %, 0.018 % and 0.12 %; before the band's next
-// step was published, 5.4 % over the whole press with one shell (primary size 3, both at
-// 1000 Hz, `hapticsim simulate --threads`).
+// over the first quarter of the press, measured 0.000000 % with one shell and two, 0.0088 % in
+// 2 substeps a period (the controllers acting on a step-late view). Released 1.25 periods ahead,
+// as regions at different rates are, it was 0.0023 %, 0.018 % and 0.12 % over the first half;
+// before the band's next step was published, 5.4 % over the whole press with one shell (primary
+// size 3, both at 1000 Hz, `hapticsim simulate --threads`).
 TEST(RealTimeSchedule, AtOneRateTheThreadsMakeTheVirtualTimeRunsExchange) {
   if (kSanitized) GTEST_SKIP() << "timing test; the sanitizer run covers the threads below";
   Scene shells = Adaptive(2, 2, 1000);
   shells.adaptivity.secondary_regions = 2;
   shells.adaptivity.outer_rate_hz = 1000;
-  // A thread woken late by half a period, which no deadline counts, misses the exchange this
-  // measures: the best of three attempts (the lag of a release too short is in every one).
+  // The exchange this measures holds while every step ends within the half period of its
+  // release lead: the primary's before the secondary reads it, the secondary's before the primary
+  // needs its Γ. A deadline counts only a whole period, so an attempt is compared only if every
+  // thread's worst wake-up lateness plus its longest step stayed under half a period. In CI
+  // (2026-12-07) three attempts at a third of real time missed no deadline and were 0.93 % or
+  // more from the virtual-time run in 2 substeps; beside three busy processes here one such was
+  // 1.75 %, its secondary done 0.62 periods after its release. This 2-vCPU VM wakes threads up to
+  // 3–5 ms late on a quiet machine, so the clocks run at a tenth of real time. The best of three
+  // such attempts: the lag of a release too short would be in every one.
+  const Attempts one_rate{/*periods=*/0.25, /*clean=*/3, /*finished_within_periods=*/0.5,
+                          /*wall_seconds_per_second=*/10};
   for (const Scene& scene : {Adaptive(3, 2, 1000), shells}) {
     ExpectThreadedWithin(scene,
                          "at one rate, " + std::to_string(scene.adaptivity.secondary_regions) +
                              " region(s) beyond the primary",
-                         0.005, 0.5, 3);
+                         0.005, one_rate);
   }
   // In 2 substeps a period (a stiff material). With the line through the primary's last two
   // substeps carried on, 1.25 periods ahead, `hapticsim simulate --threads` was 3.1 % from the
@@ -130,7 +168,7 @@ TEST(RealTimeSchedule, AtOneRateTheThreadsMakeTheVirtualTimeRunsExchange) {
   stiff.material.youngs_modulus_pa = 20000;
   stiff.material.density_kg_m3 = 800;
   ASSERT_EQ(AsyncRegions(stiff).schedule(1).substeps, 2);
-  ExpectThreadedWithin(stiff, "at one rate in 2 substeps", 0.05, 0.5, 3);
+  ExpectThreadedWithin(stiff, "at one rate in 2 substeps", 0.05, one_rate);
 }
 
 // Both threads at full speed with whatever timing the machine gives (under ThreadSanitizer this
