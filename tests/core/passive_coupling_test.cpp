@@ -227,7 +227,9 @@ TEST(PassiveCoupling, ThePortLimitsHoldWhatOutgrewTheControllers) {
     const double stored_at_start = guarded.Energies().stored_j;
     const TrialResult result = guarded.RunTrialFromRandomState(scene.input, drawn.state_seed);
     ASSERT_EQ(result.runaway, runaway) << label;
-    if (!runaway) ASSERT_EQ(result.outcome, TrialOutcome::kCompleted) << label;
+    if (!runaway) {
+      ASSERT_EQ(result.outcome, TrialOutcome::kCompleted) << label;
+    }
     const EnergyAccount e = guarded.Energies();
     EXPECT_GT(e.port_refused_j, 0) << label;
     if (runaway) {

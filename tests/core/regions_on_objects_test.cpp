@@ -271,7 +271,9 @@ TEST(AsyncRegionsOnAnObject, APressOverTheInclusionFollowsTheReference) {
   // The primary is fine, holds every voxel of the block inside the box of 2 nodes around the
   // contact, and no empty one (the box reaches past the front face).
   for (const HybridElement& e : partition.mesh().elements()) {
-    if (e.region == kPrimaryRegion) EXPECT_EQ(e.size_factor, 1);
+    if (e.region == kPrimaryRegion) {
+      EXPECT_EQ(e.size_factor, 1);
+    }
   }
   const std::vector<RegionIndex> region = partition.mesh().RegionPerLatticeCell();
   const LatticeIndex& c = partition.contact_node();
