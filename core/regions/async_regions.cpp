@@ -16,19 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Value at time t on the line through two snapshots (the newer one alone if they coincide).
-// Callers clamp t from above: a late writer must never be extrapolated far. A reader that has
-// fallen behind both snapshots (its thread was late by more than the ring holds) gets the older
-// one: extrapolating backwards multiplies the difference between the snapshots by the lag, and
-// fed back through the coupling that diverges within a few late periods.
-inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
-                     int i, double t) {
-  const double span = newer.time_s - older.time_s;
-  if (!(span > 0)) return newer.values[i];
-  t = std::max(t, older.time_s);
-  return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
-}
-
 // The material the port floor is reckoned in: the object's one material, or of several the softest
 // (the floor is an allowance, so the smaller) at the object's mean density (so mass / density is
 // its volume).
@@ -122,8 +109,8 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
             at == owned.end() || *at != dof ? -1 : static_cast<int>(at - owned.begin()));
       }
       const int gamma = static_cast<int>(dofs.outer_interface.size());
-      const int outward_width =
-          coupling_ == Coupling::kForce ? gamma : 2 * static_cast<int>(region->band_layer.size());
+      const int band = static_cast<int>(region->band_layer.size());
+      const int outward_width = (coupling_ == Coupling::kForce ? gamma : 0) + 2 * band;
       region->inward = std::make_unique<BoundaryChannel>(gamma);
       region->outward = std::make_unique<BoundaryChannel>(outward_width);
       region->outer = BoundaryChannel::ReadPair(gamma);
@@ -181,39 +168,6 @@ double AsyncRegions::SetUpProxy(const ContactSettings& contact) {
   return proxy_stiffness_n_per_m_ / proxy.lightest_loaded_mass_kg();
 }
 
-void AsyncRegions::PublishInward(RegionIndex a) noexcept {
-  Region& region = *regions_[a];
-  const Eigen::VectorXd& u = region.integrator->u();
-  const auto& gamma = region.dofs->inner_interface;
-  for (size_t i = 0; i < gamma.size(); ++i) region.inward_values[i] = u[gamma[i]];
-  regions_[a - 1]->inward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
-                                   region.inward_values);
-}
-
-void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
-  Region& region = *regions_[a];
-  if (coupling_ == Coupling::kForce) {
-    const Eigen::VectorXd& ku = region.integrator->Forces();
-    const auto& gamma = region.dofs->outer_interface;
-    for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
-  } else {
-    RegionIntegrator& integrator = *region.integrator;
-    const Eigen::VectorXd& u = integrator.u();
-    const size_t n = region.band_layer.size();
-    // Where the next step puts the band only matters to an outer region at this one's rate.
-    const bool next_read = AtOneRate(a);
-    for (size_t i = 0; i < n; ++i) {
-      const double now = u[region.band_layer[i]];
-      const int slot = region.band_layer_slot[i];
-      region.outward_values[i] = now;
-      region.outward_values[n + i] =
-          next_read && slot >= 0 ? integrator.NextBeforeLoads(slot) : now;
-    }
-  }
-  region.outward->Publish(static_cast<double>(region.state_ticks) / ticks_per_second_,
-                          region.outward_values);
-}
-
 void AsyncRegions::PublishInitialSnapshots() {
   for (int a = 0; a < num_regions(); ++a) {
     if (a > 0) PublishInward(a);
@@ -262,63 +216,6 @@ void AsyncRegions::SetRandomState(unsigned seed) {
     for (int dof : partition_.dofs(a).owned) u[dof] = uniform(rng);
   }
   StartFrom(u, Eigen::VectorXd::Zero(u.size()));
-}
-
-// Regions `inner` and inner + 1 at one rate (and so in steps as long: ScheduleRegions gives
-// neighbours at one rate the same substeps): the link whose outer thread is released half a
-// period ahead (ReleaseLeadsNs) and reads the inner band's next step.
-bool AsyncRegions::AtOneRate(RegionIndex inner) const noexcept {
-  return regions_[inner]->schedule.rate_hz == regions_[inner + 1]->schedule.rate_hz;
-}
-
-// Region a's load on its inner Γ at t0: the inner region's force there, from its newest two
-// snapshots (force coupling), or from its displacements next to Γ (displacement coupling).
-void AsyncRegions::ReadInnerLoads(RegionIndex a, double t0) noexcept {
-  Region& region = *regions_[a];
-  const auto& inner_gamma = region.dofs->inner_interface;
-  RegionIntegrator& integrator = *region.integrator;
-  const Region& inner = *regions_[a - 1];
-  (void)inner.outward->TryReadLatestTwo(&region.inner);
-  // The schedule keeps the inner region less than one of its nominal periods behind. Never
-  // extrapolate its snapshots further than one of its steps (one substep): the line through
-  // two substeps' snapshots, carried a whole period of s substeps ahead, multiplies their
-  // difference by s, and a stiff object's Γ oscillating from substep to substep diverged so
-  // (the palpation phantom at 2.5 mm, 6 substeps: the force grew ×−5 a period in real time).
-  //
-  // At this region's rate in steps as long (AtOneRate), the inner region is at t0 itself
-  // (stepped in order, or on threads released as ReleaseLeadsNs says), except on a thread that
-  // takes its period's substeps at once: its later ones come before the inner region has taken
-  // its own. Those read the band where the inner region's next step will put it, which the inner
-  // region published with its state (displacement exchange; one substep on, exact but for a
-  // prescribed DOF in the band, which is held: 2 substeps a period exchange as in order), and
-  // hold that beyond. The line carried on instead overshoots through a mode that turns most of
-  // the way from substep to substep: hapticsimd serving the organ sample (2 substeps at one
-  // rate) pressed with 1.4 N where the static solution is 0.16 N.
-  // (The force exchange publishes no next step: it keeps the line, one substep at most.)
-  const double inner_step_s = 1.0 / (inner.schedule.rate_hz * inner.schedule.substeps);
-  const bool equal_steps = coupling_ != Coupling::kForce && AtOneRate(a - 1);
-  const double t = std::min(t0, region.inner.newer.time_s + (equal_steps ? 0.0 : inner_step_s));
-  if (coupling_ == Coupling::kForce) {
-    for (size_t i = 0; i < inner_gamma.size(); ++i) {
-      region.load_values[i] =
-          -OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
-    }
-  } else {
-    // The inner region's force on Γ from its band: its displacements next to Γ on the line
-    // through its newest two states (or next, as above), Γ itself as this region has it now.
-    const size_t n = inner.band_layer.size();
-    const bool next = equal_steps && t0 > region.inner.newer.time_s;
-    for (size_t i = 0; i < n; ++i) {
-      region.band_u[inner.band_layer[i]] =
-          next ? region.inner.newer.values[n + i]
-               : OnLine(region.inner.older, region.inner.newer, static_cast<int>(i), t);
-    }
-    const Eigen::VectorXd& u = integrator.u();
-    for (int dof : inner_gamma) region.band_u[dof] = u[dof];
-    inner.band->Apply(region.band_u, region.band_ku);
-    for (size_t i = 0; i < inner_gamma.size(); ++i)
-      region.load_values[i] = -region.band_ku[inner_gamma[i]];
-  }
 }
 
 void AsyncRegions::StepRegionAt(RegionIndex a, const std::array<double, 3>* contact_next,

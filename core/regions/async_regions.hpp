@@ -90,7 +90,7 @@ struct EnergyAccount {
  *                  on its band of elements next to Γ; the outer region evaluates the inner
  *                  region's force on Γ itself from them (extrapolated linearly to its own time)
  *                  and its own current Γ, so only the cross-coupling lags. With "force", the
- *                  inner region's forces on Γ, extrapolated.
+ *                  inner region's forces on Γ, extrapolated (at one rate, as "displacement").
  *
  * At equal rates the scheme is exactly monolithic central difference (k = 1 reproduces the
  * reference to round-off). With unequal rates the lagged coupling acts as negative damping; whether
@@ -412,8 +412,7 @@ class AsyncRegions {
   double SetUpProxy(const ContactSettings& contact);
   void BuildIntegrator(RegionIndex region, Region& state);
   void PublishInitialSnapshots();
-  /** Reset, then every region's copy of the state set to displacements `u` and velocities `v`
-   *  (u⁻ = u − v·h with its own substep h), the boundaries published from it. */
+  /** Reset; each region's state set to `u` and velocities `v` (u⁻ = u − v·h), Γ published. */
   void StartFrom(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
   TrialResult RunTrialFromCurrentState(const InputSettings& input, const TrialFrames& frames = {});
   void PublishInward(RegionIndex region) noexcept;
@@ -425,7 +424,8 @@ class AsyncRegions {
   void StepRegionAt(RegionIndex region, const std::array<double, 3>* contact_next,
                     std::array<double, 3>* reaction, EndOfStepLoad* push = nullptr) noexcept;
   void ReadInnerLoads(RegionIndex region, double t0) noexcept;
-  bool AtOneRate(RegionIndex inner) const noexcept;  // the link outwards of `inner`: see .cpp
+  bool AtOneRate(RegionIndex inner) const noexcept;     // the link outwards of `inner`: see .cpp
+  size_t BandOffset(RegionIndex inner) const noexcept;  // … its outward snapshot: see .cpp
   void ControlInterfaces(RegionIndex region, double* asked_inward, double* asked_outward,
                          PortWorkLimits* limits) noexcept;
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;

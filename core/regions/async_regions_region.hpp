@@ -32,14 +32,16 @@ struct AsyncRegions::Region {
 
   // Link with the region outwards: this region is its inner side.
   std::unique_ptr<BoundaryChannel> inward;    // outer → this: outer Γ displacements
-  std::unique_ptr<BoundaryChannel> outward;   // this → outer: band displacements or Γ forces
+  std::unique_ptr<BoundaryChannel> outward;   // this → outer: band displacements or Γ forces,
+                                              // then the band's next step
   std::unique_ptr<ElementSetStiffness> band;  // this region's elements next to its outer Γ
   std::vector<int> band_layer;                // their DOFs off the outer Γ
-  // With the displacement exchange the band is published twice over: as it is, and as this
-  // region's next step will put it (RegionIntegrator::NextBeforeLoads, for an outer region with
-  // steps as long, a thread that takes a later substep of its period before this region has
-  // taken its own: ReadInnerLoads). Each band DOF's place in this region's owned DOFs; −1 for a
-  // prescribed one (a support, the contact), which is held.
+  // With either exchange the band is published as this region's next step will put it
+  // (RegionIntegrator::NextBeforeLoads, for an outer region with steps as long, a thread that
+  // takes a later substep of its period before this region has taken its own: ReadInnerLoads),
+  // after the band as it is (displacement exchange) or the forces on Γ (force exchange). Each
+  // band DOF's place in this region's owned DOFs; −1 for a prescribed one (a support, the
+  // contact), which is held.
   std::vector<int> band_layer_slot;
   BoundaryChannel::ReadPair outer;     // Γ from the outer region, read by this region's thread
   std::vector<double> outward_values;  // written by this region's thread

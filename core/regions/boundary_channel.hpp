@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -82,5 +83,18 @@ class BoundaryChannel {
   Slot slots_[kSlots];
   std::atomic<std::uint64_t> published_{0};
 };
+
+// Value `i` at time t on the line through two snapshots (the newer one alone if they coincide).
+// Callers clamp t from above: a late writer must never be extrapolated far. A reader that has
+// fallen behind both snapshots (its thread was late by more than the ring holds) gets the older
+// one: extrapolating backwards multiplies the difference between the snapshots by the lag, and
+// fed back through the coupling that diverges within a few late periods.
+inline double OnLine(const BoundaryChannel::Snapshot& older, const BoundaryChannel::Snapshot& newer,
+                     int i, double t) noexcept {
+  const double span = newer.time_s - older.time_s;
+  if (!(span > 0)) return newer.values[i];
+  t = std::max(t, older.time_s);
+  return newer.values[i] + (t - newer.time_s) / span * (newer.values[i] - older.values[i]);
+}
 
 }  // namespace hapticsim

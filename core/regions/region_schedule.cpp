@@ -13,8 +13,9 @@ Eigen::VectorXd MaskOf(int size, const std::vector<int>& dofs) {
 }
 
 // K of a region's own elements plus the inner region's band, for the region's own limit: with
-// the displacement exchange the region evaluates the band's force on its Γ from its own current Γ,
-// so that stiffness acts on Γ within the step, unlagged, as its own does.
+// the displacement exchange (and at one rate the force exchange) the region evaluates the band's
+// force on its Γ from its own current Γ, so that stiffness acts on Γ within the step, unlagged,
+// as its own does.
 class RegionWithInnerBand final : public StiffnessOperator {
  public:
   RegionWithInnerBand(const StiffnessOperator& region, const StiffnessOperator& band)
@@ -62,7 +63,9 @@ std::vector<RegionSchedule> ScheduleRegions(
                                  : scene.adaptivity.outer_rate_hz;
     schedule.rate_hz = static_cast<double>(std::llround(rate));
     const Eigen::VectorXd owned = MaskOf(n, p.dofs(a).owned);
-    if (a > 0 && displacement_coupling) {
+    // At one rate the force exchange reads the band as the displacement exchange does
+    // (AsyncRegions::ReadInnerLoads).
+    if (a > 0 && (displacement_coupling || schedule.rate_hz == schedules[a - 1].rate_hz)) {
       // Its top eigenvalues can crowd (a stress scene took 3,000 Lanczos steps without meeting
       // 1e-9): 1e-6 is plenty for a step limit, and the residual bound it adds keeps the
       // estimate on the safe side.

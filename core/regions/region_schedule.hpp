@@ -24,8 +24,9 @@ struct RegionSchedule {
  * `substep_safety` of its own critical step, and neighbours at one rate in lock-step.
  *
  * bands[a]: region a's elements next to its outer Γ (none for the outermost). With the
- * displacement exchange a region evaluates its inner neighbour's band on its own Γ within its
- * step, so that band's stiffness counts in its own limit.
+ * displacement exchange, and at its inner neighbour's rate with either, a region evaluates its
+ * inner neighbour's band on its own Γ within its step, so that band's stiffness counts in its
+ * own limit.
  *
  * primary_spring_omega2_per_s2: k/m of a contact spring on the primary's lightest loaded node
  * (a stroke's proxy, 1/s²; 0 for a driven contact node). It adds at most that to the primary's

@@ -169,6 +169,11 @@ TEST(RealTimeSchedule, AtOneRateTheThreadsMakeTheVirtualTimeRunsExchange) {
   stiff.material.density_kg_m3 = 800;
   ASSERT_EQ(AsyncRegions(stiff).schedule(1).substeps, 2);
   ExpectThreadedWithin(stiff, "at one rate in 2 substeps", 0.05, one_rate);
+  // The force exchange's later substeps read that band too: with its line carried a substep
+  // instead, 6.4 % from the virtual-time run at real time, and its exchange made 35 % of the
+  // input's work (`hapticsim simulate --threads`, this scene with adaptivity.coupling = "force").
+  stiff.adaptivity.displacement_coupling = false;
+  ExpectThreadedWithin(stiff, "at one rate in 2 substeps, the force exchange", 0.05, one_rate);
 }
 
 // Both threads at full speed with whatever timing the machine gives (under ThreadSanitizer this
@@ -241,4 +246,49 @@ TEST(RealTimeSchedule, InjectedTimingFaultsAreCountedAndTheRunStaysBounded) {
 }
 
 }  // namespace
+// At one rate the force exchange reads the inner region's band with Γ as the outer region has it
+// now, as the displacement exchange does (AsyncRegions::ReadInnerLoads). A late thread so finds
+// a passive load: the inner region's own forces carry its stale view of Γ. Measured on the stiff
+// cube in 2 substeps with 10 late primary wakes and 10 secondary lags a second (1–2 periods
+// each), six seeds: with the forces' line carried a substep, the exchange made 60–110 % of the
+// input's work, the port limits refused up to 1.1 J, and the force was 9–14 % from the
+// virtual-time run; now at most 0.5 % of the input's work, nothing refused, 3.5–4.8 %, as with
+// the displacement exchange (3.8–4.9 %).
+TEST(RealTimeSchedule, AtOneRateTheForceExchangeStaysPassiveThroughLateWakes) {
+  if (kSanitized) GTEST_SKIP() << "timing test: under a sanitizer every wake is late";
+  Scene stiff = Adaptive(3, 2, 1000);
+  stiff.material.poisson_ratio = 0.49;
+  stiff.material.youngs_modulus_pa = 20000;
+  stiff.material.density_kg_m3 = 800;
+  stiff.adaptivity.displacement_coupling = false;
+  AsyncRegions regions(stiff);
+  ASSERT_EQ(regions.schedule(1).substeps, 2);
+  double created_j = 0, input_j = 0, refused_j = 0;
+  FaultCounts counts;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    const TimingFaults faults{.seed = seed,
+                              .secondary_lags_per_s = 10,
+                              .max_lag_periods = 2,
+                              .primary_late_wakes_per_s = 10,
+                              .max_late_periods = 2};
+    RealTimeSchedule dut(regions, 1.0, faults);
+    const TrialResult threaded = dut.RunTrial();
+    EXPECT_EQ(threaded.outcome, TrialOutcome::kCompleted);
+    const EnergyAccount e = regions.Energies();
+    created_j += e.interface_created_j;
+    input_j += e.input_work_j;
+    refused_j += e.port_refused_j;
+    counts += dut.faults();
+  }
+  EXPECT_GT(counts.primary_late_wakes, 0);
+  EXPECT_GT(counts.secondary_lags, 0);
+  EXPECT_LT(created_j, 0.02 * input_j);
+  EXPECT_LT(refused_j, 0.02 * input_j);
+  std::printf(
+      "force exchange at one rate, %lld late primary wakes and %lld secondary lags: the exchange "
+      "made %.3g J and the port limits refused %.3g J of the input's %.3g J\n",
+      static_cast<long long>(counts.primary_late_wakes),
+      static_cast<long long>(counts.secondary_lags), created_j, refused_j, input_j);
+}
+
 }  // namespace hapticsim
