@@ -130,8 +130,7 @@ std::optional<RegionsMover::Outcome> RegionsMover::TakeVerdict(std::int64_t now_
 void RegionsMover::OnRunaway(std::int64_t now_ns, const RunawayEnergies& measured) {
   const Request ran{placed_.centred.configuration, placed_.node};
   refusal_.clear();
-  CentredConfiguration equal{ran.configuration, true, true};
-  equal.configuration.secondary_rate_hz = PrimaryRateHz(scene_);
+  const CentredConfiguration equal{AtEqualRates(scene_, ran.configuration), true, true};
   // From now on, a touch there asking for this configuration moves straight to equal rates.
   verdicts_[KeyOf(ran)] = equal;
   // Whatever was asked is given up (a verification running is dropped by the next Submit):

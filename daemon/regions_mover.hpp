@@ -139,11 +139,12 @@ class RegionsMover {
   void NotApplied(const Outcome& outcome);
 
  private:
-  using Key = std::tuple<int, int, double, int, int, int>;
+  using Key = std::tuple<int, int, double, double, int, int, int>;
   static Key KeyOf(const Request& r) {
     return {r.configuration.primary_size,
             r.configuration.secondary_lod,
             r.configuration.secondary_rate_hz,
+            r.configuration.outer_rate_hz,
             r.node[0],
             r.node[1],
             r.node[2]};

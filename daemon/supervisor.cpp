@@ -51,10 +51,16 @@ LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
 
 }  // namespace
 
+RegionConfiguration AtEqualRates(const Scene& scene, RegionConfiguration configuration) {
+  configuration.secondary_rate_hz = configuration.outer_rate_hz = PrimaryRateHz(scene);
+  return configuration;
+}
+
 std::string DescribeConfiguration(const RegionConfiguration& c) {
   std::ostringstream text;
   text << "primary_size " << c.primary_size << ", secondary_lod " << c.secondary_lod
        << ", secondary_rate " << c.secondary_rate_hz << " Hz";
+  if (c.outer_rate_hz > 0) text << ", outer_rate " << c.outer_rate_hz << " Hz";
   return text.str();
 }
 
@@ -86,6 +92,7 @@ Scene SceneWith(const Scene& scene, const RegionConfiguration& c) {
   out.adaptivity.primary_size = c.primary_size;
   out.adaptivity.secondary_lod = c.secondary_lod;
   out.adaptivity.secondary_rate_hz = c.secondary_rate_hz;
+  if (c.outer_rate_hz > 0) out.adaptivity.outer_rate_hz = c.outer_rate_hz;
   return out;
 }
 

@@ -11,19 +11,31 @@ namespace hapticsim {
 
 /**
  * An adaptive configuration the supervisor can choose: the three of the scene's adaptivity
- * settings it varies (the rest — shells, outer_rate, support layers, the exchange — stay the
- * scene's). Defaults: the scene's own (AdaptivitySettings), so that one quantity has one default.
+ * settings it varies (the rest — shells, support layers, the exchange — stay the scene's, and so
+ * does outer_rate but at equal rates: AtEqualRates). Defaults: the scene's own
+ * (AdaptivitySettings), so that one quantity has one default.
  */
 struct RegionConfiguration {
   int primary_size = kDaemonPrimarySize;
   int secondary_lod = AdaptivitySettings{}.secondary_lod;
   double secondary_rate_hz = AdaptivitySettings{}.secondary_rate_hz;
+  double outer_rate_hz = 0;  ///< the shells beyond the first, Hz; 0: the scene's outer_rate
   bool operator==(const RegionConfiguration&) const = default;
   /** The primary size the daemon starts from when its scene names none. */
   static constexpr int kDaemonPrimarySize = 3;
 };
 
-/** "primary_size 3, secondary_lod 2, secondary_rate 1000 Hz": as logs and errors name it. */
+/**
+ * `configuration` with every secondary shell at the scene's primary rate: where the runaway watch
+ * moves regions that ran away. Only then is the exchange monolithic central difference, stable
+ * by each region's own limit; with the first shell alone at the primary rate, an outer shell at
+ * its own rate still ran away (`hapticsim stress` seed 1, cases 388, 390, 470 and 972, two
+ * shells, in the order hapticsimd's threads step them; docs/regions.md).
+ */
+RegionConfiguration AtEqualRates(const Scene& scene, RegionConfiguration configuration);
+
+/** "primary_size 3, secondary_lod 2, secondary_rate 1000 Hz" (and ", outer_rate 1000 Hz" where
+ *  set): as logs and errors name it. */
 std::string DescribeConfiguration(const RegionConfiguration& configuration);
 /** "contact node (ix, iy, iz)", as the log and the errors name a node. */
 std::string DescribeContactNode(const LatticeIndex& node);

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/regions/async_regions.hpp"
 #include "core/scene/scene.hpp"
 
 namespace hapticsim {
@@ -136,6 +137,7 @@ TEST(RegionsMover, ARunawayDemotesTheRegionsToEqualRatesThereAndRefusesTheConfig
   EXPECT_EQ(off->to.centred.configuration.primary_size, 2);
   EXPECT_EQ(off->to.centred.configuration.secondary_lod, 2);
   EXPECT_EQ(off->to.centred.configuration.secondary_rate_hz, PrimaryRateHz(scene));
+  EXPECT_EQ(off->to.centred.configuration.outer_rate_hz, PrimaryRateHz(scene));
   EXPECT_FALSE(off->CarriesMotionFrom(kOffCentre)) << "a state that ran away is not carried";
   EXPECT_NE(off->Describe().find("runaway watch"), std::string::npos) << off->Describe();
   EXPECT_EQ(mover.placement().centred.configuration, off->to.centred.configuration);
@@ -165,6 +167,25 @@ TEST(RegionsMover, ARunawayDemotesTheRegionsToEqualRatesThereAndRefusesTheConfig
   ASSERT_TRUE(again);
   EXPECT_EQ(again->to.centred.configuration, again->request.configuration);
   EXPECT_NE(again->Describe().find("already at equal rates"), std::string::npos);
+}
+
+// Equal rates are every shell's: with two shells and the first alone at the primary rate, the
+// outer shell's own rate kept a multirate exchange, and in the order hapticsimd's threads step
+// the regions four stress cases ran away again there (AtEqualRates).
+TEST(RegionsMover, EqualRatesPutEveryShellAtThePrimaryRate) {
+  Scene scene;
+  scene.adaptivity.secondary_regions = 2;
+  scene.adaptivity.outer_rate_hz = 500;
+  const RegionConfiguration equal = AtEqualRates(scene, RegionConfiguration{2, 2, 600});
+  const AsyncRegions regions(SceneWith(scene, equal));
+  ASSERT_EQ(regions.num_regions(), 3);
+  for (int a = 0; a < regions.num_regions(); ++a) {
+    EXPECT_EQ(regions.schedule(a).rate_hz, PrimaryRateHz(scene)) << "region " << a;
+  }
+  EXPECT_EQ(DescribeConfiguration(equal),
+            "primary_size 2, secondary_lod 2, secondary_rate 1000 Hz, outer_rate 1000 Hz");
+  // Any other configuration keeps the scene's outer rate.
+  EXPECT_EQ(SceneWith(scene, RegionConfiguration{2, 2, 600}).adaptivity.outer_rate_hz, 500);
 }
 
 // Stable by construction (docs/regions.md): a configuration whose bare exchange grows — the

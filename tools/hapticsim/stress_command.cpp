@@ -122,20 +122,19 @@ SupervisorCheck CheckSupervisor(const StressOutcome& outcome) {
   std::mt19937_64 rng(outcome.stress_case.state_seed);
   const ErrorMap lying = LyingMap(scene, rng);
   // Each chosen configuration run once.
-  std::map<std::tuple<int, int, double>, GuardedRun> runs;
+  std::map<std::tuple<int, int, double, double>, GuardedRun> runs;
   auto run = [&](const RegionConfiguration& c) -> const GuardedRun& {
-    const auto key = std::make_tuple(c.primary_size, c.secondary_lod, c.secondary_rate_hz);
+    const auto key =
+        std::make_tuple(c.primary_size, c.secondary_lod, c.secondary_rate_hz, c.outer_rate_hz);
     const auto found = runs.find(key);
     if (found != runs.end()) return found->second;
     GuardedRun& ran = runs[key] =
         RunAsTheDaemonRunsIt(SceneWith(scene, c), outcome.stress_case.state_seed);
     if (ran.runaway) {
-      // The daemon then runs the secondaries at the primary rate there: that must hold.
+      // The daemon then runs every secondary at the primary rate there: that must hold.
       ++check.runaways;
-      RegionConfiguration equal = c;
-      equal.secondary_rate_hz = PrimaryRateHz(scene);
-      const GuardedRun then =
-          RunAsTheDaemonRunsIt(SceneWith(scene, equal), outcome.stress_case.state_seed);
+      const GuardedRun then = RunAsTheDaemonRunsIt(SceneWith(scene, AtEqualRates(scene, c)),
+                                                   outcome.stress_case.state_seed);
       if (then.runaway) ran.problem = "ran away, and again at equal rates";
       if (!then.problem.empty()) ran.problem = "ran away; at equal rates it " + then.problem;
     }
