@@ -52,7 +52,13 @@ LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
 }  // namespace
 
 RegionConfiguration AtEqualRates(const Scene& scene, RegionConfiguration configuration) {
-  configuration.secondary_rate_hz = configuration.outer_rate_hz = PrimaryRateHz(scene);
+  const double primary_hz = PrimaryRateHz(scene);
+  configuration.secondary_rate_hz = primary_hz;
+  // The outer rate only where shells beyond the first run at another: elsewhere the regions are
+  // the same, and a configuration already at equal rates stays itself.
+  if (scene.adaptivity.secondary_regions > 1 && scene.adaptivity.outer_rate_hz != primary_hz) {
+    configuration.outer_rate_hz = primary_hz;
+  }
   return configuration;
 }
 

@@ -137,7 +137,7 @@ TEST(RegionsMover, ARunawayDemotesTheRegionsToEqualRatesThereAndRefusesTheConfig
   EXPECT_EQ(off->to.centred.configuration.primary_size, 2);
   EXPECT_EQ(off->to.centred.configuration.secondary_lod, 2);
   EXPECT_EQ(off->to.centred.configuration.secondary_rate_hz, PrimaryRateHz(scene));
-  EXPECT_EQ(off->to.centred.configuration.outer_rate_hz, PrimaryRateHz(scene));
+  EXPECT_EQ(off->to.centred.configuration.outer_rate_hz, 0) << "one shell: no outer rate";
   EXPECT_FALSE(off->CarriesMotionFrom(kOffCentre)) << "a state that ran away is not carried";
   EXPECT_NE(off->Describe().find("runaway watch"), std::string::npos) << off->Describe();
   EXPECT_EQ(mover.placement().centred.configuration, off->to.centred.configuration);
@@ -184,8 +184,13 @@ TEST(RegionsMover, EqualRatesPutEveryShellAtThePrimaryRate) {
   }
   EXPECT_EQ(DescribeConfiguration(equal),
             "primary_size 2, secondary_lod 2, secondary_rate 1000 Hz, outer_rate 1000 Hz");
-  // Any other configuration keeps the scene's outer rate.
+  // Any other configuration keeps the scene's outer rate; one already at equal rates stays
+  // itself, as with one shell.
   EXPECT_EQ(SceneWith(scene, RegionConfiguration{2, 2, 600}).adaptivity.outer_rate_hz, 500);
+  EXPECT_EQ(AtEqualRates(scene, equal), equal);
+  scene.adaptivity.outer_rate_hz = PrimaryRateHz(scene);
+  EXPECT_EQ(AtEqualRates(scene, RegionConfiguration{2, 2, 1000}),
+            (RegionConfiguration{2, 2, 1000}));
 }
 
 // Stable by construction (docs/regions.md): a configuration whose bare exchange grows — the
