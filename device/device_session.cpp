@@ -212,8 +212,12 @@ class AnswerTally {
     report_.largest_force_step_any_n =
         std::max(report_.largest_force_step_any_n, StepBetween(a, *previous_));
     if (contact && !stale && (previous_->flags & force_feedback_t::FLAG_IN_CONTACT)) {
-      report_.largest_force_step_n =
-          std::max(report_.largest_force_step_n, StepBetween(a, *previous_));
+      const double step = StepBetween(a, *previous_);
+      report_.largest_force_step_n = std::max(report_.largest_force_step_n, step);
+      if (a.first_seq == a.seq && a.seq == previous_->seq + 1) {
+        report_.largest_force_step_one_period_n =
+            std::max(report_.largest_force_step_one_period_n, step);
+      }
     }
   }
 

@@ -79,6 +79,7 @@ nlohmann::json ReportJson(const device::SessionReport& r) {
                         {"largest_force_step_N", r.largest_force_step_n},
                         {"max_force_step_in_contact_n", r.largest_force_step_n},
                         {"max_force_step_any_n", r.largest_force_step_any_n},
+                        {"max_force_step_one_period_n", r.largest_force_step_one_period_n},
                         {"max_force_n", r.largest_force_n},
                         {"contact_answers", r.contact_answers},
                         {"error_percent_in_contact",
@@ -175,9 +176,9 @@ std::string ReportText(const device::SessionReport& r) {
   add("  round trip                 median %.0f µs, p99 %.0f µs, p99.9 %.0f µs, max %.0f µs",
       r.latency.median_us, r.latency.p99_us, r.latency.p999_us, r.latency.max_us);
   add("  forces                     %lld non-finite, %lld non-zero out of contact, largest step "
-      "%.4f N between periods in contact",
+      "%.4f N between periods in contact (%.4f N between answers of one input each)",
       static_cast<long long>(r.nonfinite_forces), static_cast<long long>(r.force_out_of_contact),
-      r.largest_force_step_n);
+      r.largest_force_step_n, r.largest_force_step_one_period_n);
   add("  in contact                 %lld answers; largest force %.3f N; largest lateral %.3f N, "
       "%.3f × the normal",
       static_cast<long long>(r.contact_answers), r.largest_force_n, r.largest_lateral_n,

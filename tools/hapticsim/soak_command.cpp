@@ -428,6 +428,7 @@ int RunSoak(const SoakOptions& o) {
       {"cpu_load_cpu_s", load_cpu_s},
       {"max_force_step_in_contact_n", report.largest_force_step_n},
       {"max_force_step_any_n", report.largest_force_step_any_n},
+      {"max_force_step_one_period_n", report.largest_force_step_one_period_n},
       {"max_force_step_limit_n", o.max_force_step_n},
       {"max_force_n", report.largest_force_n},
       {"device_max_force_n", last_status.max_force_n},
