@@ -31,9 +31,11 @@ void AsyncRegions::PublishOutward(RegionIndex a) noexcept {
     for (size_t i = 0; i < gamma.size(); ++i) region.outward_values[i] = ku[gamma[i]];
   }
   const size_t band_at = BandOffset(a);
-  // Where the next step puts the band only matters to an outer region at this one's rate.
+  // Where the next step puts the band only matters to an outer region at this one's rate; the
+  // force exchange's band to nothing else (ReadInnerLoads).
   const bool next_read = AtOneRate(a);
-  for (size_t i = 0; i < n; ++i) {
+  const size_t band_read = coupling_ == Coupling::kForce && !next_read ? 0 : n;
+  for (size_t i = 0; i < band_read; ++i) {
     const double now = u[region.band_layer[i]];
     const int slot = region.band_layer_slot[i];
     region.outward_values[band_at + i] = now;
