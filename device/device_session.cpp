@@ -7,8 +7,9 @@
 #include <optional>
 #include <vector>
 
-#include "rt/monotonic_clock.hpp"
+#include "device/force_steps.hpp"
 #include "hapticsim/force_feedback_t.hpp"
+#include "rt/monotonic_clock.hpp"
 
 namespace hapticsim::device {
 namespace {
@@ -111,11 +112,6 @@ std::int64_t BadInput(std::int64_t k, std::int64_t seq, const std::array<double,
   }
 }
 
-double StepBetween(const Answer& a, const Answer& b) {
-  return std::hypot(a.force_n[0] - b.force_n[0], a.force_n[1] - b.force_n[1],
-                    a.force_n[2] - b.force_n[2]);
-}
-
 // What the answers tell, into the report: the stream, forces, steps, press peaks, round trips.
 class AnswerTally {
  public:
@@ -161,7 +157,6 @@ class AnswerTally {
       report_.trace.push_back({(sent_ns_[seq] - first_sent_ns_) * 1e-9, tips_[seq], a.force_n,
                                a.flags, a.error_percent});
     }
-    previous_ = a;
     if (last_burst_end_ >= 0 && a.seq > last_burst_end_) ++report_.answers_after_last_burst;
     TakeRoundTrips(a);
   }
@@ -208,17 +203,10 @@ class AnswerTally {
       report_.largest_lateral_n = std::max(report_.largest_lateral_n, lateral);
       report_.largest_lateral_ratio = std::max(report_.largest_lateral_ratio, lateral / normal);
     }
-    if (!previous_) return;
-    report_.largest_force_step_any_n =
-        std::max(report_.largest_force_step_any_n, StepBetween(a, *previous_));
-    if (contact && !stale && (previous_->flags & force_feedback_t::FLAG_IN_CONTACT)) {
-      const double step = StepBetween(a, *previous_);
-      report_.largest_force_step_n = std::max(report_.largest_force_step_n, step);
-      if (a.first_seq == a.seq && a.seq == previous_->seq + 1) {
-        report_.largest_force_step_one_period_n =
-            std::max(report_.largest_force_step_one_period_n, step);
-      }
-    }
+    steps_.Take(a);
+    report_.largest_force_step_any_n = steps_.any_n();
+    report_.largest_force_step_n = steps_.in_contact_n();
+    report_.largest_force_step_one_period_n = steps_.one_period_n();
   }
 
   void TakeError(double error_percent) {
@@ -258,7 +246,7 @@ class AnswerTally {
   std::int64_t second_answers_ = 0;
   std::vector<std::array<double, 3>> tips_;  // by seq, with keep_trace
   std::int64_t first_sent_ns_ = -1;
-  std::optional<Answer> previous_;
+  ForceSteps steps_;
 };
 
 // The answers that arrived on the device's link (tallied) and the monitor's (counted).

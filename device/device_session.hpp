@@ -69,8 +69,9 @@ struct SessionReport {
   std::int64_t force_out_of_contact = 0;
   double largest_force_step_n = 0;        ///< between consecutive answers in contact, fresh input
   double largest_force_step_any_n = 0;    ///< between any consecutive answers
-  /// … in contact, fresh input, between answers that each took one input, the next one: the
-  /// step of one period, without a late period's catch-up through several inputs.
+  /// … in contact, fresh input, between answers that each took one new input, the next one: the
+  /// step of one period, without a catch-up through several inputs after a late daemon period or
+  /// a late device (ForceSteps).
   double largest_force_step_one_period_n = 0;
   double largest_force_n = 0;             ///< the largest force magnitude received
   std::vector<double> press_peaks_n;      ///< each whole press's largest force (a press input)
