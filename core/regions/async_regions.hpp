@@ -431,11 +431,8 @@ class AsyncRegions {
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
   double InwardPortLimit(RegionIndex region, double energy, bool lockstep) noexcept;
   bool InLockStep(RegionIndex region) const noexcept;
-  /** Whether the port limits act: controllers on (kPassive) and the force exchange (the only
-   *  one the controllers alone were measured not to hold; docs/regions.md, "The port limits"). */
-  bool PortLimited() const noexcept {
-    return control_ == InterfaceControl::kPassive && coupling_ == Coupling::kForce;
-  }
+  /** Whether the port limits act (controllers on): see interface_energy.cpp. */
+  bool PortLimited() const noexcept;
   double OutwardPortLimit(RegionIndex region, double energy) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
   static double PrimaryReserve(RegionIntegrator& primary) noexcept;
@@ -457,6 +454,7 @@ class AsyncRegions {
                                                int max_windows, bool orbit_norm, unsigned seed);
 
   RegionPartition partition_;
+  bool primary_one_element_deep_ = false;  // see PortLimited
   Coupling coupling_;
   InterfaceControl control_;
   std::vector<std::unique_ptr<Region>> regions_;

@@ -43,6 +43,26 @@ AsyncRegions::~AsyncRegions() = default;
 // region's own discrete energy is not positive, and then no bound on it bounds the state: the
 // runaway watch, Runaway, sees the state itself — docs/regions.md, "The runaway watch".)
 
+// Where the port limits act (docs/regions.md, "The port limits"): on the force exchange, which
+// the controllers alone were measured not to hold; and on the displacement exchange where a link
+// runs at another rate, unless the primary is one element deep. hapticsimd's threads run such a
+// link with the outer region a whole period of substeps ahead, reading the inner band
+// extrapolated and held: on a stiff cube (stress seed 1, case 970) the exchange created 78–112 J
+// on threads against 1.3 mJ in virtual time, more than one step's damping on Γ takes out. A
+// primary one element deep is left to the runaway watch: its discrete energy says little about
+// its state, so the limits cannot tell a step's honest flow from a created one — under fast
+// inputs they cost up to 50 points of error, and where its state runs away (case 160) they hold
+// it bounded at 186 % from the reference instead of the watch taking the regions to equal rates.
+bool AsyncRegions::PortLimited() const noexcept {
+  if (control_ != InterfaceControl::kPassive) return false;
+  if (coupling_ == Coupling::kForce) return true;
+  if (primary_one_element_deep_) return false;
+  for (RegionIndex inner = 0; inner + 1 < num_regions(); ++inner) {
+    if (!AtOneRate(inner)) return true;
+  }
+  return false;
+}
+
 // Before region a's step: publishes its energies, and returns what its controllers are to take
 // out for its link inwards and outwards and, where the port limits act, the most its ports may do.
 void AsyncRegions::ControlInterfaces(RegionIndex a, double* asked_inward, double* asked_outward,

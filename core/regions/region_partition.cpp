@@ -215,6 +215,25 @@ int RegionPartition::num_nodes(RegionIndex region) const {
                                         [&](unsigned m) { return (m >> region) & 1u; }));
 }
 
+bool RegionPartition::PrimaryOneElementDeep() const {
+  const std::vector<int>& gamma = dofs_[kPrimaryRegion].outer_interface;
+  if (gamma.empty()) return false;  // the primary alone: no Γ
+  std::vector<char> on_gamma(static_cast<size_t>(mesh_->num_independent()), 0);
+  for (int dof : gamma) on_gamma[static_cast<size_t>(dof % mesh_->num_independent())] = 1;
+  for (const HybridElement& element : mesh_->elements()) {
+    if (element.region != kPrimaryRegion) continue;
+    bool touches = false;
+    for (int node : element.nodes) {
+      const auto [begin, end] = mesh_->Gather(node);
+      for (const GatherTerm* term = begin; term != end; ++term) {
+        touches = touches || on_gamma[static_cast<size_t>(term->independent)];
+      }
+    }
+    if (!touches) return false;
+  }
+  return true;
+}
+
 std::string RegionPartition::RegionName(RegionIndex region) const {
   if (region == kPrimaryRegion) return "primary";
   if (num_regions() == 2) return "secondary";

@@ -86,6 +86,9 @@ class RegionPartition {
   int num_nodes(RegionIndex region) const;
   /** "primary", "secondary", or "secondary 1", "secondary 2", … with several shells. */
   std::string RegionName(RegionIndex region) const;
+  /** Whether every element of the primary touches its Γ (a primary one element deep, such as
+   *  primary_size 1): none of its owned nodes is out of reach of Γ's prescribed motion. */
+  bool PrimaryOneElementDeep() const;
 
  private:
   // The contact's and supports' DOFs, and each region's owned, fixed and interface DOFs.

@@ -165,15 +165,15 @@ struct FaultOutcome {
   double nominal_force_step_n = 0;  ///< the same input on the virtual-time schedule, N
   FaultCounts faults;
   /** Above the controllers' bound by more than the port limits allow, where they act (the force
-   *  exchange): never, by construction. Checked. */
+   *  exchange; the displacement exchange at another rate): never, by construction. Checked. */
   bool energy_balance_violated() const {
     if (!std::isfinite(energy_gain_j) || !std::isfinite(backlog_bound_j)) return diverged;
     return backlog_bound_j > 0 &&
            energy_gain_j > backlog_bound_j + StressOutcome::kRoundOff * energy_scale_j;
   }
-  /** Without the port limits (the displacement exchange), above the controllers' bound by more
-   *  than kGrowingBacklog of the nominal energy: the backlog a stall leaves. Reported, not
-   *  checked (docs/reliability.md). */
+  /** Without the port limits (the displacement exchange at one rate, or on a primary one element
+   *  deep), above the controllers' bound by more than kGrowingBacklog of the nominal energy: the
+   *  backlog a stall leaves. Reported, not checked (docs/reliability.md). */
   bool above_backlog_tolerance() const {
     return ran && backlog_bound_j == 0 && std::isfinite(energy_gain_j) &&
            energy_gain_j > StressOutcome::kGrowingBacklog * energy_scale_j;

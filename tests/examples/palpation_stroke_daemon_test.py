@@ -4,8 +4,9 @@ it (at 5 mm voxels) with a tool that slides (contact.model = "proxy"), and the s
 stroking 60 mm across its front face over shared memory, in real time. The stiffer inclusion must
 show as a bump in the force the device received; the regions must have followed the proxy across
 the face; every answer must carry the error its map gives (made first over stroke_map.toml), within
-the 7 % target, or a flag saying why not (at most 5 % of them), and the supervisor must switch to
-the 1000 Hz the map keeps over the inclusion's far edge, which the control never needs; the lateral force must stay within the static friction's cone; and the force must not
+the daemon's default 7 % target (the script asks for 2 %), or a flag saying why not (at most 5 % of
+them), and the supervisor must switch to the 1000 Hz the map asks for over the inclusion's far
+edge, which the control never needs; the lateral force must stay within the static friction's cone; and the force must not
 step by more than 0.12 N between answers. The largest step left is the friction's own: the
 lateral force falling from μ_s to μ_k times the normal as the proxy slips, 0.1 × up to 0.77 N
 (measured 0.055–0.084 N quiet, 0.061–0.085 N beside two busy threads, 16 runs). Before the
@@ -44,11 +45,14 @@ def check_rows(summary, rows):
             not 0 <= summary["error_percent_reported"][1] <= 7:
         wrong.append("the error reported reached %.3f %%, above the 7 %% target"
                      % summary["error_percent_reported"][1])
-    # The lookup follows the material under the regions: the map says a primary of 4 diverges
-    # pressed over the inclusion's far edge (nodes 10 and 12) at 600 and at 800 Hz, so the daemon
-    # must start below 1000 Hz (in step costs a third more) and switch to 1000 Hz on the way there;
-    # on the control phantom it has no reason to switch. Whether it starts at 600 or 800 Hz is
-    # the sweep's measured cost, which is timing: either is right.
+    # The lookup follows the material under the regions: the map says a primary of 4 or 5 with the
+    # secondary at 600 or 800 Hz is 2.8–4.4 % off pressed at some of nodes 10–14 (over the
+    # inclusion's far edge and past it), above the 2 % the script asks of the daemon, against
+    # 0.2–0.6 % at 1000 Hz; so the daemon must start below 1000 Hz (in step costs a third more) and
+    # switch to 1000 Hz on the way there; on the control phantom it has no reason to switch.
+    # (Until the port limits acted on the displacement exchange at another rate, 2026-12-07, those
+    # slower configurations diverged there.) Whether it starts at 600 or 800 Hz is the sweep's
+    # measured cost, which is timing: either is right.
     rates = summary["secondary_rates_hz_run"]
     if not (rates and rates[0] < 1000 and 1000 in rates[1:]):
         wrong.append("the secondary ran at %s Hz: the map asks it to switch to 1000 Hz before the "
@@ -59,9 +63,9 @@ def check_rows(summary, rows):
 
 
 def check_control(summary):
-    # The control's map keeps 600 Hz stable along the whole row (800 Hz diverges over its middle,
-    # nodes 6-10, so the daemon may move between the two), and 1000 Hz costs more: nothing there
-    # asks for it.
+    # The control's map keeps a slower rate within the script's 2 % along the whole row (it ran at
+    # 600 Hz alone; the daemon may move between 600 and 800 Hz), and 1000 Hz costs more: nothing
+    # there asks for it.
     if not summary["secondary_rates_hz_run"] or 1000 in summary["secondary_rates_hz_run"]:
         return ["on the control phantom the secondary ran at %s Hz: its map keeps a cheaper rate "
                 "than 1000 Hz along the whole row" % summary["secondary_rates_hz_run"]]
