@@ -152,6 +152,10 @@ class AnswerTally {
     if (contact) ++report_.contact_answers;
     if (contact) TakeError(a.error_percent);  // finite or not: every answer in contact counts
     if (finite) TakeForce(a, contact);
+    steps_.Take(a);  // every answer: which inputs it took counts, finite or not
+    report_.largest_force_step_any_n = steps_.any_n();
+    report_.largest_force_step_n = steps_.in_contact_n();
+    report_.largest_force_step_one_period_n = steps_.one_period_n();
     if (settings_.keep_trace && a.seq >= 1 && a.seq < static_cast<std::int64_t>(tips_.size())) {
       const auto seq = static_cast<std::size_t>(a.seq);
       report_.trace.push_back({(sent_ns_[seq] - first_sent_ns_) * 1e-9, tips_[seq], a.force_n,
@@ -203,10 +207,6 @@ class AnswerTally {
       report_.largest_lateral_n = std::max(report_.largest_lateral_n, lateral);
       report_.largest_lateral_ratio = std::max(report_.largest_lateral_ratio, lateral / normal);
     }
-    steps_.Take(a);
-    report_.largest_force_step_any_n = steps_.any_n();
-    report_.largest_force_step_n = steps_.in_contact_n();
-    report_.largest_force_step_one_period_n = steps_.one_period_n();
   }
 
   void TakeError(double error_percent) {

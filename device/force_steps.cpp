@@ -8,9 +8,12 @@
 namespace hapticsim::device {
 
 void ForceSteps::Take(const Answer& a) {
-  // An answer that took no new input repeats the newest seq it answered before.
-  const bool took_one = previous_ && a.first_seq == a.seq && a.seq == previous_->seq + 1;
-  if (previous_) {
+  // An answer that took no new input repeats the newest seq it answered before; one after a lost
+  // answer (a gap in the daemon's periods) is two periods' step, not one.
+  const bool took_one = previous_ && a.first_seq == a.seq && a.seq == previous_->seq + 1 &&
+                        a.period == previous_->period + 1;
+  const bool finite = std::isfinite(a.force_n[0] + a.force_n[1] + a.force_n[2]);
+  if (previous_ && finite && previous_finite_) {
     const double step =
         std::hypot(a.force_n[0] - previous_->force_n[0], a.force_n[1] - previous_->force_n[1],
                    a.force_n[2] - previous_->force_n[2]);
@@ -24,6 +27,7 @@ void ForceSteps::Take(const Answer& a) {
     }
   }
   previous_ = a;
+  previous_finite_ = finite;
   previous_took_one_ = took_one;
 }
 

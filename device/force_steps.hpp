@@ -11,13 +11,14 @@ namespace hapticsim::device {
  *
  * - any: between any two answers, in contact or not (a lift-off's release included);
  * - in contact: both answers in contact, the newer not flagged stale input;
- * - one period: the same, and each answer took exactly one new input, the one after the input
- *   the answer before it took. Neither a daemon period that caught up through several inputs
- *   nor one that answered again with no new input (the device late: the daemon carried the tip
- *   on by itself) is one period's step: after either, the tip's motion of several periods
- *   arrives in one answer.
+ * - one period: the same, and each of the two answers took exactly one new input, the one after
+ *   the input the answer before it took, in the daemon's next period. Neither a daemon period
+ *   that caught up through several inputs nor one that answered again with no new input (the
+ *   device late: the daemon carried the tip on by itself) is one period's step: after either,
+ *   the tip's motion of several periods arrives in one answer. (So a session's first two
+ *   answers are never one: the first has none before it.)
  *
- * Steps are force vectors' differences, N. Answers with a non-finite force are not taken.
+ * Steps are force vectors' differences, N; none is taken to or from a non-finite force.
  */
 class ForceSteps {
  public:
@@ -29,6 +30,7 @@ class ForceSteps {
 
  private:
   std::optional<Answer> previous_;
+  bool previous_finite_ = false;
   bool previous_took_one_ = false;  // the answer before took one new input, the next
   double any_n_ = 0, in_contact_n_ = 0, one_period_n_ = 0;
 };

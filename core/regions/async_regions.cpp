@@ -59,8 +59,8 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
   if (!(substep_safety > 0)) throw Error("substep safety must be positive");
   substep_safety_ = substep_safety;
   const RegionPartition& p = partition_;
-  // A primary that follows a sliding proxy must reach every node its tip touches.
   primary_one_element_deep_ = p.PrimaryOneElementDeep();
+  // A primary that follows a sliding proxy must reach every node its tip touches.
   if (p.proxy_contact()) CheckPrimaryReachesTip(scene, p.mesh().options().spacing_m);
   port_floor_j_ = PortFloorJ(FloorMaterial(p), p.dof_mass().sum() / 3.0);
   const int n = p.mesh().num_dofs();

@@ -131,10 +131,10 @@ class AsyncRegions {
 
   /**
    * kPassive: every interface's controller takes out what its exchange creates, and — with the
-   * force exchange — its port limits bound what the controllers cannot take out in time (always,
-   * in the daemon and the sweep). For analysis only — what each part costs and holds
-   * (docs/regions.md); no configuration file can ask for them: kDampingOnly, the controllers
-   * without the port limits; kOff, the bare exchange and the lag's own instability.
+   * force exchange, or at another rate (PortLimited) — its port limits bound what the controllers
+   * cannot take out in time (always, in the daemon and the sweep). For analysis only — what each
+   * part costs and holds (docs/regions.md); no configuration file can ask for them: kDampingOnly,
+   * the controllers without the port limits; kOff, the bare exchange and the lag's own instability.
    */
   enum class InterfaceControl { kPassive, kDampingOnly, kOff };
 
@@ -431,8 +431,7 @@ class AsyncRegions {
   double ObserveInwardLink(RegionIndex region, double energy) noexcept;
   double InwardPortLimit(RegionIndex region, double energy, bool lockstep) noexcept;
   bool InLockStep(RegionIndex region) const noexcept;
-  /** Whether the port limits act (controllers on): see interface_energy.cpp. */
-  bool PortLimited() const noexcept;
+  bool PortLimited(RegionIndex inner) const noexcept;  // the link outwards of `inner`: see .cpp
   double OutwardPortLimit(RegionIndex region, double energy) noexcept;
   double OutwardLinkExcess(RegionIndex region) const noexcept;
   static double PrimaryReserve(RegionIntegrator& primary) noexcept;

@@ -43,24 +43,22 @@ AsyncRegions::~AsyncRegions() = default;
 // region's own discrete energy is not positive, and then no bound on it bounds the state: the
 // runaway watch, Runaway, sees the state itself — docs/regions.md, "The runaway watch".)
 
-// Where the port limits act (docs/regions.md, "The port limits"): on the force exchange, which
-// the controllers alone were measured not to hold; and on the displacement exchange where a link
-// runs at another rate, unless the primary is one element deep. hapticsimd's threads run such a
-// link with the outer region a whole period of substeps ahead, reading the inner band
-// extrapolated and held: on a stiff cube (stress seed 1, case 970) the exchange created 78–112 J
-// on threads against 1.3 mJ in virtual time, more than one step's damping on Γ takes out. A
-// primary one element deep is left to the runaway watch: its discrete energy says little about
-// its state, so the limits cannot tell a step's honest flow from a created one — under fast
-// inputs they cost up to 50 points of error, and where its state runs away (case 160) they hold
-// it bounded at 186 % from the reference instead of the watch taking the regions to equal rates.
-bool AsyncRegions::PortLimited() const noexcept {
+// Whether the port limits act on the link outwards of region `inner` (docs/regions.md, "The port
+// limits"): with the force exchange, which the controllers alone were measured not to hold; and
+// with the displacement exchange where the link runs at another rate, unless its inner region is
+// a primary one element deep. hapticsimd's threads run such a link with the outer region a whole
+// period of substeps ahead, reading the inner band extrapolated and held: on a stiff cube (stress
+// seed 1, case 970) the exchange created 78–112 J on threads against 1.3 mJ in virtual time, more
+// than one step's damping on Γ takes out. A primary one element deep is left to the runaway
+// watch: its discrete energy says little about its state, so the limits cannot tell a step's
+// honest flow from a created one — under fast inputs they cost up to 50 points of error, and
+// where its state runs away (case 160) they hold it bounded at 186 % from the reference instead
+// of the watch taking the regions to equal rates.
+bool AsyncRegions::PortLimited(RegionIndex inner) const noexcept {
   if (control_ != InterfaceControl::kPassive) return false;
   if (coupling_ == Coupling::kForce) return true;
-  if (primary_one_element_deep_) return false;
-  for (RegionIndex inner = 0; inner + 1 < num_regions(); ++inner) {
-    if (!AtOneRate(inner)) return true;
-  }
-  return false;
+  if (AtOneRate(inner)) return false;
+  return !(inner == kPrimaryRegion && primary_one_element_deep_);
 }
 
 // Before region a's step: publishes its energies, and returns what its controllers are to take
@@ -68,7 +66,6 @@ bool AsyncRegions::PortLimited() const noexcept {
 void AsyncRegions::ControlInterfaces(RegionIndex a, double* asked_inward, double* asked_outward,
                                      PortWorkLimits* limits) noexcept {
   Region& region = *regions_[a];
-  const bool limited = PortLimited();
   // An O(n) pass over the region's DOFs (K·u is cached for the step): the controllers' floor
   // and the port limits follow the energy step by step, and the runaway watch the state's.
   const RegionIntegrator::Energies energies = region.integrator->BothEnergies();
@@ -78,11 +75,11 @@ void AsyncRegions::ControlInterfaces(RegionIndex a, double* asked_inward, double
   region.energy_peak = std::max(region.energy_peak, energy);
   if (a > 0) {
     *asked_inward = ObserveInwardLink(a, energy);
-    if (limited) limits->load_work_j = InwardPortLimit(a, energy, InLockStep(a));
+    if (PortLimited(a - 1)) limits->load_work_j = InwardPortLimit(a, energy, InLockStep(a));
   }
   if (region.inward) {
     *asked_outward = OutwardLinkExcess(a);
-    if (limited) limits->prescribed_work_j = OutwardPortLimit(a, energy);
+    if (PortLimited(a)) limits->prescribed_work_j = OutwardPortLimit(a, energy);
   }
   // The primary keeps kPrimaryReserve of its energy in reserve: damping its DOFs is a viscous
   // force at the contact the user feels (measured: a loaded press peaked 14 % high when it took
@@ -259,7 +256,7 @@ EnergyAccount AsyncRegions::Energies() noexcept {
     account.interface_dissipated_j += region.inward_taken + region.outward_taken;
     if (a > 0) {
       const Region& inner = *regions_[a - 1];
-      if (PortLimited()) {
+      if (PortLimited(a - 1)) {
         account.backlog_bound_j += inner.outward_allowance_peak + region.inward_allowance_peak +
                                    kCreditMemory * region.energy_peak + region.lockstep_load_peak;
       }

@@ -99,8 +99,9 @@ struct StressOutcome {
   bool passive_but_diverged() const { return passive_expected && controlled_diverged(); }
   /**
    * A case run as the daemon runs it that ended with more energy than the controllers' bound
-   * (EnergyAboveBound) by more than the port limits allow (backlog_bound_j, to round-off; the
-   * force exchange, where they act) — whatever its regions: that bound holds by construction;
+   * (EnergyAboveBound) by more than the port limits allow (backlog_bound_j, to round-off; where
+   * they act: the force exchange, a link at another rate) — whatever its regions: that bound holds
+   * by construction;
    * or, held by the controllers (passive_expected), by more than kGrowingBacklog of its energy;
    * or, predicted stable, by more than the observer's one step.
    */

@@ -196,6 +196,28 @@ TEST(PassiveCoupling, OnTheDefaultMaterialTheControllersCostAtMostATenthOfAPoint
   }
 }
 
+// Where the port limits act on the displacement exchange, link by link (AsyncRegions::PortLimited):
+// a link at another rate, unless its inner region is a primary one element deep (primary_size 1
+// at spacing factor 1). What they allow shows in the bound (backlog_bound_j), which sums the
+// links they act on.
+TEST(PassiveCoupling, OnTheDisplacementExchangeThePortLimitsActOnEachLinkAtAnotherRate) {
+  auto bound_after_a_press = [](int r, double secondary_hz, int shells, double outer_hz) {
+    Scene scene = Adaptive(r, 1, secondary_hz);
+    scene.adaptivity.secondary_regions = shells;
+    if (shells > 1) scene.adaptivity.outer_rate_hz = outer_hz;
+    scene.input.periods = 0.25;
+    AsyncRegions dut(scene);
+    dut.RunTrial();
+    return dut.Energies().backlog_bound_j;
+  };
+  EXPECT_GT(bound_after_a_press(2, 600, 1, 0), 0);     // at another rate
+  EXPECT_EQ(bound_after_a_press(2, 1000, 1, 0), 0);    // at one rate
+  EXPECT_EQ(bound_after_a_press(1, 600, 1, 0), 0);     // a primary one element deep
+  EXPECT_GT(bound_after_a_press(1, 600, 2, 500), 0);   // … but the shells' link acts
+  EXPECT_GT(bound_after_a_press(2, 1000, 2, 500), 0);  // the shells' link alone
+  EXPECT_EQ(bound_after_a_press(2, 1000, 2, 1000), 0);
+}
+
 // What outgrew the controllers alone (docs/regions.md, "The port limits"): the force exchange with
 // an outer shell faster than the one inside it, stress seed 1's cases 20 and 202. Run as the
 // stress test runs them — from a random state under their extreme input, every region within

@@ -43,7 +43,7 @@ def check_rows(summary, rows):
                                      summary["answers_error_unknown_unflagged"]))
     if not summary["error_percent_reported"] or \
             not 0 <= summary["error_percent_reported"][1] <= 7:
-        wrong.append("the error reported reached %.3f %%, above the 7 %% target"
+        wrong.append("the error reported reached %.3f %%, above the daemon's default 7 %% target"
                      % summary["error_percent_reported"][1])
     # The lookup follows the material under the regions: the map says a primary of 4 or 5 with the
     # secondary at 600 or 800 Hz is 2.8–4.4 % off pressed at some of nodes 10–14 (over the

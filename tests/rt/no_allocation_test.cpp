@@ -70,7 +70,7 @@ TEST(RegionSteps, NeverAllocate) {
   }
 }
 
-// The same while the port limits act: the force exchange (where they act) on a configuration
+// The same while the port limits act: the force exchange (where they act too) on a configuration
 // whose exchange grows (ν 0.49, k 1 r 2 at 900 Hz) from a random state (every mode excited),
 // stepped until they have refused work.
 TEST(RegionSteps, NeverAllocateWhileThePortLimitsAct) {

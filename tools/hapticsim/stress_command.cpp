@@ -469,7 +469,7 @@ int Run(const StressOptions& o) {
                 << injected.secondary_stalls << " stalls, " << injected.primary_late_wakes
                 << " late primary wakes, " << injected.skips << " skips), diverged "
                 << fault_diverged << ", above the energy bound by more than the port limits allow "
-                << fault_violations << " (force exchange), by more than 1 % without them "
+                << fault_violations << " (where they act), by more than 1 % without them "
                 << fault_above << " (reported, not checked)\n    largest force step "
                 << max_force_step << " N (case " << max_step_case << "; " << max_step_nominal
                 << " N on the nominal schedule)\n";
