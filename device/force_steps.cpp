@@ -7,13 +7,18 @@
 
 namespace hapticsim::device {
 
+namespace {
+
+bool Finite(const Answer& a) { return std::isfinite(a.force_n[0] + a.force_n[1] + a.force_n[2]); }
+
+}  // namespace
+
 void ForceSteps::Take(const Answer& a) {
   // An answer that took no new input repeats the newest seq it answered before; one after a lost
   // answer (a gap in the daemon's periods) is two periods' step, not one.
   const bool took_one = previous_ && a.first_seq == a.seq && a.seq == previous_->seq + 1 &&
                         a.period == previous_->period + 1;
-  const bool finite = std::isfinite(a.force_n[0] + a.force_n[1] + a.force_n[2]);
-  if (previous_ && finite && previous_finite_) {
+  if (previous_ && Finite(a) && Finite(*previous_)) {
     const double step =
         std::hypot(a.force_n[0] - previous_->force_n[0], a.force_n[1] - previous_->force_n[1],
                    a.force_n[2] - previous_->force_n[2]);
@@ -27,7 +32,6 @@ void ForceSteps::Take(const Answer& a) {
     }
   }
   previous_ = a;
-  previous_finite_ = finite;
   previous_took_one_ = took_one;
 }
 

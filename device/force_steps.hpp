@@ -30,7 +30,6 @@ class ForceSteps {
 
  private:
   std::optional<Answer> previous_;
-  bool previous_finite_ = false;
   bool previous_took_one_ = false;  // the answer before took one new input, the next
   double any_n_ = 0, in_contact_n_ = 0, one_period_n_ = 0;
 };
