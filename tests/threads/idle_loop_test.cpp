@@ -25,6 +25,16 @@ using Clock = std::chrono::steady_clock;
 
 constexpr std::array<double, 3> kAbove{0.125, 0.125, -0.002};  // 2 mm off the front face
 
+// Waits, up to 2 s, for the loop to go idle once its input is stale (50 ms): by its state, not by
+// a fixed sleep, which a sanitizer's slower periods can outlast.
+bool WaitUntilIdle(HapticLoop& loop) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (!loop.idle() && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return loop.idle();
+}
+
 std::int64_t Cycles(HapticLoop& loop, RegionIndex region) {
   return loop.monitor(region).TakeSnapshot().cycles;
 }
@@ -60,8 +70,7 @@ TEST(IdleLoop, ParksTheSecondaryAnswersEveryInputAndWakesOnInputAndTouch) {
   for (const ForceRecord& f : hovering) EXPECT_EQ(f.force_n[2], 0.0);
 
   // No device: once the input is stale the primary waits for input instead of running periods.
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
-  EXPECT_TRUE(loop.idle());
+  EXPECT_TRUE(WaitUntilIdle(loop));
   const std::int64_t primary_before = Cycles(loop, kPrimaryRegion);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   // (Awake it would run 300 periods; idle, one per kIdleWait_s at most: 15.)
@@ -117,8 +126,7 @@ TEST(IdleLoop, AfterAnIdleWaitTheAnswersAreReadOnTheGridItWentBackTo) {
   auto above = [](int) { return kAbove; };
   std::vector<ForceRecord> answers = Drive(loop, &seq, 300, above);
   ASSERT_TRUE(loop.asleep());
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));  // no device: stale, then idle
-  EXPECT_TRUE(loop.idle());
+  EXPECT_TRUE(WaitUntilIdle(loop));  // no device: stale, then idle
   const std::vector<ForceRecord> after = Drive(loop, &seq, 300, above);
   loop.Stop();
   answers.insert(answers.end(), after.begin(), after.end());
