@@ -14,6 +14,7 @@
 #include "daemon/haptic_loop.hpp"
 #include "tests/support/late_wakes.hpp"
 #include "tests/support/play_device.hpp"
+#include "tests/support/poll_until.hpp"
 #include "tests/support/sanitized.hpp"
 
 namespace hapticsim {
@@ -24,16 +25,6 @@ using Clock = std::chrono::steady_clock;
 // Under a sanitizer (kSanitized) every step is several times slower: latencies are not checked.
 
 constexpr std::array<double, 3> kAbove{0.125, 0.125, -0.002};  // 2 mm off the front face
-
-// Waits, up to 2 s, for the loop to go idle once its input is stale (50 ms): by its state, not by
-// a fixed sleep, which a sanitizer's slower periods can outlast.
-bool WaitUntilIdle(HapticLoop& loop) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (!loop.idle() && std::chrono::steady_clock::now() < give_up) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return loop.idle();
-}
 
 std::int64_t Cycles(HapticLoop& loop, RegionIndex region) {
   return loop.monitor(region).TakeSnapshot().cycles;
@@ -70,7 +61,7 @@ TEST(IdleLoop, ParksTheSecondaryAnswersEveryInputAndWakesOnInputAndTouch) {
   for (const ForceRecord& f : hovering) EXPECT_EQ(f.force_n[2], 0.0);
 
   // No device: once the input is stale the primary waits for input instead of running periods.
-  EXPECT_TRUE(WaitUntilIdle(loop));
+  EXPECT_TRUE(testing::PollUntil([&] { return loop.idle(); }));  // stale after 50 ms, then idle
   const std::int64_t primary_before = Cycles(loop, kPrimaryRegion);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   // (Awake it would run 300 periods; idle, one per kIdleWait_s at most: 15.)
@@ -126,7 +117,7 @@ TEST(IdleLoop, AfterAnIdleWaitTheAnswersAreReadOnTheGridItWentBackTo) {
   auto above = [](int) { return kAbove; };
   std::vector<ForceRecord> answers = Drive(loop, &seq, 300, above);
   ASSERT_TRUE(loop.asleep());
-  EXPECT_TRUE(WaitUntilIdle(loop));  // no device: stale, then idle
+  EXPECT_TRUE(testing::PollUntil([&] { return loop.idle(); }));  // no device: stale, then idle
   const std::vector<ForceRecord> after = Drive(loop, &seq, 300, above);
   loop.Stop();
   answers.insert(answers.end(), after.begin(), after.end());
