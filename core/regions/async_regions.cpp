@@ -361,7 +361,7 @@ void AsyncRegions::AdvancePrimaryTo(std::int64_t ticks) noexcept {
   const std::array<double, 3> held{0, 0, 0};
   Region& primary = *regions_[kPrimaryRegion];
   while (primary.state_ticks < ticks) {
-    AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
+    AdvanceSecondariesForPrimaryStep();
     if (partition_.proxy_contact()) {
       HeldToolSpring spring(proxy_stiffness_n_per_m_, proxy_contact_slot_,
                             partition_.contact_dofs());

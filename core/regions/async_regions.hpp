@@ -12,8 +12,10 @@
 #include "core/fem/region_integrator.hpp"
 #include "core/fem/stability_estimate.hpp"
 #include "core/regions/boundary_channel.hpp"
+#include "core/regions/coupled_stability.hpp"
 #include "core/regions/region_partition.hpp"
 #include "core/regions/region_schedule.hpp"
+#include "core/regions/stepping_order.hpp"
 #include "core/scene/contact_trajectory.hpp"
 #include "core/trial/reference_trial.hpp"
 
@@ -24,17 +26,6 @@ namespace hapticsim {
 struct RunawayEnergies {
   double state_j = 0;
   double allowed_j = 0;
-};
-
-/** The spectral radius of the map that advances the coupled state by one common period. */
-struct CoupledStability {
-  double spectral_radius = 0;  ///< per common period; < 1 decays, > 1 grows
-  double common_period_s = 0;  ///< the shortest time after which every region's schedule repeats
-  int periods = 0;             ///< periods of power iteration used
-  bool orbit_norm = true;      ///< false: the orbit energy was indefinite, the Euclidean norm used
-  bool stable = false;         ///< spectral_radius < kStableBelow
-  /** Margin below 1 that counts as stable: a mode decaying slower than this is refused. */
-  static constexpr double kStableBelow = 1.0 - 1e-6;
 };
 
 /**
@@ -265,6 +256,13 @@ class AsyncRegions {
    * supply Γ at `ticks`, as the primary's next step needs.
    */
   void AdvanceSecondariesTo(std::int64_t ticks) noexcept;
+  /** Virtual time, before each primary step: the secondaries stepped in the stepping order —
+   *  AdvanceSecondariesTo its end, or at a period's start every secondary wake released by then. */
+  void AdvanceSecondariesForPrimaryStep() noexcept;
+  /** How virtual-time runs step the regions (SteppingOrder; kSubsteps unless set). One thread,
+   *  while no steps run. */
+  void SetSteppingOrder(SteppingOrder order);
+  SteppingOrder stepping_order() const noexcept { return stepping_order_; }
 
   /**
    * True when the region's state is within `tolerance_m` of rest (every owned displacement, now
@@ -439,6 +437,7 @@ class AsyncRegions {
   void PublishEnergyAccount(Region& region) noexcept;
   void ResetEnergyAccount() noexcept;
   void AdvanceRegionTo(RegionIndex region, std::int64_t ticks) noexcept;
+  void ReleaseSecondariesBy(std::int64_t ticks) noexcept;  // the threads' order: see its .cpp
   void AdvancePrimaryTo(std::int64_t ticks) noexcept;
   void ScaleAll(double factor);
   double StateNorm() const;
@@ -462,6 +461,8 @@ class AsyncRegions {
   double port_floor_j_ = 0;
   double state_energy_at_reset_j_ = 0;  // Σ StateEnergy when the energy balance last started
   double substep_safety_ = kSubstepSafety;
+  SteppingOrder stepping_order_ = SteppingOrder::kSubsteps;
+  std::vector<std::int64_t> release_lead_ticks_;  // per region, in the threads' order
 
   // The surface (core/regions/region_surface.cpp): each of its values (3 per point) is a sum of terms
   // [term_start[v], term_start[v + 1]), each a weight times a region's published surface value.

@@ -15,11 +15,18 @@
 namespace hapticsim {
 namespace {
 
+// Regions on `scene` stepped in `order`.
+std::unique_ptr<AsyncRegions> RegionsIn(const Scene& scene, SteppingOrder order) {
+  auto regions = std::make_unique<AsyncRegions>(scene);
+  regions->SetSteppingOrder(order);
+  return regions;
+}
+
 // Regions around `centre`, started from `state`.
 std::unique_ptr<AsyncRegions> RegionsAround(Scene scene, const LatticeIndex& centre,
-                                            const ObjectState& state) {
+                                            const ObjectState& state, SteppingOrder order) {
   scene.input.contact_node = centre;
-  auto regions = std::make_unique<AsyncRegions>(scene);
+  auto regions = RegionsIn(scene, order);
   regions->RestoreState(state);
   return regions;
 }
@@ -50,11 +57,12 @@ void Accumulate(AsyncRegions& regions, RegionStrokeResult* out) {
 class StrokeRun {
  public:
   StrokeRun(const Scene& scene, const TrialFrames& frames,
-            const std::function<void(const AsyncRegions&)>& regions_now)
+            const std::function<void(const AsyncRegions&)>& regions_now, SteppingOrder order)
       : scene_(scene),
         frames_(frames),
         regions_now_(regions_now),
-        regions_(std::make_unique<AsyncRegions>(scene)),
+        order_(order),
+        regions_(RegionsIn(scene, order)),
         normal_(regions_->partition().contact_normal()),
         centre_(regions_->partition().contact_node()),
         proxy_(regions_->partition().PrimaryProxySurface(), centre_, normal_, scene.contact),
@@ -102,8 +110,7 @@ class StrokeRun {
       std::array<double, 3> tool = proxy_.start_m();
       const std::array<double, 3> moved = trajectory_.SubstepToolAt(n, q, substeps, dt_);
       for (int c = 0; c < 3; ++c) tool[c] += moved[c];
-      regions_->AdvanceSecondariesTo(regions_->state_ticks(kPrimaryRegion) +
-                                     regions_->period_ticks(kPrimaryRegion));
+      regions_->AdvanceSecondariesForPrimaryStep();
       ProxyPush push(proxy_, tool);
       regions_->StepPrimaryPushed(push);
       const ProxyContact::Result& touch = push.touch;
@@ -144,7 +151,7 @@ class StrokeRun {
     const ObjectState state = regions_->CaptureState();
     Accumulate(*regions_, &out_);
     work_before_j_ += regions_->InputWorkJ();
-    regions_ = RegionsAround(scene_, next, state);
+    regions_ = RegionsAround(scene_, next, state, order_);
     proxy_.Rebind(regions_->partition().PrimaryProxySurface());
     CheckAgree(proxy_, *regions_);
     runaway_periods_ = 0;
@@ -159,6 +166,7 @@ class StrokeRun {
   const Scene& scene_;
   const TrialFrames& frames_;
   const std::function<void(const AsyncRegions&)>& regions_now_;
+  SteppingOrder order_;
   RegionStrokeResult out_;
   std::unique_ptr<AsyncRegions> regions_;
   std::array<double, 3> normal_;
@@ -176,10 +184,11 @@ class StrokeRun {
 }  // namespace
 
 RegionStrokeResult RunRegionStroke(const Scene& scene, const TrialFrames& frames,
-                                   const std::function<void(const AsyncRegions&)>& regions_now) {
+                                   const std::function<void(const AsyncRegions&)>& regions_now,
+                                   SteppingOrder order) {
   HAPTICSIM_THROW_UNLESS(scene.input.waveform == Waveform::kStroke,
                          "internal: RunRegionStroke runs input.waveform = \"stroke\"");
-  return StrokeRun(scene, frames, regions_now).Run();
+  return StrokeRun(scene, frames, regions_now, order).Run();
 }
 
 }  // namespace hapticsim

@@ -43,13 +43,14 @@ struct RegionStrokeResult {
  * `frames`: the whole object (AsyncRegions::CaptureState) at the start of the periods they ask for;
  * `regions_now`, if given, is called with the regions the stroke runs on, first at the start,
  * then after each move, before any frame of theirs (hapticsim simulate --vtk draws them).
+ * `order`: how the regions are stepped (SteppingOrder).
  *
  * @throws Error for a scene whose regions cannot be made (ValidateScene; adaptivity off), or
  * whose adaptivity.primary_size cannot reach the tip's nodes (⌈contact.radius / h⌉ + 1, at least
  * 2).
  */
-RegionStrokeResult RunRegionStroke(
-    const Scene& scene, const TrialFrames& frames = {},
-    const std::function<void(const AsyncRegions&)>& regions_now = {});
+RegionStrokeResult RunRegionStroke(const Scene& scene, const TrialFrames& frames = {},
+                                   const std::function<void(const AsyncRegions&)>& regions_now = {},
+                                   SteppingOrder order = SteppingOrder::kSubsteps);
 
 }  // namespace hapticsim

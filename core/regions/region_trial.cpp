@@ -54,7 +54,7 @@ TrialResult AsyncRegions::RunTrialFromCurrentState(const InputSettings& input,
     if (frames.Due(n)) frames.observe(t, CaptureState());
     std::array<double, 3> r{};
     for (int q = 1; q <= substeps; ++q) {
-      AdvanceSecondariesTo(primary.state_ticks + primary.period_ticks);
+      AdvanceSecondariesForPrimaryStep();
       const double depth_next = trajectory.DepthAt(t + q * h);
       const std::array<double, 3> rq = StepPrimary(trajectory.DisplacementAt(t + q * h));
       if (q == 1) r = rq;

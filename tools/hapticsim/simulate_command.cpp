@@ -29,6 +29,7 @@ struct SimulateOptions {
   bool allow_unstable = false;
   bool compare_reference = false;
   bool threads = false;
+  std::string order = "substeps";  // SteppingOrderNamed
   std::string vtk_dir;
   double vtk_rate_hz = 30;
 };
@@ -94,6 +95,7 @@ struct AdaptiveReport {
   std::vector<std::optional<DeadlineStats>> deadlines;  // per region, with --threads
   std::optional<ForceError> threaded_vs_virtual;
   std::optional<std::size_t> stroke_moves;  // a stroke: how often the primary followed the proxy
+  SteppingOrder order = SteppingOrder::kSubsteps;  // the virtual-time run's
 };
 
 nlohmann::json DeadlineJson(const DeadlineStats& d) {
@@ -133,6 +135,7 @@ void ReportRegions(const AsyncRegions& regions, const std::vector<double>& compu
 // estimate is reported as an analysis; the runaway watch ends what the controllers cannot hold.
 TrialResult RunAdaptive(const Scene& scene, bool threads, AdaptiveReport* report, VtkOutput* vtk) {
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
+  regions.SetSteppingOrder(report->order);
   report->coupled = regions.EstimateCoupledStability();
   regions.SetInterfaceControl(AsyncRegions::InterfaceControl::kPassive);
   // Frames come from the virtual-time run, the schedule the error map measures.
@@ -176,6 +179,7 @@ TrialResult RunAdaptiveStroke(const Scene& scene, bool threads, AdaptiveReport* 
                          "--threads: a stroke on the regions runs in virtual time only (the "
                          "primary follows the proxy by moving the regions); drop --threads");
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety, AsyncRegions::InterfaceControl::kOff);
+  regions.SetSteppingOrder(report->order);
   report->coupled = regions.EstimateCoupledStability();
   std::optional<VtkSeries> series;
   TrialFrames frames;
@@ -188,7 +192,7 @@ TrialResult RunAdaptiveStroke(const Scene& scene, bool threads, AdaptiveReport* 
       series->SetRegions(now.partition().mesh().RegionPerLatticeCell());
     };
   }
-  const RegionStrokeResult run = RunRegionStroke(scene, frames, regions_now);
+  const RegionStrokeResult run = RunRegionStroke(scene, frames, regions_now, report->order);
   if (series) {
     series->Finish();
     vtk->written.push_back(series->collection());
@@ -204,6 +208,7 @@ int Run(const SimulateOptions& options) {
   const Scene scene = options.scene.Resolve();
   const bool adaptive = scene.adaptivity.enabled();
   AdaptiveReport report;
+  report.order = *SteppingOrderNamed(options.order);  // CLI::IsMember checked the name
   TrialOptions trial_options;
   trial_options.run_if_predicted_unstable = options.allow_unstable;
   if (options.threads && !adaptive) {
@@ -282,6 +287,7 @@ int Run(const SimulateOptions& options) {
     out["compute_us_per_simulated_ms"] = cost_us_per_ms;
     out["time_series_csv"] = wrote_series ? nlohmann::json(options.csv_path) : nlohmann::json();
     if (adaptive) {
+      out["stepping_order"] = std::string(SteppingOrderName(report.order));
       out["coupled_spectral_radius"] = report.coupled.spectral_radius;
       out["common_period_s"] = report.coupled.common_period_s;
       const EnergyAccount& e = report.energy;
@@ -325,6 +331,11 @@ int Run(const SimulateOptions& options) {
               << Quantity(scene.input.frequency_hz, "Hz") << " for " << Duration(scene.duration_s())
               << ", dt " << Duration(scene.solver.dt_s) << "\n";
     if (adaptive) {
+      std::cout << "  virtual time in the "
+                << (report.order == SteppingOrder::kThreads
+                        ? "threads' order (hapticsimd's: --order threads)"
+                        : "substeps' order (the error map's; hapticsimd's: --order threads)")
+                << "\n";
       for (const RegionReport& r : report.regions) {
         std::cout << "  " << r.name << " region: " << r.nodes << " nodes, " << r.elements
                   << " elements, " << Quantity(r.rate_hz, "Hz") << " × " << r.substeps
@@ -438,7 +449,15 @@ Command AddSimulateCommand(CLI::App& parent) {
                 "Also run the full-resolution reference and report the force error against it");
   app->add_flag("--threads", options->threads,
                 "Run the asynchronous regions on real threads (one per region, on real clocks) "
-                "and report deadlines and the difference from the virtual-time run");
+                "and report deadlines and the difference from the virtual-time run (in --order)");
+  app->add_option("--order", options->order,
+                  "How the virtual-time run steps the regions: 'substeps' (the error map's "
+                  "order: the secondaries step before each primary substep) or 'threads' "
+                  "(hapticsimd's: each region's period of substeps at one wake, released ahead as "
+                  "its threads are; where a secondary runs at another rate in several substeps, "
+                  "the force the daemon renders)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"substeps", "threads"}));
   app->add_option("--vtk", options->vtk_dir,
                   "Write the run as a VTK time series ParaView opens: DIR/adaptive.pvd and "
                   "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame of the "
