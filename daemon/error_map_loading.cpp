@@ -76,8 +76,11 @@ MapState LoadMap(const std::string& path, const Scene& scene, bool reload) {
   if (path.empty()) return state;
   try {
     state.map = LoadUsableMap(path, scene);
-    spdlog::info("error map {}: {} samples, grid '{}', made by {}", path, state.map->samples.size(),
-                 state.map->provenance.grid, state.map->provenance.code_version);
+    spdlog::info(
+        "error map {}: {} samples, grid '{}', made by {}, the regions stepped in the {}' "
+        "order",
+        path, state.map->samples.size(), state.map->provenance.grid,
+        state.map->provenance.code_version, state.map->provenance.stepping_order);
   } catch (const Error& e) {
     spdlog::error("{}; {}", e.what(),
                   reload ? "keeping the map loaded before"

@@ -69,6 +69,9 @@ struct ErrorMap {
     std::string shard = "1/1";         ///< the slice this file holds, "I/N" (1-based)
     double direction_threshold = 0.1;  ///< fraction of the peak below which direction is ignored
     bool linearity_used = false;       ///< amplitude axis derived from linearity
+    /** The order its trials stepped the regions in (SteppingOrderName): "substeps", or
+     *  "threads", hapticsimd's. Maps written before the key: "substeps". */
+    std::string stepping_order = "substeps";
   };
 
   Provenance provenance;

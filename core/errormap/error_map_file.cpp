@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/fnv1a.hpp"
+#include "core/regions/stepping_order.hpp"
 
 namespace hapticsim {
 namespace {
@@ -70,6 +71,7 @@ Json MetaOf(const ErrorMap& map) {
                {"shard", p.shard},
                {"direction_threshold_fraction_of_peak", p.direction_threshold},
                {"linearity_used", p.linearity_used},
+               {"stepping_order", p.stepping_order},
                {"fields",
                 {{"l2_percent", "relative L2 force error over the trial, %"},
                  {"max_magnitude_percent", "worst force-magnitude error, % of the reference peak"},
@@ -251,6 +253,11 @@ std::uint64_t ReadMeta(MapFileReader& reader, ErrorMap* out) {
     p.shard = meta.at("shard").get<std::string>();
     p.direction_threshold = meta.at("direction_threshold_fraction_of_peak").get<double>();
     p.linearity_used = meta.at("linearity_used").get<bool>();
+    p.stepping_order = meta.value("stepping_order", std::string("substeps"));
+    if (!SteppingOrderNamed(p.stepping_order)) {
+      Refuse(path, "its stepping_order \"" + p.stepping_order +
+                       "\" is neither \"substeps\" nor \"threads\"");
+    }
     const auto& axes = meta.at("axes");
     if (axes.size() != kNumMapAxes) Refuse(path, "corrupted: wrong number of axes");
     std::uint64_t grid_size = 1;
@@ -386,6 +393,9 @@ ErrorMap MergeErrorMaps(const std::vector<ErrorMap>& shards) {
                            which + "was made by another model or code version (" + b.code_version +
                                " vs " + a.code_version + ")");
     HAPTICSIM_THROW_UNLESS(b.grid == a.grid, which + "is from another grid (" + b.grid + ")");
+    HAPTICSIM_THROW_UNLESS(b.stepping_order == a.stepping_order,
+                           which + "stepped the regions in the " + b.stepping_order +
+                               "' order, map 1 in the " + a.stepping_order + "'");
     for (size_t i = 0; i < shard.samples.size(); ++i) {
       const MapSample& s = shard.samples[i];
       if (!s.computed()) continue;

@@ -84,6 +84,7 @@ ErrorMap EmptyMap(const Scene& base, const SweepGrid& grid, const SweepOptions& 
       std::to_string(options.shard_index + 1) + "/" + std::to_string(options.shard_count);
   map.provenance.direction_threshold = ForceError::kDirectionThreshold;
   map.provenance.linearity_used = linear;
+  map.provenance.stepping_order = std::string(SteppingOrderName(options.order));
   for (const MapSample& s : map.samples) SceneAtPoint(base, s.point);  // validates every point
   return map;
 }
@@ -160,12 +161,14 @@ MapSample RunSample(const Scene& base, const SweepRun& run, const Reference& ref
 // Phase 2, one task: its regions built once, every run made, each sample placed where its
 // targets say (another amplitude or density: the reference peak scaled).
 PlacedSamples RunTask(const Scene& base, const SweepTask& task, const References& references,
-                      const ErrorMap& map, double* adaptive_s, std::size_t* trials) {
+                      const ErrorMap& map, SteppingOrder order, double* adaptive_s,
+                      std::size_t* trials) {
   PlacedSamples results;
   // No stability estimate: the interface controllers hold most lagged exchanges, what their
   // dissipation costs is in the error this trial measures, and a trial that diverges anyway is
   // recorded as diverged (docs/regions.md, "Passive interfaces"). The runaway watch ends it too.
   AsyncRegions regions(SceneAtPoint(base, task.point));
+  regions.SetSteppingOrder(order);
   for (const SweepRun& run : task.runs) {
     const MapSample sample =
         RunSample(base, run, references.at(ReferenceKeyOf(run.point)), regions, adaptive_s, trials);
@@ -264,7 +267,7 @@ ErrorMap RunSweep(const Scene& scene, const SweepGrid& grid, const SweepOptions&
         double adaptive_s = 0;
         std::size_t trials = 0;
         const PlacedSamples results =
-            RunTask(base, all_tasks[todo[i]], references, map, &adaptive_s, &trials);
+            RunTask(base, all_tasks[todo[i]], references, map, options.order, &adaptive_s, &trials);
         for (const auto& [index, sample] : results) {
           map.samples[index] = sample;  // each sample belongs to exactly one task
         }

@@ -7,6 +7,7 @@
 
 #include "core/errormap/error_map.hpp"
 #include "core/errormap/sweep_grid.hpp"
+#include "core/regions/stepping_order.hpp"
 #include "core/scene/scene.hpp"
 
 namespace hapticsim {
@@ -42,6 +43,9 @@ struct SweepOptions {
       true;  ///< materials of equal E/ρ, ν, d, contrast: run once, force scaled by ρ
   std::string journal_path;                 ///< completed tasks are appended here ("" = none)
   bool resume = false;                      ///< read the journal first and skip what it holds
+  /** How the trials step the regions: the substeps' order, or hapticsimd's threads' (maps made
+   *  in either say which: ErrorMap::Provenance::stepping_order). */
+  SteppingOrder order = SteppingOrder::kSubsteps;
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after current tasks
   std::function<void(const SweepProgress&)> progress;
   double progress_interval_s = 0.5;

@@ -48,7 +48,7 @@ std::string SweepFingerprint(const ErrorMap& map, const SweepGrid& grid,
   std::ostringstream text;
   text << map.provenance.scene_toml << map.provenance.model << map.provenance.code_version
        << grid.name << options.shard_index << '/' << options.shard_count << options.use_linearity
-       << options.use_similarity;
+       << options.use_similarity << map.provenance.stepping_order;
   Fnv1a hash;
   const std::string words = text.str();
   hash.Bytes(words.data(), words.size());

@@ -25,6 +25,7 @@ ErrorMap ExampleMap() {
   map.provenance.model = "test model";
   map.provenance.code_version = "test";
   map.provenance.grid = "test";
+  map.provenance.stepping_order = "threads";
   for (size_t i = 0; i < map.samples.size(); ++i) {
     MapSample& s = map.samples[i];
     s.status = i == 4 ? SampleStatus::kPredictedUnstable : SampleStatus::kOk;
@@ -63,6 +64,7 @@ TEST(ErrorMapFile, RoundTripKeepsEveryField) {
   const ErrorMap back = LoadErrorMap(path);
   EXPECT_EQ(back.axes, map.axes);
   EXPECT_EQ(back.provenance.scene_toml, map.provenance.scene_toml);
+  EXPECT_EQ(back.provenance.stepping_order, "threads");
   EXPECT_EQ(back.ResultsChecksum(), map.ResultsChecksum());
   ASSERT_EQ(back.samples.size(), map.samples.size());
   EXPECT_TRUE(std::isnan(back.samples[4].l2_percent));
@@ -107,6 +109,19 @@ TEST(ErrorMapFile, TruncatedCorruptedWrongVersionAndForeignFilesAreRefusedSaying
   EXPECT_NE(LoadError(path).find("not an error map"), std::string::npos) << LoadError(path);
 
   EXPECT_NE(LoadError(TempPath("does-not-exist.hsmap")).find("cannot open"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+// The order the trials stepped the regions in: a map from before the key was made in the
+// substeps' order; an order no one knows is refused, named.
+TEST(ErrorMapFile, ASteppingOrderIsReadAndAnUnknownOneIsRefused) {
+  EXPECT_EQ(LoadErrorMap(HAPTICSIM_SMALL_MAP).provenance.stepping_order, "substeps");
+  const std::string path = TempPath("unknown-order.hsmap");
+  ErrorMap map = ExampleMap();
+  map.provenance.stepping_order = "sideways";
+  SaveErrorMap(map, path);
+  EXPECT_NE(LoadError(path).find("stepping_order \"sideways\""), std::string::npos)
+      << LoadError(path);
   std::filesystem::remove(path);
 }
 

@@ -137,6 +137,29 @@ TEST(ErrorMapCli, ADamagedMapIsRefusedWithAMessageThatSaysHow) {
   EXPECT_NE(result.err.find("truncated"), std::string::npos) << result.err;
 }
 
+// A map made in hapticsimd's threads' order (sweep --order threads) says so, its results differ
+// where a secondary runs at another rate in several substeps (ν 0.49 here), and it does not merge
+// with a shard of the substeps' order.
+TEST(ErrorMapCli, AMapSweptInTheThreadsOrderSaysSoAndMergesOnlyWithItsOwnOrder) {
+  const std::string threads = Temp("threads.hsmap"), shard = Temp("threads-shard.hsmap");
+  ASSERT_EQ(Hapticsim(SweepArgs(threads, {"--order", "threads"})).exit_status, 0);
+  const auto info = Json(Hapticsim({"map", "info", threads, "--json"}));
+  EXPECT_EQ(info["stepping_order"], "threads");
+  EXPECT_EQ(Json(Hapticsim({"map", "info", Temp("full.hsmap"), "--json"}))["stepping_order"],
+            "substeps");
+  EXPECT_EQ(info["not_computed"], 0);
+  EXPECT_NE(info["results_checksum"], FullSweep()["results_checksum"]);
+  const std::string text = Hapticsim({"map", "info", threads}).out;
+  EXPECT_NE(text.find("regions stepped in the threads' order"), std::string::npos) << text;
+
+  ASSERT_EQ(Hapticsim(SweepArgs(shard, {"--shard", "2/2", "--order", "threads"})).exit_status, 0);
+  const std::string first = Temp("substeps-shard.hsmap");
+  ASSERT_EQ(Hapticsim(SweepArgs(first, {"--shard", "1/2"})).exit_status, 0);
+  const CommandResult merged = Hapticsim({"map", "merge", Temp("mixed.hsmap"), first, shard});
+  EXPECT_EQ(merged.exit_status, 2);
+  EXPECT_NE(merged.err.find("threads' order"), std::string::npos) << merged.err;
+}
+
 TEST(ErrorMapCli, ShardsMergeToTheSameResultsAsOneSweep) {
   const std::string a = Temp("shard1.hsmap"), b = Temp("shard2.hsmap"), merged = Temp("m.hsmap");
   ASSERT_EQ(Hapticsim(SweepArgs(a, {"--shard", "1/2"})).exit_status, 0);

@@ -52,6 +52,7 @@ int Info(const MapCommandOptions& o) {
         {"model", p.model},
         {"code_version", p.code_version},
         {"linearity_used", p.linearity_used},
+        {"stepping_order", p.stepping_order},
         {"direction_threshold_fraction_of_peak", p.direction_threshold},
         {"results_checksum", map.ResultsChecksum()},
         {"axes", axes},
@@ -62,7 +63,8 @@ int Info(const MapCommandOptions& o) {
   std::cout << "Error map " << o.map << " (format " << kErrorMapFormatVersion << ", "
             << (map.grid ? "grid" : "scattered") << ")\n"
             << "  made by " << p.code_version << " from grid '" << p.grid << "', shard " << p.shard
-            << (p.linearity_used ? ", amplitude axis from linearity" : "") << "\n"
+            << (p.linearity_used ? ", amplitude axis from linearity" : "")
+            << ", regions stepped in the " << p.stepping_order << "' order\n"
             << "  model: " << p.model << "\n"
             << "  samples: " << map.samples.size() << " — ok " << ok << ", predicted unstable "
             << map.CountStatus(SampleStatus::kPredictedUnstable) << ", diverged "

@@ -30,6 +30,7 @@ struct SweepCommandOptions {
   std::string shard = "1/1";
   bool no_linearity = false;
   bool no_similarity = false;
+  std::string order = "substeps";  // SteppingOrderNamed
 };
 
 std::pair<int, int> ParseShard(const std::string& text) {
@@ -77,6 +78,7 @@ int Run(const SweepCommandOptions& o) {
   options.shard_count = shard_count;
   options.use_linearity = !o.no_linearity;
   options.use_similarity = !o.no_similarity;
+  options.order = *SteppingOrderNamed(o.order);  // CLI::IsMember checked the name
   options.journal_path = o.out + ".journal";
   options.resume = o.resume;
   options.stop = &g_stop;
@@ -168,6 +170,13 @@ Command AddSweepCommand(CLI::App& parent) {
   app->add_flag("--no-similarity", o->no_similarity,
                 "Run every material instead of deriving a material of the same E/ρ, ν, d and "
                 "contrast as an earlier one from it (its forces scaled by the density ratio)");
+  app->add_option("--order", o->order,
+                  "How the trials step the regions: 'substeps' (the secondaries before each "
+                  "primary substep) or 'threads' (as hapticsimd's threads do: where a secondary "
+                  "runs at another rate in several substeps, the error the daemon's force has; "
+                  "docs/regions.md). The map says which")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"substeps", "threads"}));
   return {app, [o] { return Run(*o); }};
 }
 
