@@ -177,8 +177,8 @@ TEST(HapticsimCli, AdaptiveSimulateRunsWhatTheBareExchangeCannotHoldAndReportsTh
 
 // --order threads steps the virtual-time run as hapticsimd's threads step the regions. Where a
 // secondary runs at another rate in several substeps that is another force: ν 0.49, primary one
-// element deep at spacing 2, 600 Hz (the secondary in 2 substeps) — measured 2.43 % from the
-// reference in the error map's order and 37.9 % in the threads' (docs/regions.md, "Known").
+// element deep at spacing 2, 600 Hz (the secondary in 2 substeps) — measured 2.44 % from the
+// reference in the error map's order and 35.05 % in the threads' (docs/regions.md, "Known").
 TEST(HapticsimCli, SimulateInTheThreadsOrderShowsWhatTheMapsOrderDoesNot) {
   std::vector<std::string> args{"simulate",
                                 "--json",

@@ -16,6 +16,7 @@
 #include "tools/hapticsim/command.hpp"
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/scene_options.hpp"
+#include "tools/hapticsim/stepping_order_option.hpp"
 #include "tools/hapticsim/svg_plot.hpp"
 #include "tools/hapticsim/vtk_series.hpp"
 
@@ -29,7 +30,7 @@ struct SimulateOptions {
   bool allow_unstable = false;
   bool compare_reference = false;
   bool threads = false;
-  std::string order = "substeps";  // SteppingOrderNamed
+  SteppingOrder order = SteppingOrder::kSubsteps;  // the virtual-time run's
   std::string vtk_dir;
   double vtk_rate_hz = 30;
 };
@@ -208,7 +209,7 @@ int Run(const SimulateOptions& options) {
   const Scene scene = options.scene.Resolve();
   const bool adaptive = scene.adaptivity.enabled();
   AdaptiveReport report;
-  report.order = *SteppingOrderNamed(options.order);  // CLI::IsMember checked the name
+  report.order = options.order;
   TrialOptions trial_options;
   trial_options.run_if_predicted_unstable = options.allow_unstable;
   if (options.threads && !adaptive) {
@@ -333,7 +334,7 @@ int Run(const SimulateOptions& options) {
     if (adaptive) {
       std::cout << "  virtual time in the "
                 << (report.order == SteppingOrder::kThreads
-                        ? "threads' order (hapticsimd's: --order threads)"
+                        ? "threads' order (hapticsimd's)"
                         : "substeps' order (the error map's; hapticsimd's: --order threads)")
                 << "\n";
       for (const RegionReport& r : report.regions) {
@@ -450,14 +451,12 @@ Command AddSimulateCommand(CLI::App& parent) {
   app->add_flag("--threads", options->threads,
                 "Run the asynchronous regions on real threads (one per region, on real clocks) "
                 "and report deadlines and the difference from the virtual-time run (in --order)");
-  app->add_option("--order", options->order,
-                  "How the virtual-time run steps the regions: 'substeps' (the error map's "
-                  "order: the secondaries step before each primary substep) or 'threads' "
-                  "(hapticsimd's: each region's period of substeps at one wake, released ahead as "
-                  "its threads are; where a secondary runs at another rate in several substeps, "
-                  "the force the daemon renders)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"substeps", "threads"}));
+  AddSteppingOrderOption(
+      app, &options->order,
+      "How the virtual-time run steps the regions: 'substeps' (the error map's order: the "
+      "secondaries step before each primary substep) or 'threads' (hapticsimd's: each region's "
+      "period of substeps at one wake, released ahead as its threads are; where a secondary runs "
+      "at another rate in several substeps, the force the daemon renders)");
   app->add_option("--vtk", options->vtk_dir,
                   "Write the run as a VTK time series ParaView opens: DIR/adaptive.pvd and "
                   "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame of the "

@@ -12,6 +12,7 @@
 #include "tools/hapticsim/format.hpp"
 #include "tools/hapticsim/progress_line.hpp"
 #include "tools/hapticsim/scene_options.hpp"
+#include "tools/hapticsim/stepping_order_option.hpp"
 
 namespace hapticsim::cli {
 namespace {
@@ -30,7 +31,7 @@ struct SweepCommandOptions {
   std::string shard = "1/1";
   bool no_linearity = false;
   bool no_similarity = false;
-  std::string order = "substeps";  // SteppingOrderNamed
+  SteppingOrder order = SteppingOrder::kSubsteps;
 };
 
 std::pair<int, int> ParseShard(const std::string& text) {
@@ -78,7 +79,7 @@ int Run(const SweepCommandOptions& o) {
   options.shard_count = shard_count;
   options.use_linearity = !o.no_linearity;
   options.use_similarity = !o.no_similarity;
-  options.order = *SteppingOrderNamed(o.order);  // CLI::IsMember checked the name
+  options.order = o.order;
   options.journal_path = o.out + ".journal";
   options.resume = o.resume;
   options.stop = &g_stop;
@@ -170,13 +171,11 @@ Command AddSweepCommand(CLI::App& parent) {
   app->add_flag("--no-similarity", o->no_similarity,
                 "Run every material instead of deriving a material of the same E/ρ, ν, d and "
                 "contrast as an earlier one from it (its forces scaled by the density ratio)");
-  app->add_option("--order", o->order,
-                  "How the trials step the regions: 'substeps' (the secondaries before each "
-                  "primary substep) or 'threads' (as hapticsimd's threads do: where a secondary "
-                  "runs at another rate in several substeps, the error the daemon's force has; "
-                  "docs/regions.md). The map says which")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"substeps", "threads"}));
+  AddSteppingOrderOption(app, &o->order,
+                         "How the trials step the regions: 'substeps' (the secondaries before "
+                         "each primary substep) or 'threads' (as hapticsimd's threads do: where a "
+                         "secondary runs at another rate in several substeps, the error the "
+                         "daemon's force has; docs/regions.md). The map says which");
   return {app, [o] { return Run(*o); }};
 }
 
