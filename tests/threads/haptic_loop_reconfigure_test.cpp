@@ -7,6 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -32,8 +35,17 @@ Scene AdaptiveScene() {
   return scene;
 }
 
-TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplaced) {
-  const Scene scene = AdaptiveScene();
+// One run of the loop answering a hovering tool while its regions are replaced six times.
+struct ReplacementRun {
+  std::vector<ForceRecord> forces;
+  std::int64_t paused_periods = 0;
+  std::size_t dropped = 0;
+  // An answer is stamped when its period ends, at most (worst lateness + longest step) after its
+  // release: how far the stamps may lag the release grid, periods.
+  double stamp_delay_periods = 0;
+};
+
+ReplacementRun AnswerWhileReplacing(const Scene& scene) {
   HapticLoop loop(scene, HapticLoop::Options{});
   loop.Start();
   std::atomic<int> replaced{0};
@@ -57,7 +69,8 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
       ++replaced;
     }
   });
-  const auto forces = testing::PlayDevice(
+  ReplacementRun run;
+  run.forces = testing::PlayDevice(
       loop, 300,
       [](int) {
         return std::array<double, 3>{0.1, 0.1, -0.002};
@@ -65,22 +78,41 @@ TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplac
       [&] { return replaced == 6; });
   supervisor.join();
   loop.Stop();
-  EXPECT_GT(loop.paused_periods(), 0);
-  // One answer per release: the primary's release grid from the first answer to the last. An
-  // answer is stamped when its period ends, at most (worst lateness + longest step) after its
-  // release, so the span between the first and last stamps is the releases between them give or
-  // take that much. A stop and restart would lose at least 5 periods per reconfiguration, 30 here.
+  run.paused_periods = loop.paused_periods();
+  run.dropped = loop.forces().dropped();
+  const DeadlineSnapshot primary = loop.monitor(kPrimaryRegion).TakeSnapshot();
+  run.stamp_delay_periods =
+      (primary.worst_lateness_s + primary.recent_execution_max_s) / primary.period_s;
+  return run;
+}
+
+TEST(HapticLoopReconfigure, EveryPrimaryPeriodIsAnsweredWhileTheRegionsAreReplaced) {
+  // A primary that lagged 25 periods or more (a stall of the machine's: CI's have lasted 30 to
+  // 100 ms) leaves the count below too loose to tell a lost answer: run again, up to three times.
+  // Under a sanitizer every step is slower and the stamps lag 25 to 50 periods beside two busy
+  // threads: there the hand-over is what is checked, and a lost answer only where it shows.
+  ReplacementRun run;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    run = AnswerWhileReplacing(AdaptiveScene());
+    if (kSanitized || run.stamp_delay_periods < 25) break;
+    std::printf("attempt %d: the stamps lagged up to %.1f periods; again\n", attempt,
+                run.stamp_delay_periods);
+  }
+  EXPECT_GT(run.paused_periods, 0);
+  // One answer per release: the primary's release grid from the first answer to the last. The
+  // span between the first and last stamps is the releases between them give or take the stamps'
+  // lag. A stop and restart would lose at least 5 periods per reconfiguration, 30 here.
+  const std::vector<ForceRecord>& forces = run.forces;
   ASSERT_GT(forces.size(), 100u);
   const double span_periods = (forces.back().utime_us - forces.front().utime_us) / 1000.0;
-  const DeadlineSnapshot primary = loop.monitor(kPrimaryRegion).TakeSnapshot();
-  const double stamp_delay_periods =
-      (primary.worst_lateness_s + primary.recent_execution_max_s) / primary.period_s;
   EXPECT_NEAR(static_cast<double>(forces.size()) - 1, span_periods,
-              std::max(2.0, 0.005 * span_periods) + stamp_delay_periods)
-      << "answers lost or doubled across " << replaced << " reconfigurations (the stamps lag"
-      << " their releases by up to " << stamp_delay_periods << " periods)";
-  EXPECT_LT(stamp_delay_periods, 25) << "the primary lagged too far for the count to tell";
-  EXPECT_EQ(loop.forces().dropped(), 0u) << "the answer ring overflowed";
+              std::max(2.0, 0.005 * span_periods) + run.stamp_delay_periods)
+      << "answers lost or doubled across six reconfigurations (the stamps lag their releases by "
+      << "up to " << run.stamp_delay_periods << " periods)";
+  if (!kSanitized) {
+    EXPECT_LT(run.stamp_delay_periods, 25) << "the primary lagged too far for the count to tell";
+  }
+  EXPECT_EQ(run.dropped, 0u) << "the answer ring overflowed";
   for (size_t i = 1; i < forces.size(); ++i) ASSERT_GE(forces[i].seq, forces[i - 1].seq);
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cstdio>
 #include <functional>
 #include <thread>
@@ -63,10 +64,17 @@ TEST(IdleLoop, ParksTheSecondaryAnswersEveryInputAndWakesOnInputAndTouch) {
   // No device: once the input is stale the primary waits for input instead of running periods.
   EXPECT_TRUE(testing::PollUntil([&] { return loop.idle(); }));  // stale after 50 ms, then idle
   const std::int64_t primary_before = Cycles(loop, kPrimaryRegion);
+  const auto wait_began = Clock::now();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  // (Awake it would run 300 periods; idle, one per kIdleWait_s at most: 15.)
-  EXPECT_LE(Cycles(loop, kPrimaryRegion) - primary_before, 20);
-  EXPECT_GT(loop.primary_alive_ns(), HapticLoop::NowNs() - 100'000'000) << "no sign of life";
+  const double waited_ms =
+      std::chrono::duration<double, std::milli>(Clock::now() - wait_began).count();
+  // Awake it would run a period a millisecond; idle, one per kIdleWait_s (20 ms) at most, over
+  // however long this thread's sleep lasted (a busy machine oversleeps).
+  EXPECT_LE(Cycles(loop, kPrimaryRegion) - primary_before, waited_ms / 20 + 5)
+      << "in " << waited_ms << " ms";
+  // A sign of life at least every kIdleWait_s: within 5 of them (under a sanitizer, 25).
+  const std::int64_t alive_within_ns = kSanitized ? 500'000'000 : 100'000'000;
+  EXPECT_GT(loop.primary_alive_ns(), HapticLoop::NowNs() - alive_within_ns) << "no sign of life";
 
   // An input after the silence is answered at once, not at the idle primary's next look round.
   int prompt = 0;
@@ -152,9 +160,24 @@ TEST(IdleLoop, AfterAnIdleWaitTheAnswersAreReadOnTheGridItWentBackTo) {
       "before the wait)\n",
       after.size(), on_one_grid, in_stretches, before_the_wait);
   EXPECT_GT(on_one_grid, 250);
-  // A machine that wakes many late (CI's once woke two in three) makes as many late after the
-  // wait as before it, give or take.
-  EXPECT_LT(in_stretches, 75 + before_the_wait);
+  // Read in stretches, the answers after the wait are read on their own grid: as late as if they
+  // were all there was. (The loop flags the answers between the two drives stale; unflagged, the
+  // stretches would run together and the old grid would count again.)
+  std::vector<Wake> after_alone(read_in_stretches.end() - static_cast<std::ptrdiff_t>(after.size()),
+                                read_in_stretches.end());
+  const std::vector<bool> near_alone = NearALateWake(after_alone);
+  int late_alone = 0;
+  for (size_t i = 0; i < after_alone.size(); ++i) {
+    late_alone += !after_alone[i].input_stale && near_alone[i];
+  }
+  EXPECT_EQ(in_stretches, late_alone);
+  // And the loop went back on a grid at once, not running the periods it waited through back to
+  // back (~150 late from the wait on): a machine that wakes many late (CI's once woke two in
+  // three) makes as many late after the wait as before it, give or take. Not under a sanitizer,
+  // whose slower periods finish late in runs of their own (TSan once: 93 after, 0 before).
+  if (!kSanitized) {
+    EXPECT_LT(in_stretches, 75 + before_the_wait);
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 // hands across; in any build, each test checks what the protocol promises.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -83,11 +84,11 @@ TEST(InputHandoff, AFullRingStillDeliversTheNewestAndCountsWhatItDropped) {
 TEST(InputHandoff, ANudgeOrTheConditionEndsAWaitWithoutAnInput) {
   InputHandoff handoff;
   handoff.Drain([](const DeviceSample&) {});
+  std::int64_t start = MonotonicNowNs();  // before the nudger: it nudges 20 ms after this or later
   std::thread nudger([&] {
     std::this_thread::sleep_for(milliseconds(20));
     handoff.Nudge();
   });
-  std::int64_t start = MonotonicNowNs();
   handoff.WaitForArrival(2.0, [] { return false; });
   nudger.join();
   EXPECT_LT(SecondsSince(start), 1.0);
@@ -229,6 +230,7 @@ TEST(SecondaryParking, SecondariesParkOnlyOnceAllWereFoundAtRestAndEveryWakeRele
   std::array<std::int64_t, kSecondaries + 1> steps{};  // plain: each secondary's own state
   std::array<std::atomic<bool>, kSecondaries + 1> at_rest{};
   std::array<std::int64_t, kSecondaries + 1> woke_at{};  // plain: the last origin each saw
+  std::array<std::atomic<bool>, kSecondaries + 1> stepped_since_wake{};
   std::atomic<bool> stop{false};
   std::vector<std::thread> secondaries;
   for (int a = 1; a <= kSecondaries; ++a) {
@@ -240,6 +242,7 @@ TEST(SecondaryParking, SecondariesParkOnlyOnceAllWereFoundAtRestAndEveryWakeRele
           continue;
         }
         ++steps[a];
+        stepped_since_wake[a] = true;
         std::this_thread::sleep_for(microseconds(200));
       }
     });
@@ -272,9 +275,15 @@ TEST(SecondaryParking, SecondariesParkOnlyOnceAllWereFoundAtRestAndEveryWakeRele
     for (auto& count : steps) count = 0;
     std::this_thread::sleep_for(milliseconds(2));
     for (int a = 1; a <= kSecondaries; ++a) stepped_while_parked += steps[a] != 0;
+    for (auto& flag : stepped_since_wake) flag = false;
     parking.Wake(1000 + s);
     ASSERT_TRUE(wait_for([&] { return !parking.AllParked(kSecondaries); }));
-    std::this_thread::sleep_for(milliseconds(3));  // they step again
+    // They step again: each of them, however long the machine takes to run them.
+    EXPECT_TRUE(wait_for([&] {
+      return std::all_of(stepped_since_wake.begin() + 1, stepped_since_wake.end(),
+                         [](const std::atomic<bool>& stepped) { return stepped.load(); });
+    })) << "a secondary did not step after wake "
+        << s;
   }
   stop = true;
   parking.WakeAll();
