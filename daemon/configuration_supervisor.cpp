@@ -91,20 +91,34 @@ void ConfigurationSupervisor::ReportError() {
 }
 
 // Around the node the regions moved to, the configuration may miss the target that it met where
-// it was chosen (a box cut by the object's edge, a coarser neighbourhood): choose again for that
-// node, once per node. What is chosen switches like any other.
+// it was chosen (a box cut by the object's edge, a coarser neighbourhood), or, for a sliding tool,
+// miss it a node or two ahead (LookaheadNodes): choose again for that node, once per node. What
+// is chosen switches like any other.
 void ConfigurationSupervisor::ChooseForCentreIfMissed() {
   const LatticeIndex& node = loop_.centre_node();
-  if (reported_target_met_ || !decision_.have_map || !map_.map || pinned_ || chooser_.busy() ||
-      pending_ || chosen_for_nodes_.count(node)) {
+  if (!decision_.have_map || !map_.map || pinned_ || chooser_.busy() || pending_ ||
+      chosen_for_nodes_.count(node)) {
     return;
   }
-  spdlog::warn(
-      "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the target "
-      "{} %: choosing again for this node",
-      node[0], node[1], node[2], DescribeConfiguration(active()),
-      reported_error_ < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error_),
-      target_);
+  const int reach = LookaheadNodes(scene_);
+  if (reported_target_met_) {
+    if (reach == 0) return;
+    const NodeError ahead = LookupErrorAt(*map_.map, scene_, active(), node, reach);
+    if (ahead.usable && ahead.error_percent <= target_) return;
+    spdlog::info(
+        "within {} nodes of contact node ({}, {}, {}) the looked-up error of {} is {} against "
+        "the target {} %: choosing again before the tool slides there",
+        reach, node[0], node[1], node[2], DescribeConfiguration(active()),
+        ahead.usable ? fmt::format("{:.3g} %", ahead.error_percent) : std::string("unknown"),
+        target_);
+  } else {
+    spdlog::warn(
+        "around contact node ({}, {}, {}) the looked-up error of {} is {} % against the target "
+        "{} %: choosing again for this node",
+        node[0], node[1], node[2], DescribeConfiguration(active()),
+        reported_error_ < 0 ? std::string("unknown") : fmt::format("{:.3g}", reported_error_),
+        target_);
+  }
   StartChoice(std::nullopt);
 }
 

@@ -35,9 +35,11 @@ std::string BuildProblem(const Scene& scene) {
 }
 
 // The query for one configuration's error at the scene's point: the input frequency and
-// amplitude unknown (their worst case over the map).
+// amplitude unknown (their worst case over the map), and the contact node anywhere within
+// `reach_nodes` of the scene's along each axis (the worst case over the mapped nodes there; the
+// box is clipped to the map's nodes, so that only the scene's own node outside them is clamped).
 LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
-                               const RegionConfiguration& c) {
+                               const RegionConfiguration& c, int reach_nodes) {
   LookupQuery query = LookupQuery::At(at);
   query.lo[kLod] = query.hi[kLod] = c.secondary_lod;
   query.lo[kSize] = query.hi[kSize] = c.primary_size;
@@ -46,10 +48,19 @@ LookupQuery ConfigurationQuery(const ErrorMap& map, const MapPoint& at,
   query.lo[amplitude] = map.axes[amplitude].front();
   query.hi[amplitude] = map.axes[amplitude].back();
   query.frequency_known = false;
+  for (const MapAxis node_axis :
+       {MapAxis::kContactNodeX, MapAxis::kContactNodeY, MapAxis::kContactNodeZ}) {
+    const int a = static_cast<int>(node_axis);
+    const double node = at[a];
+    query.lo[a] = std::min(node, std::max(node - reach_nodes, map.axes[a].front()));
+    query.hi[a] = std::max(node, std::min(node + reach_nodes, map.axes[a].back()));
+  }
   return query;
 }
 
 }  // namespace
+
+int LookaheadNodes(const Scene& scene) { return UsesProxyContact(scene) ? kLookaheadNodes : 0; }
 
 RegionConfiguration AtEqualRates(const Scene& scene, RegionConfiguration configuration) {
   const double primary_hz = PrimaryRateHz(scene);
@@ -76,14 +87,15 @@ std::string DescribeContactNode(const LatticeIndex& node) {
 }
 
 NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
-                        const RegionConfiguration& configuration, const LatticeIndex& node) {
+                        const RegionConfiguration& configuration, const LatticeIndex& node,
+                        int reach_nodes) {
   NodeError out;
   if (!map.grid) return out;
   LookupResult result;
   try {  // a map the lookup cannot take (an axis of more than 64 values): no error, never a throw
     const ErrorLookup lookup(map, ErrorField::kMagnitude);
     result = lookup.Lookup(ConfigurationQuery(
-        map, PointOfScene(SceneWith(scene, configuration, node)), configuration));
+        map, PointOfScene(SceneWith(scene, configuration, node)), configuration, reach_nodes));
   } catch (const Error&) {
     return out;
   }
@@ -150,6 +162,7 @@ struct Candidate {
   RegionConfiguration configuration;
   double error = -1, cost = 0;
   bool clamped = false;
+  int reach_nodes = 0;  // the error is the worst within this many nodes of the contact node
 };
 
 // Mean measured cost of each configuration (secondary_lod, primary_size, secondary_rate) over the
@@ -168,10 +181,11 @@ std::map<std::array<double, 3>, double> MeanCosts(const ErrorMap& map) {
 }
 
 // Every configuration of the map usable at this scene (the pinned one only, when pinned) that
-// costs less than `below_cost_us_per_ms`, with its looked-up error and measured cost.
+// costs less than `below_cost_us_per_ms`, with its looked-up error (the worst within
+// `reach_nodes` of the contact node) and measured cost.
 std::vector<Candidate> MapCandidates(const Scene& scene, const ErrorMap& map,
                                      const std::optional<RegionConfiguration>& pinned,
-                                     double below_cost_us_per_ms) {
+                                     double below_cost_us_per_ms, int reach_nodes) {
   std::vector<Candidate> candidates;
   const ErrorLookup lookup(map, ErrorField::kMagnitude);
   const std::map<std::array<double, 3>, double> cost = MeanCosts(map);
@@ -181,12 +195,12 @@ std::vector<Candidate> MapCandidates(const Scene& scene, const ErrorMap& map,
       for (double rate : map.axes[kRate]) {
         const RegionConfiguration c{static_cast<int>(size), static_cast<int>(lod), rate};
         if (pinned && !(c == *pinned)) continue;
-        const LookupResult result = lookup.Lookup(ConfigurationQuery(map, at, c));
+        const LookupResult result = lookup.Lookup(ConfigurationQuery(map, at, c, reach_nodes));
         if (!result.usable()) continue;  // predicted unstable or diverged in the map
         const auto entry = cost.find({lod, size, rate});
         const double mean_cost = entry == cost.end() ? 1e9 : entry->second;
         if (!(mean_cost < below_cost_us_per_ms)) continue;
-        candidates.push_back({c, result.error, mean_cost, result.clamped});
+        candidates.push_back({c, result.error, mean_cost, result.clamped, reach_nodes});
       }
     }
   }
@@ -199,8 +213,12 @@ std::string ReasonFor(const Candidate& candidate, bool have_map, bool target_met
   std::ostringstream reason;
   reason << DescribeConfiguration(candidate.configuration);
   if (have_map) {
-    reason << ": looked-up error " << candidate.error << " % against the target "
-           << target_percent << " %" << (target_met ? "" : " (TARGET EXCEEDED)")
+    reason << ": looked-up error " << candidate.error << " %";
+    if (candidate.reach_nodes > 0) {
+      reason << " (the worst within " << candidate.reach_nodes << " nodes of the contact node)";
+    }
+    reason << " against the target " << target_percent << " %"
+           << (target_met ? "" : " (TARGET EXCEEDED)")
            << (candidate.clamped ? " (the scene is outside the map: clamped)" : "");
   } else {
     reason << ": no error map, the error is unknown";
@@ -219,7 +237,13 @@ SupervisorDecision ChooseConfiguration(const Scene& scene, const ErrorMap* map,
   // Only a map it can use: its lookup takes every axis and its configuration values are whole
   // numbers in range (they are cast to int).
   if (map && map->grid && MapProblem(scene, *map).empty()) {
-    candidates = MapCandidates(scene, *map, pinned, below_cost_us_per_ms);
+    // A sliding tool takes the regions on across the face: judged over the nodes ahead, and
+    // where nothing is usable over all of them, at the contact node alone.
+    const int reach = LookaheadNodes(scene);
+    candidates = MapCandidates(scene, *map, pinned, below_cost_us_per_ms, reach);
+    if (candidates.empty() && reach > 0) {
+      candidates = MapCandidates(scene, *map, pinned, below_cost_us_per_ms, 0);
+    }
   }
   if (candidates.empty() && capped) {
     throw Error("no usable configuration in the error map is cheaper than " +

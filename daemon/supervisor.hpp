@@ -52,13 +52,22 @@ struct SupervisorDecision {
 };
 
 /**
+ * Why the daemon cannot use a grid map with its scene, or "" when it can: the lookup must take
+ * every axis (at most ErrorLookup::kMaxAxisValues values), and every axis value must be one its
+ * scene key accepts (a primary size of 1e300 is no configuration). The message names the key.
+ * Scattered maps have no lookup and are left to ChooseConfiguration (it runs without them).
+ */
+std::string MapProblem(const Scene& scene, const ErrorMap& map);
+
+/**
  * Picks the cheapest configuration (by the map's measured cost) whose looked-up error meets
  * `target_percent`; when none does, the one with the least error, target_met = false. A
  * configuration the map measured unstable or diverged is never chosen. The error is looked up
  * for the scene's material and contact node (the daemon passes the node its regions are centred
- * on) with the input frequency and amplitude unknown (their worst case over the map). Without a
- * map: the scene's own configuration. A map with a MapProblem counts as none. `pinned`: only
- * that configuration.
+ * on) with the input frequency and amplitude unknown (their worst case over the map); for a
+ * sliding tool the worst over the mapped nodes within LookaheadNodes of it too, or, where no
+ * configuration is usable over all of them, at the node alone. Without a map: the scene's own
+ * configuration. A map with a MapProblem counts as none. `pinned`: only that configuration.
  *
  * Stability is not estimated (docs/regions.md, "Stable by construction"): every region steps
  * within its own limit (its substeps see to it), the interface controllers hold the coupling's
@@ -69,14 +78,6 @@ struct SupervisorDecision {
  * before accuracy, when the running one keeps missing them).
  * @throws Error when no candidate's regions can be built (or none is cheaper, with a ceiling).
  */
-/**
- * Why the daemon cannot use a grid map with its scene, or "" when it can: the lookup must take
- * every axis (at most ErrorLookup::kMaxAxisValues values), and every axis value must be one its
- * scene key accepts (a primary size of 1e300 is no configuration). The message names the key.
- * Scattered maps have no lookup and are left to ChooseConfiguration (it runs without them).
- */
-std::string MapProblem(const Scene& scene, const ErrorMap& map);
-
 SupervisorDecision ChooseConfiguration(
     const Scene& scene, const ErrorMap* map, double target_percent,
     const std::optional<RegionConfiguration>& pinned,
@@ -92,10 +93,25 @@ struct NodeError {
 /**
  * Looks up `configuration`'s error with the regions centred on `node`, the input unknown as in
  * ChooseConfiguration: between mapped contact nodes the error is interpolated, beyond them it is
- * the nearest edge's, flagged clamped. Does not throw (a map it cannot look up: not usable).
+ * the nearest edge's, flagged clamped. `reach_nodes` > 0: the worst over the mapped nodes within
+ * that many of `node` along each axis, as well (LookaheadNodes). Does not throw (a map it cannot
+ * look up: not usable).
  */
 NodeError LookupErrorAt(const ErrorMap& map, const Scene& scene,
-                        const RegionConfiguration& configuration, const LatticeIndex& node);
+                        const RegionConfiguration& configuration, const LatticeIndex& node,
+                        int reach_nodes = 0);
+
+/**
+ * How far ahead of the contact node, in nodes along each axis, a configuration is judged: a
+ * sliding tool takes the regions on across the face node by node (ProxyWantsPrimaryAt), and a
+ * configuration chosen for the node under it alone is, a node or two on, one the map calls
+ * diverged or over the target there (the phantom's map: 4 of 6 configurations diverged or over
+ * 2 % somewhere along the stroked row). Judged over the nodes ahead, a choice lasts while the
+ * tool slides, and the next is made before the regions reach what the map says they cannot do.
+ * A tool that sticks to its node: 0.
+ */
+inline constexpr int kLookaheadNodes = 2;
+int LookaheadNodes(const Scene& scene);
 
 /** The scene with `configuration` as its adaptivity. */
 Scene SceneWith(const Scene& scene, const RegionConfiguration& configuration);

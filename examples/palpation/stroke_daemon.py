@@ -9,7 +9,7 @@ seconds), so each answer says how wrong its force is and the supervisor keeps th
 the map says they are right.
 
 Usage: stroke_daemon.py [--hapticsim PATH] [--hapticsimd PATH] [--scene FILE.toml] [--out DIR]
-                        [--no-map]
+                        [--no-map] [--order substeps|threads]
 
 Writes DIR/stroke-daemon.csv (the tool's x in mm, the normal and the lateral force on the user in N,
 one row per answer in contact while sliding, from the second stroke on: the first starts with the
@@ -77,11 +77,13 @@ def daemon_scene(hapticsim, scene, out):
         return path, tomllib.load(f)["input"]["amplitude"]
 
 
-def make_map(hapticsim, scene, out):
-    """The error map of `scene` over MAP_GRID (hapticsim sweep; a few seconds), in `out`."""
+def make_map(hapticsim, scene, out, order="substeps"):
+    """The error map of `scene` over MAP_GRID (hapticsim sweep, the regions stepped in `order`; a
+    few seconds), in `out`."""
     path = os.path.join(out, "stroke.hsmap")
     print("stroke_daemon: making its error map (%s) ..." % MAP_GRID, file=sys.stderr)
-    run([hapticsim, "sweep", "--scene", scene, "--grid", MAP_GRID, "--out", path],
+    run([hapticsim, "sweep", "--scene", scene, "--grid", MAP_GRID, "--order", order, "--out",
+         path],
         "hapticsim sweep", "\n(its grid is %s, made for the phantom's front row of nodes; "
         "--no-map serves without a map)" % MAP_GRID)
     return path
@@ -136,7 +138,7 @@ def slides(trace):
 def main():
     args = parse_args(__doc__, "stroke-daemon-out", daemon=True)
     scene, amplitude = daemon_scene(args.hapticsim, args.scene, args.out)
-    error_map = "" if args.no_map else make_map(args.hapticsim, scene, args.out)
+    error_map = "" if args.no_map else make_map(args.hapticsim, scene, args.out, args.order)
     socket = os.path.join(tempfile.mkdtemp(prefix="hsim-"), "hapticsimd.sock")
     daemon, log = start_daemon(args.hapticsimd, scene, args.out, socket, error_map)
     trace = os.path.join(args.out, "stroke-daemon-trace.csv")
@@ -178,12 +180,15 @@ def main():
     with open(log) as f:
         text = f.read()
     moves = text.count("regions centred on contact node")
-    # The secondary rates the daemon ran, in order: its start's, then each it switched to.
+    # The configurations the daemon ran, in order: its start's, then each it switched to, as
+    # [primary_size, secondary_rate_Hz]; and the secondary rates alone.
+    configurations = [[int(size), int(rate)] for size, rate in re.findall(
+        r"(?:info configuration|reconfigured): primary_size (\d+), secondary_lod \d+, "
+        r"secondary_rate (\d+) Hz", text)]
     rates = []
-    for rate in re.findall(r"(?:info configuration|reconfigured): primary_size \d+, "
-                           r"secondary_lod \d+, secondary_rate (\d+) Hz", text):
-        if not rates or rates[-1] != int(rate):  # a switch of the primary's size alone
-            rates.append(int(rate))
+    for _, rate in configurations:
+        if not rates or rates[-1] != rate:  # a switch of the primary's size alone
+            rates.append(rate)
     plain = (at(15.0) + at(65.0)) / 2
     known = [error for _, _, _, error, _ in points if error >= 0]
     # An answer without an error says why in its flags: no map (32), or none for where the regions
@@ -201,6 +206,7 @@ def main():
                       "answers_error_unknown": len(points) - len(known),
                       "answers_error_unknown_unflagged": len(unexplained),
                       "secondary_rates_hz_run": rates,
+                      "configurations_run": configurations,
                       "csv": csv_path, "plot": plot},
                      indent=2))
 

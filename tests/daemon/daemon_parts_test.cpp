@@ -597,6 +597,70 @@ TEST(Supervisor, TheErrorFollowsTheContactNodeBetweenMappedNodesAndIsFlaggedBeyo
   EXPECT_TRUE(LookupErrorAt(map, scene, c, {4, 4, 0}).usable);  // weight 0 on the unstable one
 }
 
+// A sliding tool takes the regions on across the face: a configuration is judged over the mapped
+// nodes within LookaheadNodes of the contact node, not the node alone. The map: one primary size,
+// a cheap 500 Hz secondary that diverged two nodes along x, and a dearer 1000 Hz one usable on
+// all three mapped nodes.
+TEST(Supervisor, ASlidingToolsConfigurationIsJudgedOverTheNodesAheadOfIt) {
+  Scene scene;
+  scene.mesh.nodes = 9;  // middle of the front face: (4, 4, 0)
+  scene.adaptivity.primary_size = 3;
+  std::array<std::vector<double>, kNumMapAxes> axes;
+  const MapPoint at = PointOfScene(scene);
+  for (int a = 0; a < kNumMapAxes; ++a) axes[a] = {at[a]};
+  constexpr int kRate = static_cast<int>(MapAxis::kSecondaryRate);
+  constexpr int kNodeX = static_cast<int>(MapAxis::kContactNodeX);
+  axes[static_cast<int>(MapAxis::kSecondaryLod)] = {2};
+  axes[static_cast<int>(MapAxis::kPrimarySize)] = {3};
+  axes[kRate] = {500, 1000};
+  axes[kNodeX] = {2, 4, 6};
+  ErrorMap map = ErrorMap::MakeGrid(axes);
+  ASSERT_EQ(map.samples.size(), 6u);
+  for (MapSample& sample : map.samples) {
+    const bool cheap = sample.point[kRate] == 500;
+    sample.status =
+        cheap && sample.point[kNodeX] == 6 ? SampleStatus::kDiverged : SampleStatus::kOk;
+    sample.max_magnitude_percent = cheap ? 1.0 : 1.5;
+    sample.cost_us_per_ms = {10, cheap ? 10.0 : 20.0, 0, 0};
+  }
+  const RegionConfiguration cheap{3, 2, 500};
+  const RegionConfiguration dear{3, 2, 1000};
+
+  // The tool sticking to its node: the node alone, the cheap one.
+  EXPECT_EQ(LookaheadNodes(scene), 0);
+  EXPECT_EQ(ChooseConfiguration(scene, &map, 2.0, std::nullopt).configuration, cheap);
+
+  // Sliding: the cheap one diverged two nodes on, so the dear one, its error the worst ahead.
+  scene.contact.model = ContactModel::kProxy;
+  ASSERT_EQ(LookaheadNodes(scene), 2);
+  const SupervisorDecision sliding = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
+  EXPECT_EQ(sliding.configuration, dear);
+  EXPECT_DOUBLE_EQ(sliding.error_percent, 1.5);
+  EXPECT_FALSE(sliding.clamped) << "the look ahead is clipped to the mapped nodes";
+  EXPECT_NE(sliding.reason.find("within 2 nodes"), std::string::npos) << sliding.reason;
+  EXPECT_TRUE(LookupErrorAt(map, scene, cheap, {4, 4, 0}).usable);
+  EXPECT_FALSE(LookupErrorAt(map, scene, cheap, {4, 4, 0}, 2).usable);
+  EXPECT_FALSE(LookupErrorAt(map, scene, cheap, {3, 4, 0}, 2).usable) << "x = 5: half x = 6's";
+  EXPECT_TRUE(LookupErrorAt(map, scene, cheap, {3, 4, 0}, 1).usable) << "x = 2 to 4";
+
+  // At the map's end the nodes ahead are x = 2 to 4 (x = 0 and 1 are not mapped: not clamped):
+  // the cheap one again.
+  scene.input.contact_node = LatticeIndex{2, 4, 0};
+  const SupervisorDecision at_the_end = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
+  EXPECT_EQ(at_the_end.configuration, cheap);
+  EXPECT_FALSE(at_the_end.clamped);
+
+  // Where no configuration is usable over all the nodes ahead, the node alone decides.
+  for (MapSample& sample : map.samples) {
+    if (sample.point[kNodeX] == 6) sample.status = SampleStatus::kDiverged;
+  }
+  scene.input.contact_node = LatticeIndex{4, 4, 0};
+  const SupervisorDecision nothing_ahead = ChooseConfiguration(scene, &map, 2.0, std::nullopt);
+  EXPECT_EQ(nothing_ahead.configuration, cheap);
+  EXPECT_TRUE(nothing_ahead.have_map);
+  EXPECT_EQ(nothing_ahead.reason.find("within"), std::string::npos) << nothing_ahead.reason;
+}
+
 }  // namespace
 }  // namespace hapticsim
 
