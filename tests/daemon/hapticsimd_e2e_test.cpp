@@ -41,6 +41,7 @@
 #include "tests/support/daemon_harness.hpp"
 #include "tests/support/fake_systemd.hpp"
 #include "tests/support/late_wakes.hpp"
+#include "tests/support/poll_until.hpp"
 #include "tests/support/private_socket.hpp"
 #include "tests/support/run_command.hpp"
 
@@ -677,8 +678,10 @@ TEST(HapticsimdReload, ACorruptMapOnReloadIsRefusedAndTheDaemonKeepsServing) {
   const status_t before_reload = *client.LastStatus();
   std::ofstream(config) << "[supervisor]\nerror_map = \"" << map << "\"\nerror_target = 3\n";
   daemon.Signal(SIGHUP);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  EXPECT_NE(daemon.Log().find("config reload refused"), std::string::npos) << daemon.Log();
+  EXPECT_TRUE(testing::PollUntil(
+      [&] { return daemon.Log().find("config reload refused") != std::string::npos; },
+      std::chrono::seconds(5)))
+      << daemon.Log();
   EXPECT_EQ(client.LastStatus()->error_target_percent, before_reload.error_target_percent);
   EXPECT_EQ(client.LastStatus()->error_map, before_reload.error_map);
   EXPECT_EQ(client.LastStatus()->error_percent, error) << "the refused config changed the map";
@@ -837,7 +840,11 @@ TEST(HapticsimdCommands, AFloodOfPinsMakesNoThreadAndTheDaemonStopsWithinTwoSeco
   // device inputs sent beside them stand for what arrives, with 5 % of room for the commands'
   // larger packets (measured: 1,988 refused, 2,000 inputs received; with the rate limit's
   // refusals uncounted, 1,744).
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a status after the flood
+  // A status after the flood (one each 200 ms): up to 5 s for the counts to agree, then read.
+  auto refused_all_but_the_allowed = [](const status_t& s) {
+    return s.commands_refused >= 0.95 * static_cast<double>(s.inputs_received) - 30;
+  };
+  client.WaitForStatus(refused_all_but_the_allowed, 5);
   const status_t flooded = *client.LastStatus();
   EXPECT_GE(flooded.commands_refused, 0.95 * static_cast<double>(flooded.inputs_received) - 30)
       << flooded.commands_refused << " commands refused of about " << flooded.inputs_received
