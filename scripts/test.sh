@@ -26,8 +26,10 @@ echo "== AddressSanitizer + UndefinedBehaviorSanitizer: the suite (build-asan/, 
 # in Release; the sharded sweep), covered by the Release run.
 # The portable baseline without dispatch (none under a sanitizer): the kernels' x86-64-v2 code,
 # which the Release build above never runs on a CPU with AVX2, is tested here.
+# No benchmarks: no test runs them, and a sanitized one measures the sanitizer.
 CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -G Ninja \
   -DHAPTICSIM_SANITIZE=address,undefined -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DHAPTICSIM_BUILD_BENCHMARKS=OFF \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" >/dev/null
 cmake --build "$root/build-asan"
 (cd "$root/build-asan" && ctest --output-on-failure -j"$(nproc)" -LE 'threads|soak|stress|timing|mpi' \
