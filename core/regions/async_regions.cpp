@@ -127,6 +127,7 @@ AsyncRegions::AsyncRegions(const Scene& scene, double substep_safety, InterfaceC
     regions_.push_back(std::move(region));
   }
   BuildSurface();
+  SetSteppingOrder(stepping_order_);  // the threads' release leads, whichever order runs
   Reset();
 }
 
