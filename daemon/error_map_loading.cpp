@@ -71,6 +71,15 @@ std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Sce
   return map;
 }
 
+std::string MapOrderWarning(const std::string& path, const ErrorMap& map) {
+  if (map.provenance.stepping_order != "substeps") return "";
+  return "error map " + path +
+         " was swept in the substeps' order, which hapticsimd's threads do not run: where a "
+         "secondary region runs at another rate in several substeps, its errors can be far below "
+         "the force's (docs/regions.md). Sweep it again with hapticsim sweep, which steps the "
+         "threads' order by default";
+}
+
 MapState LoadMap(const std::string& path, const Scene& scene, bool reload) {
   MapState state{path, nullptr};
   if (path.empty()) return state;
@@ -81,6 +90,9 @@ MapState LoadMap(const std::string& path, const Scene& scene, bool reload) {
         "order",
         path, state.map->samples.size(), state.map->provenance.grid,
         state.map->provenance.code_version, state.map->provenance.stepping_order);
+    if (const std::string warning = MapOrderWarning(path, *state.map); !warning.empty()) {
+      spdlog::warn("{}", warning);
+    }
   } catch (const Error& e) {
     spdlog::error("{}; {}", e.what(),
                   reload ? "keeping the map loaded before"

@@ -43,9 +43,10 @@ struct SweepOptions {
       true;  ///< materials of equal E/ρ, ν, d, contrast: run once, force scaled by ρ
   std::string journal_path;                 ///< completed tasks are appended here ("" = none)
   bool resume = false;                      ///< read the journal first and skip what it holds
-  /** How the trials step the regions: the substeps' order, or hapticsimd's threads' (maps made
-   *  in either say which: ErrorMap::Provenance::stepping_order). */
-  SteppingOrder order = SteppingOrder::kSubsteps;
+  /** How the trials step the regions: hapticsimd's threads' order by default, so the map's
+   *  errors are those of the force the daemon renders; or the substeps' order, the regions' own
+   *  (maps made in either say which: ErrorMap::Provenance::stepping_order). */
+  SteppingOrder order = SteppingOrder::kThreads;
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after current tasks
   std::function<void(const SweepProgress&)> progress;
   double progress_interval_s = 0.5;

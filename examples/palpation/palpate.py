@@ -80,7 +80,7 @@ def parse_args(doc, out, daemon=False):
                             "daemon/hapticsimd")
         parser.add_argument("--no-map", action="store_true",
                             help="serve without an error map (the error is then unknown, -1)")
-        parser.add_argument("--order", choices=["substeps", "threads"], default="substeps",
+        parser.add_argument("--order", choices=["threads", "substeps"], default="threads",
                             help="the order the map's sweep steps the regions in (hapticsim sweep "
                             "--order; threads: as hapticsimd's threads do)")
     parser.add_argument("--scene", default=os.path.join(HERE, "palpation.toml"))

@@ -77,7 +77,7 @@ def daemon_scene(hapticsim, scene, out):
         return path, tomllib.load(f)["input"]["amplitude"]
 
 
-def make_map(hapticsim, scene, out, order="substeps"):
+def make_map(hapticsim, scene, out, order="threads"):
     """The error map of `scene` over MAP_GRID (hapticsim sweep, the regions stepped in `order`; a
     few seconds), in `out`."""
     path = os.path.join(out, "stroke.hsmap")

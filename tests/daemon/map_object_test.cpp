@@ -96,5 +96,27 @@ TEST(MapObject, OtherSupportsOrMaterialLabelsAreRefused) {
             std::string::npos);
 }
 
+// A map swept in the substeps' order measured an exchange the daemon's threads do not run: the
+// daemon says so and how to sweep it again, and keeps using it (it is the user's, and most of its
+// configurations are the same in both orders). A map of the threads' order draws no warning; so
+// does none that a file without the key (made before the order was recorded) would not.
+TEST(MapObject, AMapOfTheSubstepsOrderIsTakenWithAWarning) {
+  const Scene scene;
+  ErrorMap substeps = MapMadeFor(scene, scene);
+  substeps.provenance.stepping_order = "substeps";
+  const std::string path = Temp("substeps.hsmap");
+  SaveErrorMap(substeps, path);
+  const std::string warning = MapOrderWarning(path, substeps);
+  EXPECT_NE(warning.find(path + " was swept in the substeps' order"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("Sweep it again with hapticsim sweep"), std::string::npos) << warning;
+  const MapState loaded = LoadMap(path, scene);
+  ASSERT_NE(loaded.map, nullptr) << "a map of the substeps' order was refused";
+  EXPECT_EQ(loaded.map->provenance.stepping_order, "substeps");
+
+  ErrorMap threads = substeps;
+  threads.provenance.stepping_order = "threads";
+  EXPECT_EQ(MapOrderWarning(path, threads), "");
+}
+
 }  // namespace
 }  // namespace hapticsim

@@ -137,25 +137,26 @@ TEST(ErrorMapCli, ADamagedMapIsRefusedWithAMessageThatSaysHow) {
   EXPECT_NE(result.err.find("truncated"), std::string::npos) << result.err;
 }
 
-// A map made in hapticsimd's threads' order (sweep --order threads) says so, its results differ
-// where a secondary runs at another rate in several substeps (ν 0.49 here), and it does not merge
-// with a shard of the substeps' order.
+// A map is swept in hapticsimd's threads' order unless asked for the substeps' (sweep --order
+// substeps); each says which, their results differ where a secondary runs at another rate in
+// several substeps (ν 0.49 here), and one does not merge with a shard of the other order.
 TEST(ErrorMapCli, AMapSweptInTheThreadsOrderSaysSoAndMergesOnlyWithItsOwnOrder) {
-  const std::string threads = Temp("threads.hsmap"), shard = Temp("threads-shard.hsmap");
-  const nlohmann::json& substeps = FullSweep();  // writes full.hsmap (each test is a process)
-  ASSERT_EQ(Hapticsim(SweepArgs(threads, {"--order", "threads"})).exit_status, 0);
-  const auto info = Json(Hapticsim({"map", "info", threads, "--json"}));
+  const std::string substeps = Temp("substeps.hsmap"), shard = Temp("threads-shard.hsmap");
+  const nlohmann::json& threads = FullSweep();  // writes full.hsmap (each test is a process)
+  ASSERT_EQ(Hapticsim(SweepArgs(substeps, {"--order", "substeps"})).exit_status, 0);
+  const auto info = Json(Hapticsim({"map", "info", Temp("full.hsmap"), "--json"}));
   EXPECT_EQ(info["stepping_order"], "threads");
-  EXPECT_EQ(Json(Hapticsim({"map", "info", Temp("full.hsmap"), "--json"}))["stepping_order"],
-            "substeps");
+  const auto other = Json(Hapticsim({"map", "info", substeps, "--json"}));
+  EXPECT_EQ(other["stepping_order"], "substeps");
   EXPECT_EQ(info["not_computed"], 0);
-  EXPECT_NE(info["results_checksum"], substeps["results_checksum"]);
-  const std::string text = Hapticsim({"map", "info", threads}).out;
+  EXPECT_EQ(info["results_checksum"], threads["results_checksum"]);
+  EXPECT_NE(other["results_checksum"], threads["results_checksum"]);
+  const std::string text = Hapticsim({"map", "info", Temp("full.hsmap")}).out;
   EXPECT_NE(text.find("regions stepped in the threads' order"), std::string::npos) << text;
 
-  ASSERT_EQ(Hapticsim(SweepArgs(shard, {"--shard", "2/2", "--order", "threads"})).exit_status, 0);
+  ASSERT_EQ(Hapticsim(SweepArgs(shard, {"--shard", "2/2"})).exit_status, 0);
   const std::string first = Temp("substeps-shard.hsmap");
-  ASSERT_EQ(Hapticsim(SweepArgs(first, {"--shard", "1/2"})).exit_status, 0);
+  ASSERT_EQ(Hapticsim(SweepArgs(first, {"--shard", "1/2", "--order", "substeps"})).exit_status, 0);
   const CommandResult merged = Hapticsim({"map", "merge", Temp("mixed.hsmap"), first, shard});
   EXPECT_EQ(merged.exit_status, 2);
   EXPECT_NE(merged.err.find("threads' order"), std::string::npos) << merged.err;

@@ -30,7 +30,7 @@ struct SimulateOptions {
   bool allow_unstable = false;
   bool compare_reference = false;
   bool threads = false;
-  SteppingOrder order = SteppingOrder::kSubsteps;  // the virtual-time run's
+  SteppingOrder order = SteppingOrder::kThreads;  // the virtual-time run's: hapticsimd's
   std::string vtk_dir;
   double vtk_rate_hz = 30;
 };
@@ -96,7 +96,7 @@ struct AdaptiveReport {
   std::vector<std::optional<DeadlineStats>> deadlines;  // per region, with --threads
   std::optional<ForceError> threaded_vs_virtual;
   std::optional<std::size_t> stroke_moves;  // a stroke: how often the primary followed the proxy
-  SteppingOrder order = SteppingOrder::kSubsteps;  // the virtual-time run's
+  SteppingOrder order = SteppingOrder::kThreads;  // the virtual-time run's: hapticsimd's
 };
 
 nlohmann::json DeadlineJson(const DeadlineStats& d) {
@@ -334,8 +334,8 @@ int Run(const SimulateOptions& options) {
     if (adaptive) {
       std::cout << "  virtual time in the "
                 << (report.order == SteppingOrder::kThreads
-                        ? "threads' order (hapticsimd's)"
-                        : "substeps' order (the error map's; hapticsimd's: --order threads)")
+                        ? "threads' order (hapticsimd's, and the error map's by default)"
+                        : "substeps' order (not hapticsimd's: --order threads)")
                 << "\n";
       for (const RegionReport& r : report.regions) {
         std::cout << "  " << r.name << " region: " << r.nodes << " nodes, " << r.elements
@@ -453,10 +453,11 @@ Command AddSimulateCommand(CLI::App& parent) {
                 "and report deadlines and the difference from the virtual-time run (in --order)");
   AddSteppingOrderOption(
       app, &options->order,
-      "How the virtual-time run steps the regions: 'substeps' (the error map's order: the "
-      "secondaries step before each primary substep) or 'threads' (hapticsimd's: each region's "
-      "period of substeps at one wake, released ahead as its threads are; where a secondary runs "
-      "at another rate in several substeps, the force the daemon renders)");
+      "How the virtual-time run steps the regions: 'threads' (hapticsimd's, and the error map's "
+      "by default: each region's period of substeps at one wake, released ahead as its threads "
+      "are; the force the daemon renders) or 'substeps' (the secondaries step before each "
+      "primary substep: where a secondary runs at another rate in several substeps, an exchange "
+      "the daemon does not run)");
   app->add_option("--vtk", options->vtk_dir,
                   "Write the run as a VTK time series ParaView opens: DIR/adaptive.pvd and "
                   "DIR/reference.pvd (an adaptive scene writes both), one .vtu per frame of the "

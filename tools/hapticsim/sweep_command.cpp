@@ -31,7 +31,7 @@ struct SweepCommandOptions {
   std::string shard = "1/1";
   bool no_linearity = false;
   bool no_similarity = false;
-  SteppingOrder order = SteppingOrder::kSubsteps;
+  SteppingOrder order = SteppingOrder::kThreads;  // hapticsimd's, whose force the map judges
 };
 
 std::pair<int, int> ParseShard(const std::string& text) {
@@ -172,10 +172,11 @@ Command AddSweepCommand(CLI::App& parent) {
                 "Run every material instead of deriving a material of the same E/ρ, ν, d and "
                 "contrast as an earlier one from it (its forces scaled by the density ratio)");
   AddSteppingOrderOption(app, &o->order,
-                         "How the trials step the regions: 'substeps' (the secondaries before "
-                         "each primary substep) or 'threads' (as hapticsimd's threads do: where a "
-                         "secondary runs at another rate in several substeps, the error the "
-                         "daemon's force has; docs/regions.md). The map says which");
+                         "How the trials step the regions: 'threads' (as hapticsimd's threads do, "
+                         "so the map holds the error of the force the daemon renders) or "
+                         "'substeps' (the secondaries before each primary substep: where a "
+                         "secondary runs at another rate in several substeps, an exchange the "
+                         "daemon does not run; docs/regions.md). The map says which");
   return {app, [o] { return Run(*o); }};
 }
 
