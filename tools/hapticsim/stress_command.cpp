@@ -58,10 +58,11 @@ struct SupervisorCheck {
 
 // The supervisor no longer estimates stability (docs/regions.md, "Stable by construction"), so
 // what it chose is run here as the daemon runs it: production substeps, interface controllers and
-// runaway watch on, from the case's random start under its input for 2 s. It must end within the
-// energy balance the controllers guarantee (the same check as the case's own run), or be ended by
-// the runaway watch — which the daemon answers by taking the regions to equal rates. Diverging
-// any other way, or keeping more energy than the balance allows, is a failure ("" when none).
+// runaway watch on, the regions stepped in the order hapticsimd's threads step them, from the
+// case's random start under its input for 2 s. It must end within the energy balance the
+// controllers guarantee (the same check as the case's own run), or be ended by the runaway watch —
+// which the daemon answers by taking the regions to equal rates. Diverging any other way, or
+// keeping more energy than the balance allows, is a failure ("" when none).
 struct GuardedRun {
   bool runaway = false;
   std::string problem;
@@ -69,6 +70,7 @@ struct GuardedRun {
 GuardedRun RunAsTheDaemonRunsIt(const Scene& scene, unsigned state_seed) {
   GuardedRun out;
   AsyncRegions regions(scene, AsyncRegions::kSubstepSafety);
+  regions.SetSteppingOrder(SteppingOrder::kThreads);
   InputSettings input = scene.input;
   input.periods = 2.0 * input.frequency_hz;
   StressOutcome as_run;  // its energy_balance_violated() is the case's own check
@@ -458,7 +460,7 @@ int Run(const StressOptions& o) {
         << "    region reported is past its limit: " << region_is_past_limit << " of "
         << past_limit_diverged << "\n"
         << "  supervisor decisions        " << choices
-        << ", run as the daemon runs them: " << chose_unstable
+        << ", run as the daemon runs them (its threads' order): " << chose_unstable
         << " broke the energy balance unguarded, " << runaways
         << " ended by the runaway watch (the daemon takes those to equal rates); pinned "
            "refused "
@@ -516,7 +518,7 @@ Command AddStressCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--supervisor-every", options->supervisor_every,
                   "Ask the supervisor to choose for every Nth case only (each choice is run as "
-                  "the daemon runs it, 2 s of simulated time)")
+                  "the daemon runs it, in its threads' order, 2 s of simulated time)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app->add_flag("--faults", options->faults,
