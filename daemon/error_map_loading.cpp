@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/errormap/error_map_file.hpp"
+#include "core/regions/stepping_order.hpp"
 #include "core/scene/scene_toml.hpp"
 #include "daemon/supervisor.hpp"
 
@@ -72,7 +73,7 @@ std::shared_ptr<const ErrorMap> LoadUsableMap(const std::string& path, const Sce
 }
 
 std::string MapOrderWarning(const std::string& path, const ErrorMap& map) {
-  if (map.provenance.stepping_order != "substeps") return "";
+  if (map.provenance.stepping_order != SteppingOrderName(SteppingOrder::kSubsteps)) return "";
   return "error map " + path +
          " was swept in the substeps' order, which hapticsimd's threads do not run: where a "
          "secondary region runs at another rate in several substeps, its errors can be far below "

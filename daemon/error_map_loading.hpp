@@ -27,8 +27,8 @@ std::string MapObjectProblem(const Scene& scene, const ErrorMap& map);
  * What the daemon warns of a map swept in the substeps' order ("" for one swept in the threads'
  * order, the daemon's). Its trials stepped an exchange the daemon's threads do not run: where a
  * secondary runs at another rate in several substeps its errors can be far below the force's
- * (docs/regions.md: 2.4 % in the map, 35 % on the threads). Such a map is still used, not refused:
- * it is the user's, and most of its configurations are the same in both orders.
+ * (docs/regions.md: 2.4 % in that order, 35 % in the threads'). Such a map is still used, not
+ * refused: it is the user's, and most of its configurations are the same in both orders.
  */
 std::string MapOrderWarning(const std::string& path, const ErrorMap& map);
 

@@ -98,8 +98,7 @@ TEST(MapObject, OtherSupportsOrMaterialLabelsAreRefused) {
 
 // A map swept in the substeps' order measured an exchange the daemon's threads do not run: the
 // daemon says so and how to sweep it again, and keeps using it (it is the user's, and most of its
-// configurations are the same in both orders). A map of the threads' order draws no warning; so
-// does none that a file without the key (made before the order was recorded) would not.
+// configurations are the same in both orders). A map of the threads' order draws no warning.
 TEST(MapObject, AMapOfTheSubstepsOrderIsTakenWithAWarning) {
   const Scene scene;
   ErrorMap substeps = MapMadeFor(scene, scene);

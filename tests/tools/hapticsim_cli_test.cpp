@@ -180,7 +180,7 @@ TEST(HapticsimCli, AdaptiveSimulateRunsWhatTheBareExchangeCannotHoldAndReportsTh
 // force: ν 0.49, primary one element deep at spacing 2, 600 Hz (the secondary in 2 substeps) —
 // measured 2.44 % from the reference in the substeps' order and 35.05 % in the threads'
 // (docs/regions.md, "Known"): the default reports the daemon's error, not the lower one.
-TEST(HapticsimCli, SimulateInTheThreadsOrderShowsWhatTheMapsOrderDoesNot) {
+TEST(HapticsimCli, SimulateStepsTheThreadsOrderUnlessAskedForTheSubsteps) {
   std::vector<std::string> args{"simulate",
                                 "--json",
                                 "--compare-reference",
